@@ -1,0 +1,21 @@
+//! Glint's renderer: geometry, BVH, materials, lights, cameras, integrators and the render
+//! loop. It does no I/O and never prints; `glint-io` builds its `Scene` from scene files.
+
+pub mod bvh;
+pub mod camera;
+pub mod geometry;
+pub mod light;
+pub mod material;
+pub mod math;
+pub mod ray;
+pub mod scene;
+pub mod texture;
+
+pub use camera::{Camera, Projection};
+pub use geometry::{Aabb, Shape};
+pub use light::Light;
+pub use material::{Material, MaterialId};
+pub use math::{Basis, Color, Matrix4, Transform, Vec3};
+pub use ray::Ray;
+pub use scene::{Background, GeometryDesc, Hit, Instance, Scene, SceneParts, SurfaceInteraction};
+pub use texture::{ColorSource, CubeMap, Image, TextureId};

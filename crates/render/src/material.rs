@@ -1,0 +1,69 @@
+//! Materials: the course's shaders as one closed enum.
+
+use crate::math::Color;
+use crate::texture::ColorSource;
+
+/// Index of a `Material` in `Scene::materials`.
+pub type MaterialId = u32;
+
+/// A surface's response to light. Each variant is one course shader (FORMAT.md 2.5, 4); the
+/// course integrator evaluates them with the lecture's formulas.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Material {
+    /// `<shader type="Lambertian">`: kd ⊙ I · max(0, n·l) per light.
+    Lambertian { diffuse: ColorSource },
+    /// `<shader type="BlinnPhong">`: Lambertian plus ks ⊙ I · max(0, n·h)^p. A non-zero
+    /// `mirror_coef` blends in a mirror reflection as BlinnPhongMirrored does (slide001 p.111).
+    BlinnPhong {
+        diffuse: ColorSource,
+        specular: ColorSource,
+        phong_exponent: f32,
+        mirror_coef: f32,
+    },
+    /// `<shader type="Phong">`: as BlinnPhong with max(0, v·r)^p.
+    Phong {
+        diffuse: ColorSource,
+        specular: ColorSource,
+        phong_exponent: f32,
+    },
+    /// `<shader type="Mirror">`: ideal reflection, or glossy when `roughness` > 0.
+    Mirror { roughness: f32 },
+    /// `<shader type="Glaze">`: Lambertian + km · mirror (additive, FORMAT.md A7).
+    Glaze {
+        diffuse: ColorSource,
+        mirror_coef: f32,
+    },
+    /// `<shader type="BlinnPhongMirrored">`: (1 − km)·BlinnPhong + km·mirror, glossy with
+    /// `roughness`.
+    BlinnPhongMirrored {
+        diffuse: ColorSource,
+        specular: ColorSource,
+        phong_exponent: f32,
+        mirror_coef: f32,
+        roughness: f32,
+    },
+    /// `<shader type="Dielectric">`: Snell refraction with Fresnel (Schlick) and
+    /// total internal reflection; inside the medium colour is scaled by attenuation^t
+    /// (FORMAT.md A8).
+    Dielectric {
+        refractive_index: f32,
+        attenuation: Color,
+    },
+    /// `<shader type="CoolToWarm">`: Gooch shading (FORMAT.md 4.8, A13).
+    CoolToWarm { diffuse: ColorSource },
+    /// `<shader type="Diffuse">`: Monte Carlo diffuse: direct light as Lambertian plus one
+    /// cosine-distributed bounce that gathers background, environment and emitters
+    /// (FORMAT.md 4.7, A12).
+    Diffuse { diffuse: ColorSource },
+    /// Emitted radiance of shape emitters and visible area lights (FORMAT.md A10, A11).
+    Emissive { radiance: Color },
+}
+
+impl Material {
+    /// The default for dangling references (FORMAT.md A16): a visible grey Lambertian.
+    pub fn fallback() -> Material {
+        Material::Lambertian {
+            diffuse: ColorSource::constant(Color::splat(0.5)),
+        }
+    }
+}
