@@ -19,3 +19,11 @@ pub use math::{Basis, Color, Matrix4, Transform, Vec3};
 pub use ray::Ray;
 pub use scene::{Background, GeometryDesc, Hit, Instance, Scene, SceneParts, SurfaceInteraction};
 pub use texture::{ColorSource, CubeMap, Image, TextureId};
+
+pub mod film;
+pub mod integrator;
+pub mod render;
+pub mod sampling;
+
+pub use film::Film;
+pub use render::{render, Cancelled, IntegratorKind, RenderSettings, RenderStats};

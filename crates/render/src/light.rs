@@ -24,9 +24,12 @@ pub enum Light {
         radius: f32,
         intensity: Color,
     },
-    /// An emitting triangle (also used for emitting boxes and meshes, one light per triangle,
-    /// each carrying its share of the shape's area for selection).
-    Triangle { vertices: [Vec3; 3], intensity: Color },
+    /// An emitting triangle, box (as its 12 triangles) or mesh: one light for the whole shape,
+    /// sampled uniformly by area over its triangles.
+    Triangles {
+        triangles: Vec<[Vec3; 3]>,
+        intensity: Color,
+    },
 }
 
 impl Light {
@@ -41,7 +44,7 @@ impl Light {
             Light::Point { intensity, .. }
             | Light::Area { intensity, .. }
             | Light::Sphere { intensity, .. }
-            | Light::Triangle { intensity, .. } => *intensity,
+            | Light::Triangles { intensity, .. } => *intensity,
         }
     }
 }

@@ -55,8 +55,18 @@ pub enum Material {
     /// cosine-distributed bounce that gathers background, environment and emitters
     /// (FORMAT.md 4.7, A12).
     Diffuse { diffuse: ColorSource },
-    /// Emitted radiance of shape emitters and visible area lights (FORMAT.md A10, A11).
-    Emissive { radiance: Color },
+    /// Emitted radiance of shape emitters and visible area lights (FORMAT.md A10, A11). The
+    /// course integrator shows `radiance` where the emitter is seen. `surface` is the shape's
+    /// own shader (a shape light keeps its `shader` ref; an area light's rectangle has none):
+    /// physically based integrators let it reflect light too. `light` is the index in
+    /// `Scene::lights` of the light that samples this surface, so an integrator that reaches
+    /// an emitter by a BSDF sample can weigh it against light sampling; the loader makes one
+    /// `Emissive` material per emitting light.
+    Emissive {
+        radiance: Color,
+        surface: Option<MaterialId>,
+        light: Option<u32>,
+    },
 }
 
 impl Material {

@@ -1,0 +1,170 @@
+//! Reference-image tests: the instructor's renders marked [verified] in FORMAT.md 6.1,
+//! re-rendered by Glint at 250x250 with the 0.2 grey background those renders used
+//! (FORMAT.md 1.3), compared per channel in 8-bit levels.
+//!
+//! Error measures: the mean absolute difference over all pixels and channels (levels of 255),
+//! and the fraction of pixels where any channel differs by more than 8 levels. Thresholds from
+//! the issue: at most 1.5 and 2 %, except CornellRoom_wMirroredSpheres (many mirror bounces
+//! amplify tiny differences) at 3.0 and 10 %.
+
+use std::path::{Path, PathBuf};
+
+use glint_render::{render, Background, RenderSettings, Scene, Vec3};
+
+fn shared_dir() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared");
+    if dir.join("scenes/course").is_dir() {
+        Some(dir)
+    } else if std::env::var_os("CI").is_some() {
+        panic!("../shared/scenes/course is missing: CI must provide the course corpus");
+    } else {
+        eprintln!("SKIPPED: ../shared/scenes/course is absent, so reference images cannot be checked");
+        None
+    }
+}
+
+struct ImageError {
+    mean_absolute: f64,
+    fraction_over_8: f64,
+}
+
+fn compare(rendered: &[u8], reference: &[u8]) -> ImageError {
+    assert_eq!(rendered.len(), reference.len());
+    let mut sum = 0u64;
+    let mut over = 0usize;
+    for (a, b) in rendered.chunks(3).zip(reference.chunks(3)) {
+        let mut worst = 0;
+        for c in 0..3 {
+            let d = (a[c] as i32 - b[c] as i32).unsigned_abs();
+            sum += d as u64;
+            worst = worst.max(d);
+        }
+        if worst > 8 {
+            over += 1;
+        }
+    }
+    ImageError {
+        mean_absolute: sum as f64 / rendered.len() as f64,
+        fraction_over_8: over as f64 / (rendered.len() / 3) as f64,
+    }
+}
+
+fn render_course(scene_path: &Path, width: u32, height: u32) -> Vec<u8> {
+    let mut loaded = glint_io::load_scene(scene_path)
+        .unwrap_or_else(|e| panic!("{} failed to load: {e}", scene_path.display()));
+    loaded.parts.background = Background::Color(Vec3::splat(0.2));
+    let scene = Scene::new(loaded.parts);
+    let settings = RenderSettings {
+        width,
+        height,
+        ..RenderSettings::default()
+    };
+    let (film, _) = render(&scene, &settings, &|_, _| true).expect("not cancelled");
+    film.to_rgb8_course()
+}
+
+fn check(scene: &str, reference: &str, max_mean: f64, max_fraction: f64) {
+    let Some(shared) = shared_dir() else { return };
+    let dir = shared.join("scenes/course/willemsen/scenes_A");
+    let reference_image = image::open(dir.join("renderedImages").join(reference))
+        .expect("reference PNG readable")
+        .to_rgb8();
+    let (w, h) = reference_image.dimensions();
+    let rendered = render_course(&dir.join(scene), w, h);
+    let error = compare(&rendered, reference_image.as_raw());
+    println!(
+        "{scene} vs {reference}: mean absolute error {:.3} levels, {:.2} % of pixels off by more than 8",
+        error.mean_absolute,
+        100.0 * error.fraction_over_8
+    );
+    assert!(
+        error.mean_absolute <= max_mean,
+        "{scene}: mean absolute error {:.3} > {max_mean}",
+        error.mean_absolute
+    );
+    assert!(
+        error.fraction_over_8 <= max_fraction,
+        "{scene}: {:.2} % of pixels off by more than 8 levels > {:.0} %",
+        100.0 * error.fraction_over_8,
+        100.0 * max_fraction
+    );
+}
+
+#[test]
+fn one_sphere_xml() {
+    check("oneSphere.xml", "oneSphere.png", 1.5, 0.02);
+}
+
+#[test]
+fn one_sphere_json() {
+    check("oneSphere.json", "oneSphere.png", 1.5, 0.02);
+}
+
+#[test]
+fn one_triangle_xml() {
+    check("oneTriangle.xml", "oneTriangle.png", 1.5, 0.02);
+}
+
+#[test]
+fn one_triangle_json() {
+    check("oneTriangle.json", "oneTriangle.png", 1.5, 0.02);
+}
+
+#[test]
+fn three_triangles_xml() {
+    check("threeTriangles.xml", "threeTriangles.png", 1.5, 0.02);
+}
+
+#[test]
+fn three_triangles_json() {
+    check("threeTriangles.json", "threeTriangles.png", 1.5, 0.02);
+}
+
+#[test]
+fn one_box_xml() {
+    check("oneBox.xml", "oneBox.png", 1.5, 0.02);
+}
+
+#[test]
+fn one_box_json() {
+    check("oneBox.json", "oneBox.png", 1.5, 0.02);
+}
+
+#[test]
+fn mirror_scene() {
+    check("mirrorScene00.xml", "mirrorTest.png", 1.5, 0.02);
+}
+
+#[test]
+fn glazed_floor() {
+    check(
+        "simpleSphereScene_GlazedFloor.xml",
+        "simpleTwoSpheres_GlazedFloor.png",
+        1.5,
+        0.02,
+    );
+}
+
+#[test]
+fn cornell_room_mirrored_spheres() {
+    check(
+        "CornellRoom_wMirroredSpheres.xml",
+        "CornellRoom_wMirroredSpheres.png",
+        3.0,
+        0.10,
+    );
+}
+
+/// The comparison must be able to fail: an image flipped vertically (the classic row-order
+/// mistake, FORMAT.md A3) is far outside the threshold.
+#[test]
+fn flipped_image_fails_the_measure() {
+    let Some(shared) = shared_dir() else { return };
+    let dir = shared.join("scenes/course/willemsen/scenes_A");
+    let reference = image::open(dir.join("renderedImages/oneSphere.png"))
+        .unwrap()
+        .to_rgb8();
+    let flipped = image::imageops::flip_vertical(&reference);
+    let error = compare(flipped.as_raw(), reference.as_raw());
+    assert!(error.mean_absolute > 1.5, "flip error {}", error.mean_absolute);
+}

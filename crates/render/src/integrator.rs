@@ -1,0 +1,580 @@
+//! Integrators: the course's recursive ray tracer and debug views.
+
+use crate::light::Light;
+use crate::material::Material;
+use crate::math::{Basis, Color, Vec3};
+use crate::ray::Ray;
+use crate::sampling::{mix64, sample_cosine_hemisphere, sample_uniform_sphere, Rng};
+use crate::scene::{Scene, SurfaceInteraction};
+use crate::texture::ColorSource;
+
+/// Per-sample state handed to an integrator: the sample's random stream and where the sample
+/// sits in the pixel's jittered grid (area lights and glossy reflection stratify against it).
+#[derive(Clone, Debug)]
+pub struct SampleContext {
+    pub rng: Rng,
+    /// Index of this sample within its pixel, 0 .. grid_size².
+    pub sample_index: u32,
+    /// Samples per axis of the pixel's jittered grid.
+    pub grid_size: u32,
+    /// A value fixed for the whole pixel, used to shuffle light samples against pixel samples.
+    pub pixel_key: u64,
+    pub max_depth: u32,
+    /// Rays traced so far for this sample (camera ray included).
+    pub rays: u64,
+}
+
+impl SampleContext {
+    /// A stratified 2-D sample for light or glossy sampling: the pixel's N² cells are shuffled
+    /// by a per-pixel permutation (slide_DistributionRays pp.20-25) so light cells do not line
+    /// up with pixel cells, then jittered within the cell. `salt` separates uses.
+    pub fn stratified_2d(&mut self, salt: u64) -> (f32, f32) {
+        let n = self.grid_size.max(1);
+        let cells = n * n;
+        let cell = permute(self.sample_index, cells, mix64(self.pixel_key ^ salt) as u32);
+        let (cx, cy) = (cell % n, cell / n);
+        let u1 = (cx as f32 + self.rng.next_f32()) / n as f32;
+        let u2 = (cy as f32 + self.rng.next_f32()) / n as f32;
+        (u1.min(ONE_MINUS_EPSILON), u2.min(ONE_MINUS_EPSILON))
+    }
+}
+
+const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Kensler's hash-based permutation of 0..n (Correlated Multi-Jittered Sampling, 2013): a
+/// bijection chosen by `seed`, evaluated without storing the permutation.
+pub fn permute(mut i: u32, n: u32, seed: u32) -> u32 {
+    if n <= 1 {
+        return 0;
+    }
+    let mut w = n - 1;
+    w |= w >> 1;
+    w |= w >> 2;
+    w |= w >> 4;
+    w |= w >> 8;
+    w |= w >> 16;
+    loop {
+        i ^= seed;
+        i = i.wrapping_mul(0xe170_893d);
+        i ^= seed >> 16;
+        i ^= (i & w) >> 4;
+        i ^= seed >> 8;
+        i = i.wrapping_mul(0x0929_eb3f);
+        i ^= seed >> 23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(1 | seed >> 27);
+        i = i.wrapping_mul(0x6935_fa69);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dc_b303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e50_1cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860_a3df);
+        i &= w;
+        i ^= i >> 5;
+        if i < n {
+            break;
+        }
+    }
+    (i.wrapping_add(seed)) % n
+}
+
+/// Computes the radiance arriving along a camera ray.
+pub trait Integrator: Sync {
+    fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color;
+}
+
+/// Mirror reflection of direction `d` about unit normal `n`: r = d − 2(d·n)n (slide001 p.105).
+#[inline]
+pub fn reflect(d: Vec3, n: Vec3) -> Vec3 {
+    d - n * (2.0 * d.dot(n))
+}
+
+/// Refraction of unit direction `d` through a surface with unit normal `n` facing against `d`
+/// (d·n < 0), going from index `n_from` into `n_to` (Snell, slide001 pp.115-116, FCG 13.1).
+/// `None` means total internal reflection.
+#[inline]
+pub fn refract(d: Vec3, n: Vec3, n_from: f32, n_to: f32) -> Option<Vec3> {
+    let eta = n_from / n_to;
+    let cos_i = d.dot(n);
+    let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+    if k < 0.0 {
+        return None;
+    }
+    Some((d - n * cos_i) * eta - n * k.sqrt())
+}
+
+/// Schlick's approximation of Fresnel reflectance for the cosine `cos` of the angle on the
+/// side of the lower index (FCG 13.1).
+#[inline]
+pub fn schlick(cos: f32, refractive_index: f32) -> f32 {
+    let r0 = ((refractive_index - 1.0) / (refractive_index + 1.0)).powi(2);
+    r0 + (1.0 - r0) * (1.0 - cos.clamp(0.0, 1.0)).powi(5)
+}
+
+fn resolve(scene: &Scene, source: &ColorSource, si: &SurfaceInteraction) -> Color {
+    match source.texture {
+        Some(id) => match scene.textures.get(id as usize) {
+            Some(image) => source.color.mul_elem(image.lookup(si.uv.0, si.uv.1)),
+            None => source.color,
+        },
+        None => source.color,
+    }
+}
+
+/// A point on a light chosen for one shadow ray, with what the integrators need of it.
+struct LightSample {
+    position: Vec3,
+    /// Unit normal of the emitter at `position` (None for point lights).
+    normal: Option<Vec3>,
+    /// Probability density of `position` per unit area (1 for point lights).
+    pdf_area: f32,
+}
+
+/// Salt values keeping the 2-D sample streams of different uses apart.
+const SALT_LIGHT: u64 = 0x1157;
+const SALT_GLOSSY: u64 = 0x6105;
+const SALT_BOUNCE: u64 = 0xb0c3;
+
+/// Picks a point on `light` as seen from `p`. `exact` requests the deterministic point the
+/// course uses with one ray per pixel (an area light's centre, FORMAT.md 4.5).
+fn sample_light(
+    light: &Light,
+    light_index: usize,
+    p: Vec3,
+    ctx: &mut SampleContext,
+    exact: bool,
+) -> LightSample {
+    match light {
+        Light::Point { position, .. } => LightSample {
+            position: *position,
+            normal: None,
+            pdf_area: 1.0,
+        },
+        Light::Area {
+            position,
+            normal,
+            width,
+            length,
+            ..
+        } => {
+            let (u_edge, v_edge) = Light::area_edges(*normal, *width, *length);
+            let (u1, u2) = if exact {
+                (0.5, 0.5)
+            } else {
+                ctx.stratified_2d(SALT_LIGHT ^ light_index as u64)
+            };
+            let area = (width * length).abs().max(f32::MIN_POSITIVE);
+            LightSample {
+                position: *position + u_edge * (u1 - 0.5) + v_edge * (u2 - 0.5),
+                normal: Some(normal.normalized()),
+                pdf_area: 1.0 / area,
+            }
+        }
+        Light::Sphere { center, radius, .. } => {
+            // Uniform on the hemisphere facing p: the far side cannot light p.
+            let to_p = (p - *center).normalized();
+            let dir = if exact {
+                to_p
+            } else {
+                let (u1, u2) = ctx.stratified_2d(SALT_LIGHT ^ light_index as u64);
+                let d = sample_uniform_sphere(u1, u2);
+                if d.dot(to_p) < 0.0 {
+                    -d
+                } else {
+                    d
+                }
+            };
+            let area = 2.0 * std::f32::consts::PI * radius * radius;
+            LightSample {
+                position: *center + dir * radius.abs(),
+                normal: Some(dir),
+                pdf_area: 1.0 / area.max(f32::MIN_POSITIVE),
+            }
+        }
+        Light::Triangles { triangles, .. } => {
+            let total: f32 = triangles.iter().map(triangle_area).sum();
+            let (u1, u2) = if exact {
+                (0.5, 1.0 / 3.0)
+            } else {
+                ctx.stratified_2d(SALT_LIGHT ^ light_index as u64)
+            };
+            // Choose a triangle by area with u1, then reuse its remainder for the point.
+            let mut target = u1 * total;
+            let mut chosen = triangles.len().saturating_sub(1);
+            for (k, tri) in triangles.iter().enumerate() {
+                let a = triangle_area(tri);
+                if target < a {
+                    chosen = k;
+                    target /= a.max(f32::MIN_POSITIVE);
+                    break;
+                }
+                target -= a;
+            }
+            let Some([a, b, c]) = triangles.get(chosen).copied() else {
+                return LightSample {
+                    position: p,
+                    normal: None,
+                    pdf_area: 0.0,
+                };
+            };
+            let (b1, b2) = if exact {
+                (1.0 / 3.0, 1.0 / 3.0)
+            } else {
+                crate::sampling::sample_uniform_triangle(target.clamp(0.0, 1.0), u2)
+            };
+            LightSample {
+                position: a + (b - a) * b1 + (c - a) * b2,
+                normal: Some((b - a).cross(c - a).normalized()),
+                pdf_area: 1.0 / total.max(f32::MIN_POSITIVE),
+            }
+        }
+    }
+}
+
+fn triangle_area(t: &[Vec3; 3]) -> f32 {
+    0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
+}
+
+/// The course's recursive ray tracer (slide001; FORMAT.md 4): the lecture's shading formulas
+/// with no light falloff, shadow rays with epsilon 1e-3, mirror/glaze/dielectric recursion up
+/// to `max_depth`, and `Diffuse` as a Monte Carlo surface lit by background and emitters.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct CourseIntegrator;
+
+impl Integrator for CourseIntegrator {
+    fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color {
+        ray_color(scene, ray, 0, true, ctx)
+    }
+}
+
+/// `count_emission` is false on Diffuse bounce rays: emitters were already sampled directly
+/// at the bounce's origin, and counting them again would double their light.
+fn ray_color(
+    scene: &Scene,
+    ray: &Ray,
+    depth: u32,
+    count_emission: bool,
+    ctx: &mut SampleContext,
+) -> Color {
+    let Some(hit) = scene.intersect(ray) else {
+        return scene.background_radiance(ray.direction);
+    };
+    let si = scene.surface(ray, &hit);
+    let d = ray.direction.normalized();
+    let v = -d;
+    // Two-sided shading (FORMAT.md A6): opaque surfaces face the viewer.
+    let n = if si.normal.dot(d) > 0.0 {
+        -si.normal
+    } else {
+        si.normal
+    };
+    let material = scene
+        .materials
+        .get(si.material as usize)
+        .cloned()
+        .unwrap_or_else(Material::fallback);
+    match &material {
+        Material::Lambertian { diffuse } => {
+            let kd = resolve(scene, diffuse, &si);
+            direct(scene, &si, ctx, |l| kd * n.dot(l).max(0.0))
+        }
+        Material::BlinnPhong {
+            diffuse,
+            specular,
+            phong_exponent,
+            mirror_coef,
+        } => {
+            let kd = resolve(scene, diffuse, &si);
+            let ks = resolve(scene, specular, &si);
+            let shaded = blinn_phong(scene, &si, n, v, kd, ks, *phong_exponent, ctx);
+            if *mirror_coef > 0.0 {
+                shaded * (1.0 - mirror_coef)
+                    + mirror(scene, &si, d, n, 0.0, depth, ctx) * *mirror_coef
+            } else {
+                shaded
+            }
+        }
+        Material::Phong {
+            diffuse,
+            specular,
+            phong_exponent,
+        } => {
+            let kd = resolve(scene, diffuse, &si);
+            let ks = resolve(scene, specular, &si);
+            let p = *phong_exponent;
+            direct(scene, &si, ctx, |l| {
+                let r = -l + n * (2.0 * l.dot(n));
+                kd * n.dot(l).max(0.0) + ks * v.dot(r).max(0.0).powf(p)
+            })
+        }
+        Material::Mirror { roughness } => mirror(scene, &si, d, n, *roughness, depth, ctx),
+        Material::Glaze {
+            diffuse,
+            mirror_coef,
+        } => {
+            // Additive, as the lecture writes it (FORMAT.md A7): c = c_Lambertian + km·c_mirror.
+            let kd = resolve(scene, diffuse, &si);
+            direct(scene, &si, ctx, |l| kd * n.dot(l).max(0.0))
+                + mirror(scene, &si, d, n, 0.0, depth, ctx) * *mirror_coef
+        }
+        Material::BlinnPhongMirrored {
+            diffuse,
+            specular,
+            phong_exponent,
+            mirror_coef,
+            roughness,
+        } => {
+            let kd = resolve(scene, diffuse, &si);
+            let ks = resolve(scene, specular, &si);
+            let shaded = blinn_phong(scene, &si, n, v, kd, ks, *phong_exponent, ctx);
+            shaded * (1.0 - mirror_coef)
+                + mirror(scene, &si, d, n, *roughness, depth, ctx) * *mirror_coef
+        }
+        Material::Dielectric {
+            refractive_index,
+            attenuation,
+        } => dielectric(scene, &si, hit.t, ray, *refractive_index, *attenuation, depth, ctx),
+        Material::CoolToWarm { diffuse } => cool_to_warm(scene, &si, n, resolve(scene, diffuse, &si)),
+        Material::Diffuse { diffuse } => {
+            let kd = resolve(scene, diffuse, &si);
+            diffuse_surface(scene, &si, n, kd, depth, ctx)
+        }
+        Material::Emissive { radiance, .. } => {
+            if count_emission {
+                *radiance
+            } else {
+                Color::ZERO
+            }
+        }
+    }
+}
+
+/// Sums `shade(l, intensity)` over the lights that see the point: for each light one shadow
+/// ray toward one point on it (the light's centre with one ray per pixel). `shade` gets the
+/// unit direction to the light and returns the per-unit-intensity response; the course has no
+/// distance falloff and no cosine at the light (FORMAT.md 4.1, 4.5).
+fn direct(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    ctx: &mut SampleContext,
+    shade: impl Fn(Vec3) -> Color,
+) -> Color {
+    let exact = ctx.grid_size <= 1;
+    let mut sum = Color::ZERO;
+    for (index, light) in scene.lights.iter().enumerate() {
+        let sample = sample_light(light, index, si.point, ctx, exact);
+        let to_light = sample.position - si.point;
+        let l = to_light.normalized();
+        ctx.rays += 1;
+        if scene.occluded(&Ray::spawn_to(si.point, sample.position)) {
+            continue;
+        }
+        sum += shade(l).mul_elem(light.intensity());
+    }
+    sum
+}
+
+#[allow(clippy::too_many_arguments)]
+fn blinn_phong(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    n: Vec3,
+    v: Vec3,
+    kd: Color,
+    ks: Color,
+    exponent: f32,
+    ctx: &mut SampleContext,
+) -> Color {
+    direct(scene, si, ctx, |l| {
+        let h = (v + l).normalized();
+        kd * n.dot(l).max(0.0) + ks * n.dot(h).max(0.0).powf(exponent)
+    })
+}
+
+/// The colour seen in the mirror direction, glossy when `roughness` > 0: the reflection is
+/// perturbed within a square of side `roughness` in the plane of the basis built from r
+/// (slide_DistributionRays pp.26-29).
+fn mirror(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    d: Vec3,
+    n: Vec3,
+    roughness: f32,
+    depth: u32,
+    ctx: &mut SampleContext,
+) -> Color {
+    if depth >= ctx.max_depth {
+        return Color::ZERO;
+    }
+    let mut r = reflect(d, n);
+    if roughness > 0.0 {
+        let basis = Basis::from_one(r);
+        let (u1, u2) = ctx.stratified_2d(SALT_GLOSSY ^ depth as u64);
+        let u = -0.5 * roughness + u1 * roughness;
+        let v = -0.5 * roughness + u2 * roughness;
+        r = r + basis.u * u + basis.v * v;
+    }
+    ctx.rays += 1;
+    ray_color(scene, &Ray::spawn(si.point, r), depth + 1, true, ctx)
+}
+
+/// FCG 13.1's dielectric: Schlick-weighted reflection and refraction, total internal
+/// reflection, and Beer-like attenuation k = a^t while the ray travels inside (FORMAT.md A8:
+/// `attenuationCoef` is the fraction transmitted per unit distance, (1,1,1) is clear).
+#[allow(clippy::too_many_arguments)]
+fn dielectric(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    t_hit: f32,
+    ray: &Ray,
+    index: f32,
+    attenuation: Color,
+    depth: u32,
+    ctx: &mut SampleContext,
+) -> Color {
+    if depth >= ctx.max_depth {
+        return Color::ZERO;
+    }
+    let d = ray.direction.normalized();
+    let n = si.normal;
+    let reflected = reflect(d, n);
+    let entering = d.dot(n) < 0.0;
+    let (k, refracted, cos) = if entering {
+        let t = refract(d, n, 1.0, index);
+        (Color::ONE, t, -d.dot(n))
+    } else {
+        // Inside the medium: the distance travelled is t·|direction|.
+        let distance = t_hit * ray.direction.length();
+        let k = attenuation.map(|a| a.max(0.0).powf(distance));
+        let t = refract(d, -n, index, 1.0);
+        let cos = t.map(|t| t.dot(n)).unwrap_or(0.0);
+        (k, t, cos)
+    };
+    let Some(refracted) = refracted else {
+        ctx.rays += 1;
+        return k.mul_elem(ray_color(scene, &Ray::spawn(si.point, reflected), depth + 1, true, ctx));
+    };
+    let r = schlick(cos, index);
+    ctx.rays += 2;
+    let c_reflect = ray_color(scene, &Ray::spawn(si.point, reflected), depth + 1, true, ctx);
+    let c_refract = ray_color(
+        scene,
+        &Ray::spawn(si.point, refracted.normalized()),
+        depth + 1,
+        true,
+        ctx,
+    );
+    k.mul_elem(c_reflect * r + c_refract * (1.0 - r))
+}
+
+/// Gooch cool-to-warm shading (FCG 10.3, FORMAT.md A13): k_w = (1 + n·l)/2,
+/// c = k_w·c_warm + (1 − k_w)·c_cool, with c_cool = (0,0,0.55) + 0.25·kd and
+/// c_warm = (0.3,0.3,0) + 0.25·kd. A non-photorealistic shader: no shadows, and with several
+/// lights the light-weighted mean of the per-light colours.
+fn cool_to_warm(scene: &Scene, si: &SurfaceInteraction, n: Vec3, kd: Color) -> Color {
+    let cool = Vec3::new(0.0, 0.0, 0.55) + kd * 0.25;
+    let warm = Vec3::new(0.3, 0.3, 0.0) + kd * 0.25;
+    if scene.lights.is_empty() {
+        return cool;
+    }
+    let mut sum = Color::ZERO;
+    let mut weight = Color::ZERO;
+    for light in &scene.lights {
+        let position = match light {
+            Light::Point { position, .. }
+            | Light::Area { position, .. }
+            | Light::Sphere {
+                center: position, ..
+            } => *position,
+            Light::Triangles { triangles, .. } => {
+                triangles.first().map_or(si.point, |t| (t[0] + t[1] + t[2]) / 3.0)
+            }
+        };
+        let l = (position - si.point).normalized();
+        let kw = 0.5 * (1.0 + n.dot(l));
+        let i = light.intensity();
+        sum += (warm * kw + cool * (1.0 - kw)).mul_elem(i);
+        weight += i;
+    }
+    Vec3::new(
+        if weight.x > 0.0 { sum.x / weight.x } else { cool.x },
+        if weight.y > 0.0 { sum.y / weight.y } else { cool.y },
+        if weight.z > 0.0 { sum.z / weight.z } else { cool.z },
+    )
+}
+
+/// The course's `Diffuse` shader (FORMAT.md 4.7, A12): a Monte Carlo Lambertian surface.
+/// - Point lights light it with the course formula kd ⊙ I · max(0, n·l), as Lambertian does.
+/// - Area lights and shape emitters are emitters of radiance `intensity` (one-sided along an
+///   area light's normal), sampled by area with the solid-angle conversion: kd/π · L_e ·
+///   cosθ · cosθ' / r² / pdf. (The course's Diffuse scenes are Cornell boxes whose light
+///   intensities are radiances, 21.7 for example; the point-light reading would saturate.)
+/// - One cosine-distributed bounce ray gathers the background, the environment map and the
+///   light other surfaces send; emitters it meets count zero, having been sampled directly.
+fn diffuse_surface(
+    scene: &Scene,
+    si: &SurfaceInteraction,
+    n: Vec3,
+    kd: Color,
+    depth: u32,
+    ctx: &mut SampleContext,
+) -> Color {
+    let mut sum = Color::ZERO;
+    for (index, light) in scene.lights.iter().enumerate() {
+        let sample = sample_light(light, index, si.point, ctx, false);
+        let to_light = sample.position - si.point;
+        let dist2 = to_light.length_squared();
+        let l = to_light.normalized();
+        let cos_surface = n.dot(l);
+        if cos_surface <= 0.0 || dist2 <= 0.0 {
+            continue;
+        }
+        let contribution = match (light, sample.normal) {
+            (Light::Point { .. }, _) => kd * cos_surface,
+            (_, Some(light_normal)) => {
+                // Area lights and emitting triangles are one-sided: they emit along their
+                // normal (a triangle's by its winding, as `../shared/refs/cornell` defines).
+                // A sphere's sampled normal already faces the shading point.
+                let cos_light = (-l).dot(light_normal);
+                if cos_light <= 0.0 || sample.pdf_area <= 0.0 {
+                    continue;
+                }
+                kd * (std::f32::consts::FRAC_1_PI * cos_surface * cos_light
+                    / (dist2 * sample.pdf_area))
+            }
+            (_, None) => continue,
+        };
+        ctx.rays += 1;
+        if scene.occluded(&Ray::spawn_to(si.point, sample.position)) {
+            continue;
+        }
+        sum += contribution.mul_elem(light.intensity());
+    }
+    if depth < ctx.max_depth {
+        let (u1, u2) = ctx.stratified_2d(SALT_BOUNCE ^ depth as u64);
+        let local = sample_cosine_hemisphere(u1, u2);
+        let frame = Basis::from_one(-n);
+        // Basis::from_one(a) has W = -a/|a|, so W = n here: the local z axis is the normal.
+        let dir = frame.u * local.x + frame.v * local.y + frame.w * local.z;
+        ctx.rays += 1;
+        let incoming = ray_color(scene, &Ray::spawn(si.point, dir), depth + 1, false, ctx);
+        sum += kd.mul_elem(incoming);
+    }
+    sum
+}
+
+/// Debug view: the world-space geometric normal at the first hit as colour, (n + 1) / 2;
+/// black where the ray leaves the scene. Selected with `--shader normals`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct NormalsIntegrator;
+
+impl Integrator for NormalsIntegrator {
+    fn radiance(&self, scene: &Scene, ray: &Ray, _ctx: &mut SampleContext) -> Color {
+        match scene.intersect(ray) {
+            Some(hit) => (scene.surface(ray, &hit).normal + Vec3::ONE) * 0.5,
+            None => Color::ZERO,
+        }
+    }
+}
+
