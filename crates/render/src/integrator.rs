@@ -269,12 +269,7 @@ fn ray_color(
     } else {
         si.normal
     };
-    let material = scene
-        .materials
-        .get(si.material as usize)
-        .cloned()
-        .unwrap_or_else(Material::fallback);
-    match &material {
+    match Material::get(&scene.materials, si.material) {
         Material::Lambertian { diffuse } => {
             let kd = resolve(scene, diffuse, &si);
             direct(scene, &si, ctx, |l| kd * n.dot(l).max(0.0))

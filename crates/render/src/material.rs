@@ -8,7 +8,7 @@ pub type MaterialId = u32;
 
 /// A surface's response to light. Each variant is one course shader (FORMAT.md 2.5, 4); the
 /// course integrator evaluates them with the lecture's formulas.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Material {
     /// `<shader type="Lambertian">`: kd ⊙ I · max(0, n·l) per light.
     Lambertian { diffuse: ColorSource },
@@ -72,8 +72,19 @@ pub enum Material {
 impl Material {
     /// The default for dangling references (FORMAT.md A16): a visible grey Lambertian.
     pub fn fallback() -> Material {
-        Material::Lambertian {
-            diffuse: ColorSource::constant(Color::splat(0.5)),
-        }
+        FALLBACK_MATERIAL
+    }
+}
+
+/// See `Material::fallback`.
+pub const FALLBACK_MATERIAL: Material = Material::Lambertian {
+    diffuse: ColorSource::constant(Color::new(0.5, 0.5, 0.5)),
+};
+
+impl Material {
+    /// The material with index `id`, or the fallback for an index out of range.
+    #[inline]
+    pub fn get(materials: &[Material], id: MaterialId) -> &Material {
+        materials.get(id as usize).unwrap_or(&FALLBACK_MATERIAL)
     }
 }
