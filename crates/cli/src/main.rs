@@ -1,1 +1,54 @@
-fn main() {}
+//! `glint`: render course ray-tracing scenes to PNG or EXR. See `glint --help`.
+//!
+//! This file only wires the process to the run: it parses the arguments (clap exits with
+//! status 2 on usage errors and 0 for help), installs the Ctrl-C handler, and turns the
+//! outcome into an exit status. Arguments live in `args.rs`, the run in `run.rs`.
+#![forbid(unsafe_code)]
+
+mod args;
+mod run;
+
+use std::io::IsTerminal;
+use std::process::ExitCode;
+
+use clap::Parser;
+
+use crate::args::Cli;
+use crate::run::{Failure, Interrupt, SignalAction, EXIT_INTERRUPTED};
+
+/// Shared with the Ctrl-C handler, which must be `'static`.
+static INTERRUPT: Interrupt = Interrupt::new();
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let available = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let job = match cli.into_job(available) {
+        Ok(job) => job,
+        Err(error) => return fail(&Failure::Usage(error)),
+    };
+
+    // Without a handler Ctrl-C would still kill the process without writing anything (the
+    // image is written atomically), only less politely; so a failure here is only a note.
+    if let Err(error) = ctrlc::set_handler(|| match INTERRUPT.on_signal() {
+        SignalAction::ExitNow => {
+            eprintln!("\nerror: {}", Failure::Interrupted);
+            std::process::exit(EXIT_INTERRUPTED.into());
+        }
+        SignalAction::Cancel | SignalAction::Ignore => {}
+    }) {
+        eprintln!("note: cannot handle Ctrl-C: {error}");
+    }
+
+    // Not locked: the progress bar draws from the render threads.
+    let mut stderr = std::io::stderr();
+    let progress_bar = stderr.is_terminal();
+    match run::run(&job, &INTERRUPT, &mut stderr, progress_bar) {
+        Ok(_) => ExitCode::SUCCESS,
+        Err(failure) => fail(&failure),
+    }
+}
+
+fn fail(failure: &Failure) -> ExitCode {
+    eprintln!("error: {failure}");
+    ExitCode::from(failure.exit_code())
+}

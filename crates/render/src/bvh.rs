@@ -173,7 +173,8 @@ impl RayInverse {
         RayInverse {
             origin: ray.origin.to_array(),
             inv_dir: d.map(|c| 1.0 / c),
-            negative: d.map(|c| c < 0.0),
+            // Sign bit, not `< 0`: 1 / -0.0 is -inf, and the near/far choice must agree with it.
+            negative: d.map(|c| c.is_sign_negative()),
         }
     }
 
@@ -217,9 +218,7 @@ fn build_recursive(prims: &mut [BuildPrim], first: usize, nodes: &mut Vec<BvhNod
     if n == 1 {
         return;
     }
-    let centroid_bounds = prims
-        .iter()
-        .fold(Aabb::EMPTY, |a, p| a.grow(p.centroid));
+    let centroid_bounds = prims.iter().fold(Aabb::EMPTY, |a, p| a.grow(p.centroid));
     let axis = (centroid_bounds.max - centroid_bounds.min).max_axis();
     let extent = centroid_bounds.max[axis] - centroid_bounds.min[axis];
 

@@ -49,10 +49,9 @@ impl Camera {
         let v = -0.5 * h + h * py / ny as f32;
         let b = &self.basis;
         match self.projection {
-            Projection::Perspective => Ray::new(
-                self.position,
-                b.w * -self.focal_length + b.u * u + b.v * v,
-            ),
+            Projection::Perspective => {
+                Ray::new(self.position, b.w * -self.focal_length + b.u * u + b.v * v)
+            }
             Projection::Orthographic => Ray::new(self.position + b.u * u + b.v * v, -b.w),
         }
     }

@@ -76,7 +76,9 @@ impl Shape {
                 min: center - Vec3::splat(radius.abs()),
                 max: center + Vec3::splat(radius.abs()),
             },
-            Shape::Triangle { vertices: [a, b, c] } => Aabb::EMPTY.grow(a).grow(b).grow(c),
+            Shape::Triangle {
+                vertices: [a, b, c],
+            } => Aabb::EMPTY.grow(a).grow(b).grow(c),
             Shape::Box { min, max } => Aabb {
                 min: min.min(max),
                 max: min.max(max),
@@ -100,7 +102,9 @@ impl Shape {
         let _ = hit;
         match *self {
             Shape::Sphere { center, radius } => ((p - center) / radius).normalized(),
-            Shape::Triangle { vertices: [a, b, c] } => (b - a).cross(c - a).normalized(),
+            Shape::Triangle {
+                vertices: [a, b, c],
+            } => (b - a).cross(c - a).normalized(),
             Shape::Box { min, max } => box_normal(p, min, max),
         }
     }
@@ -138,7 +142,9 @@ impl Shape {
     pub fn area(&self) -> f32 {
         match *self {
             Shape::Sphere { radius, .. } => 4.0 * std::f32::consts::PI * radius * radius,
-            Shape::Triangle { vertices: [a, b, c] } => 0.5 * (b - a).cross(c - a).length(),
+            Shape::Triangle {
+                vertices: [a, b, c],
+            } => 0.5 * (b - a).cross(c - a).length(),
             Shape::Box { min, max } => {
                 let d = (max - min).abs();
                 2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
@@ -154,15 +160,26 @@ impl Shape {
 pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<PrimitiveHit> {
     let oc = ray.origin - center;
     let a = ray.direction.length_squared();
+    if a == 0.0 {
+        return None;
+    }
     let half_b = ray.direction.dot(oc);
     let c = oc.length_squared() - radius * radius;
-    let disc = half_b * half_b - a * c;
-    if disc < 0.0 || a == 0.0 {
+    // The discriminant from the ray's perpendicular offset to the centre (Ray Tracing Gems,
+    // ch. 7): b² − ac cancels catastrophically in f32 when the sphere is far away relative to
+    // its radius, putting hit points further off the surface than `SPAWN_EPSILON`.
+    let perpendicular = oc - ray.direction * (half_b / a);
+    let disc = a * (radius * radius - perpendicular.length_squared());
+    if disc < 0.0 {
         return None;
     }
     let sq = disc.sqrt();
     // The numerically stable pair of roots (no cancellation when half_b ≈ ±sq).
-    let q = if half_b > 0.0 { -half_b - sq } else { -half_b + sq };
+    let q = if half_b > 0.0 {
+        -half_b - sq
+    } else {
+        -half_b + sq
+    };
     let (mut t0, mut t1) = (q / a, if q != 0.0 { c / q } else { 0.0 });
     if q == 0.0 {
         t0 = 0.0;
@@ -173,7 +190,11 @@ pub fn intersect_sphere(ray: &Ray, center: Vec3, radius: f32) -> Option<Primitiv
     }
     for t in [t0, t1] {
         if t >= ray.t_min && t <= ray.t_max {
-            return Some(PrimitiveHit { t, b1: 0.0, b2: 0.0 });
+            return Some(PrimitiveHit {
+                t,
+                b1: 0.0,
+                b2: 0.0,
+            });
         }
     }
     None

@@ -31,7 +31,11 @@ impl SampleContext {
     pub fn stratified_2d(&mut self, salt: u64) -> (f32, f32) {
         let n = self.grid_size.max(1);
         let cells = n * n;
-        let cell = permute(self.sample_index, cells, mix64(self.pixel_key ^ salt) as u32);
+        let cell = permute(
+            self.sample_index,
+            cells,
+            mix64(self.pixel_key ^ salt) as u32,
+        );
         let (cx, cy) = (cell % n, cell / n);
         let u1 = (cx as f32 + self.rng.next_f32()) / n as f32;
         let u2 = (cy as f32 + self.rng.next_f32()) / n as f32;
@@ -329,8 +333,19 @@ fn ray_color(
         Material::Dielectric {
             refractive_index,
             attenuation,
-        } => dielectric(scene, &si, hit.t, ray, *refractive_index, *attenuation, depth, ctx),
-        Material::CoolToWarm { diffuse } => cool_to_warm(scene, &si, n, resolve(scene, diffuse, &si)),
+        } => dielectric(
+            scene,
+            &si,
+            hit.t,
+            ray,
+            *refractive_index,
+            *attenuation,
+            depth,
+            ctx,
+        ),
+        Material::CoolToWarm { diffuse } => {
+            cool_to_warm(scene, &si, n, resolve(scene, diffuse, &si))
+        }
         Material::Diffuse { diffuse } => {
             let kd = resolve(scene, diffuse, &si);
             diffuse_surface(scene, &si, n, kd, depth, ctx)
@@ -448,11 +463,23 @@ fn dielectric(
     };
     let Some(refracted) = refracted else {
         ctx.rays += 1;
-        return k.mul_elem(ray_color(scene, &Ray::spawn(si.point, reflected), depth + 1, true, ctx));
+        return k.mul_elem(ray_color(
+            scene,
+            &Ray::spawn(si.point, reflected),
+            depth + 1,
+            true,
+            ctx,
+        ));
     };
     let r = schlick(cos, index);
     ctx.rays += 2;
-    let c_reflect = ray_color(scene, &Ray::spawn(si.point, reflected), depth + 1, true, ctx);
+    let c_reflect = ray_color(
+        scene,
+        &Ray::spawn(si.point, reflected),
+        depth + 1,
+        true,
+        ctx,
+    );
     let c_refract = ray_color(
         scene,
         &Ray::spawn(si.point, refracted.normalized()),
@@ -482,9 +509,9 @@ fn cool_to_warm(scene: &Scene, si: &SurfaceInteraction, n: Vec3, kd: Color) -> C
             | Light::Sphere {
                 center: position, ..
             } => *position,
-            Light::Triangles { triangles, .. } => {
-                triangles.first().map_or(si.point, |t| (t[0] + t[1] + t[2]) / 3.0)
-            }
+            Light::Triangles { triangles, .. } => triangles
+                .first()
+                .map_or(si.point, |t| (t[0] + t[1] + t[2]) / 3.0),
         };
         let l = (position - si.point).normalized();
         let kw = 0.5 * (1.0 + n.dot(l));
@@ -493,9 +520,21 @@ fn cool_to_warm(scene: &Scene, si: &SurfaceInteraction, n: Vec3, kd: Color) -> C
         weight += i;
     }
     Vec3::new(
-        if weight.x > 0.0 { sum.x / weight.x } else { cool.x },
-        if weight.y > 0.0 { sum.y / weight.y } else { cool.y },
-        if weight.z > 0.0 { sum.z / weight.z } else { cool.z },
+        if weight.x > 0.0 {
+            sum.x / weight.x
+        } else {
+            cool.x
+        },
+        if weight.y > 0.0 {
+            sum.y / weight.y
+        } else {
+            cool.y
+        },
+        if weight.z > 0.0 {
+            sum.z / weight.z
+        } else {
+            cool.z
+        },
     )
 }
 
@@ -572,4 +611,3 @@ impl Integrator for NormalsIntegrator {
         }
     }
 }
-

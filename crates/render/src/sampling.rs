@@ -28,7 +28,8 @@ impl Rng {
     /// The stream of one pixel sample: keyed by a hash of all three so neighbouring pixels
     /// and samples are decorrelated.
     pub fn for_sample(seed: u64, pixel: u64, sample: u64) -> Rng {
-        let key = mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel.wrapping_mul(0xff51_afd7_ed55_8ccd));
+        let key =
+            mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel.wrapping_mul(0xff51_afd7_ed55_8ccd));
         Rng::new(mix64(key ^ sample.wrapping_mul(0xc4ce_b9fe_1a85_ec53)), key)
     }
 

@@ -1,0 +1,503 @@
+//! Command-line arguments: what the user typed (`Cli`, parsed by clap) and what the run needs
+//! (`Job`, resolved and validated). The split follows ripgrep's `LowArgs` / `HiArgs`.
+//!
+//! Two forms are accepted. The course's, flag for flag as in the instructor's `GraphicsArgs`
+//! (FORMAT.md 1.4), so the course's scripts work unchanged:
+//!
+//! ```text
+//! glint -i scene.xml -o out.png -w 250 -h 250 -r 16 -k 4 -n 2
+//! ```
+//!
+//! and the modern one, with the scene as a positional argument:
+//!
+//! ```text
+//! glint render scene.xml -o out.png -w 250 -h 250 -r 16
+//! ```
+//!
+//! `-h` is the image height, as in the course, so help is `-?` / `--help`.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
+use glint_render::{Color, IntegratorKind, RenderSettings};
+
+/// Largest accepted image side. Pixel indices are computed in `u32` in places, and a bigger
+/// image would not fit in memory anyway.
+pub const MAX_SIDE: u32 = 65_535;
+/// Largest accepted `--recursionDepth`. The course integrator recurses on the worker thread's
+/// stack and a dielectric doubles the rays at each level, so deeper limits only hang or crash.
+pub const MAX_DEPTH: u32 = 100;
+/// Largest accepted `--numcpus`.
+pub const MAX_THREADS: u64 = 1024;
+
+const AFTER_HELP: &str = "\
+Examples:
+  glint -i scene.xml -o out.png -w 250 -h 250 -r 16
+  glint render scene.json -o out.exr --background 0.2,0.2,0.2
+
+Output is PNG (8-bit, clamped, floor(c*255), no gamma, as the course writes it) or EXR
+(linear 32-bit float), chosen by the extension. Without -o the image goes to the scene's
+name with .png in the current directory.
+
+Exit status: 0 success, 1 failure (e.g. the image cannot be written), 2 bad scene or bad
+arguments, 130 interrupted (Ctrl-C; nothing is written).";
+
+/// What the user typed.
+#[derive(Parser, Debug)]
+#[command(
+    name = "glint",
+    version,
+    about = "Render course ray-tracing scenes (XML or JSON) to PNG or EXR.",
+    after_help = AFTER_HELP,
+    disable_help_flag = true,
+    args_conflicts_with_subcommands = true
+)]
+pub struct Cli {
+    /// Scene file, XML or JSON (or use `glint render SCENE`).
+    #[arg(short = 'i', long = "inputfile", value_name = "SCENE")]
+    pub input: Option<PathBuf>,
+
+    #[command(flatten)]
+    pub options: Options,
+
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render SCENE (the same options as the course's form).
+    #[command(disable_help_flag = true, after_help = AFTER_HELP)]
+    Render {
+        /// Scene file, XML or JSON.
+        #[arg(value_name = "SCENE")]
+        scene: PathBuf,
+
+        #[command(flatten)]
+        options: Options,
+    },
+}
+
+/// Options shared by both forms.
+#[derive(Args, Debug, Clone)]
+pub struct Options {
+    /// Output image, .png or .exr [default: ./SCENE-NAME.png].
+    #[arg(short = 'o', long = "outputfile", value_name = "FILE")]
+    pub output: Option<PathBuf>,
+
+    /// Image width in pixels.
+    #[arg(short = 'w', long, value_name = "PIXELS", default_value_t = 100,
+          value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
+    pub width: u32,
+
+    /// Image height in pixels (-h is height, as in the course: help is -?).
+    #[arg(short = 'h', long, value_name = "PIXELS", default_value_t = 100,
+          value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
+    pub height: u32,
+
+    /// Rays per pixel, on an N x N jittered grid, N = floor(sqrt(RPP)).
+    #[arg(short = 'r', long = "rpp", visible_alias = "spp", value_name = "RPP",
+          default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
+    pub rpp: u32,
+
+    /// Maximum reflection/refraction recursion depth.
+    #[arg(short = 'k', long = "recursionDepth", value_name = "DEPTH", default_value_t = 4,
+          value_parser = clap::value_parser!(u32).range(0..=MAX_DEPTH as i64))]
+    pub recursion_depth: u32,
+
+    /// Render threads [default: all cores].
+    #[arg(short = 'n', long = "numcpus", value_name = "THREADS",
+          value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
+    pub threads: Option<u64>,
+
+    /// Image-plane aspect ratio (width / height) [default: WIDTH / HEIGHT].
+    #[arg(short = 'a', long, value_name = "RATIO", value_parser = parse_aspect)]
+    pub aspect: Option<f32>,
+
+    /// Constant background instead of the scene's (the course's references: 0.2,0.2,0.2).
+    #[arg(long, value_name = "R,G,B", value_parser = parse_rgb)]
+    pub background: Option<Rgb>,
+
+    /// Seed of the random numbers (jitter, area lights, glossy and diffuse bounces).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    pub seed: u64,
+
+    /// The course's ray tracer, or a debug view of the normal at the first hit, (n + 1) / 2.
+    #[arg(long, visible_alias = "shader", value_name = "NAME", value_enum,
+          default_value_t = IntegratorArg::Course)]
+    pub integrator: IntegratorArg,
+
+    /// Also print the settings and the loading time.
+    #[arg(short = 'v', long, action = ArgAction::SetTrue)]
+    pub verbose: bool,
+
+    /// Print help.
+    #[arg(short = '?', long, action = ArgAction::Help)]
+    pub help: Option<bool>,
+
+    /// Depth-of-field focus distance (glint has no depth of field yet).
+    #[arg(short = 'd', long, value_name = "DIST", help_heading = COURSE_NO_EFFECT)]
+    pub depth: Option<f32>,
+
+    /// BVH split method (glint always builds a binned-SAH BVH).
+    #[arg(short = 's', long, value_name = "METHOD", help_heading = COURSE_NO_EFFECT)]
+    pub split: Option<String>,
+
+    /// Preview window width (glint has no preview window).
+    #[arg(short = 'x', long, value_name = "PIXELS", help_heading = COURSE_NO_EFFECT)]
+    pub winwidth: Option<u32>,
+
+    /// Preview window height (glint has no preview window).
+    #[arg(short = 'y', long, value_name = "PIXELS", help_heading = COURSE_NO_EFFECT)]
+    pub winheight: Option<u32>,
+}
+
+const COURSE_NO_EFFECT: &str = "Course options accepted for its scripts, with no effect";
+
+/// `--integrator` / `--shader` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum IntegratorArg {
+    // No doc comments on the variants: clap would then list them one per line.
+    Course,
+    Normals,
+}
+
+impl From<IntegratorArg> for IntegratorKind {
+    fn from(arg: IntegratorArg) -> IntegratorKind {
+        match arg {
+            IntegratorArg::Course => IntegratorKind::Course,
+            IntegratorArg::Normals => IntegratorKind::Normals,
+        }
+    }
+}
+
+/// A colour given on the command line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rgb(pub [f32; 3]);
+
+impl Rgb {
+    pub fn to_color(self) -> Color {
+        let [r, g, b] = self.0;
+        Color::new(r, g, b)
+    }
+}
+
+/// Parses `R,G,B` (commas and/or spaces between three finite, non-negative numbers).
+pub fn parse_rgb(text: &str) -> Result<Rgb, String> {
+    let parts: Vec<&str> = text
+        .split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|p| !p.is_empty())
+        .collect();
+    if parts.len() != 3 {
+        return Err(format!(
+            "expected three comma-separated numbers R,G,B (e.g. 0.2,0.2,0.2), got {} value{}",
+            parts.len(),
+            if parts.len() == 1 { "" } else { "s" }
+        ));
+    }
+    let mut rgb = [0.0f32; 3];
+    for (slot, part) in rgb.iter_mut().zip(&parts) {
+        let value: f32 = part
+            .parse()
+            .map_err(|_| format!("'{part}' is not a number"))?;
+        if !value.is_finite() {
+            return Err(format!("'{part}' is not a finite number"));
+        }
+        if value < 0.0 {
+            return Err(format!("colour components must be >= 0, got {part}"));
+        }
+        *slot = value;
+    }
+    Ok(Rgb(rgb))
+}
+
+/// Parses `--aspect`: a finite number > 0.
+pub fn parse_aspect(text: &str) -> Result<f32, String> {
+    let value: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if !value.is_finite() || value <= 0.0 {
+        return Err(format!(
+            "the aspect ratio must be a finite number > 0, got {text}"
+        ));
+    }
+    Ok(value)
+}
+
+/// Arguments that parsed but make no sense together: exit status 2, like clap's own errors.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct UsageError(pub String);
+
+impl fmt::Display for UsageError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for UsageError {}
+
+/// Everything a run needs, resolved and checked.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Job {
+    pub scene: PathBuf,
+    pub output: PathBuf,
+    pub settings: RenderSettings,
+    pub threads: usize,
+    pub background: Option<Color>,
+    pub verbose: bool,
+    /// Notes about accepted options that have no effect, printed before rendering.
+    pub notes: Vec<String>,
+}
+
+/// Output formats by extension, lower case. `glint_io::write_image` decides by the same rule;
+/// checking here turns a typo into an immediate usage error instead of one after the render.
+const OUTPUT_EXTENSIONS: [&str; 2] = ["png", "exr"];
+
+impl Cli {
+    /// Resolves the arguments into a `Job`. `available_threads` is the default for `-n`.
+    pub fn into_job(self, available_threads: usize) -> Result<Job, UsageError> {
+        let (scene, options) =
+            match self.command {
+                Some(Command::Render { scene, options }) => (scene, options),
+                None => match self.input {
+                    Some(scene) if !scene.as_os_str().is_empty() => (scene, self.options),
+                    _ => return Err(UsageError(
+                        "Need input file! Use `glint -i SCENE ...` or `glint render SCENE ...` \
+                         (see `glint --help`)"
+                            .to_string(),
+                    )),
+                },
+            };
+        options.into_job(scene, available_threads)
+    }
+}
+
+impl Options {
+    fn into_job(self, scene: PathBuf, available_threads: usize) -> Result<Job, UsageError> {
+        let output = match self.output {
+            Some(output) if output.as_os_str().is_empty() => {
+                return Err(UsageError("the output file name is empty".to_string()))
+            }
+            Some(output) => output,
+            None => default_output(&scene)?,
+        };
+        check_output_extension(&output)?;
+
+        let mut notes = Vec::new();
+        if let Some(depth) = self.depth {
+            notes.push(format!(
+                "--depth {depth} has no effect: glint has no depth of field yet"
+            ));
+        }
+        if let Some(split) = &self.split {
+            notes.push(format!(
+                "--split {split} has no effect: glint always builds a binned-SAH BVH"
+            ));
+        }
+        if self.winwidth.is_some() || self.winheight.is_some() {
+            notes.push("--winwidth/--winheight have no effect: glint has no preview window".into());
+        }
+        let settings = RenderSettings {
+            width: self.width,
+            height: self.height,
+            rays_per_pixel: self.rpp,
+            max_depth: self.recursion_depth,
+            aspect: self.aspect,
+            seed: self.seed,
+            integrator: self.integrator.into(),
+            ..RenderSettings::default()
+        };
+        let grid = settings.grid_size();
+        if grid * grid != self.rpp {
+            notes.push(format!(
+                "-r {} is not a perfect square: using a {grid}x{grid} grid, {} rays per pixel",
+                self.rpp,
+                grid * grid
+            ));
+        }
+        Ok(Job {
+            scene,
+            output,
+            settings,
+            threads: self
+                .threads
+                .map_or(available_threads.max(1), |n| n as usize),
+            background: self.background.map(Rgb::to_color),
+            verbose: self.verbose,
+            notes,
+        })
+    }
+}
+
+/// The scene's file name with `.png`, in the current directory.
+fn default_output(scene: &Path) -> Result<PathBuf, UsageError> {
+    match scene.file_stem() {
+        Some(stem) if !stem.is_empty() => Ok(PathBuf::from(stem).with_extension("png")),
+        _ => Err(UsageError(format!(
+            "cannot name the output after '{}'; give one with -o FILE",
+            scene.display()
+        ))),
+    }
+}
+
+fn check_output_extension(output: &Path) -> Result<(), UsageError> {
+    let extension = output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    match extension {
+        Some(e) if OUTPUT_EXTENSIONS.contains(&e.as_str()) => Ok(()),
+        _ => Err(UsageError(format!(
+            "cannot write '{}': the output must end in .png or .exr",
+            output.display()
+        ))),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::CommandFactory;
+
+    fn job(args: &[&str]) -> Result<Job, String> {
+        let cli = Cli::try_parse_from(std::iter::once("glint").chain(args.iter().copied()))
+            .map_err(|e| e.to_string())?;
+        cli.into_job(8).map_err(|e| e.to_string())
+    }
+
+    #[test]
+    fn clap_definition_is_consistent() {
+        Cli::command().debug_assert();
+    }
+
+    #[test]
+    fn course_form_with_all_numbers() {
+        let job = job(&[
+            "-i", "s.xml", "-o", "o.png", "-w", "250", "-h", "120", "-r", "16", "-k", "6", "-n",
+            "2", "-a", "1.5",
+        ])
+        .unwrap();
+        assert_eq!(job.scene, PathBuf::from("s.xml"));
+        assert_eq!(job.output, PathBuf::from("o.png"));
+        assert_eq!((job.settings.width, job.settings.height), (250, 120));
+        assert_eq!(job.settings.rays_per_pixel, 16);
+        assert_eq!(job.settings.max_depth, 6);
+        assert_eq!(job.settings.aspect, Some(1.5));
+        assert_eq!(job.threads, 2);
+        assert!(job.notes.is_empty());
+    }
+
+    #[test]
+    fn long_names_and_defaults() {
+        let job = job(&[
+            "--inputfile",
+            "dir/s.json",
+            "--recursionDepth",
+            "2",
+            "--spp",
+            "4",
+        ])
+        .unwrap();
+        assert_eq!(job.output, PathBuf::from("s.png"));
+        assert_eq!((job.settings.width, job.settings.height), (100, 100));
+        assert_eq!(job.settings.rays_per_pixel, 4);
+        assert_eq!(job.settings.max_depth, 2);
+        assert_eq!(job.settings.seed, 0);
+        assert_eq!(job.settings.integrator, IntegratorKind::Course);
+        assert_eq!(job.threads, 8);
+        assert_eq!(job.background, None);
+    }
+
+    #[test]
+    fn render_form() {
+        let job = job(&[
+            "render",
+            "s.xml",
+            "-o",
+            "x.EXR",
+            "--shader",
+            "normals",
+            "--seed",
+            "7",
+            "--background",
+            "0.2, 0.2, 0.2",
+        ])
+        .unwrap();
+        assert_eq!(job.scene, PathBuf::from("s.xml"));
+        assert_eq!(job.output, PathBuf::from("x.EXR"));
+        assert_eq!(job.settings.integrator, IntegratorKind::Normals);
+        assert_eq!(job.settings.seed, 7);
+        assert_eq!(job.background, Some(Color::new(0.2, 0.2, 0.2)));
+    }
+
+    #[test]
+    fn missing_input_is_a_usage_error() {
+        let error = job(&["-o", "x.png"]).unwrap_err();
+        assert!(error.contains("Need input file!"), "{error}");
+    }
+
+    #[test]
+    fn bad_numbers_are_rejected() {
+        for args in [
+            &["-i", "s.xml", "-w", "0"][..],
+            &["-i", "s.xml", "-h", "-3"],
+            &["-i", "s.xml", "-r", "0"],
+            &["-i", "s.xml", "-n", "0"],
+            &["-i", "s.xml", "-k", "1000"],
+            &["-i", "s.xml", "-a", "0"],
+            &["-i", "s.xml", "-a", "nan"],
+            &["-i", "s.xml", "--background", "1,2"],
+            &["-i", "s.xml", "--background", "1,2,inf"],
+            &["-i", "s.xml", "--background", "1,x,2"],
+            &["-i", "s.xml", "--shader", "phong"],
+            &["-i", "s.xml", "-o", "out.jpg"],
+            &["-i", "s.xml", "--frobnicate"],
+            &["render"],
+        ] {
+            assert!(job(args).is_err(), "{args:?} was accepted");
+        }
+    }
+
+    #[test]
+    fn both_forms_at_once_are_rejected() {
+        assert!(job(&["-i", "a.xml", "render", "b.xml"]).is_err());
+    }
+
+    #[test]
+    fn course_options_without_effect_leave_notes() {
+        let job = job(&[
+            "-i",
+            "s.xml",
+            "-d",
+            "3",
+            "-s",
+            "spatialMedian",
+            "-x",
+            "300",
+            "-r",
+            "8",
+        ])
+        .unwrap();
+        assert_eq!(job.notes.len(), 4, "{:?}", job.notes);
+        assert!(job.notes[0].starts_with("--depth 3 "), "{:?}", job.notes);
+        assert!(
+            job.notes[1].starts_with("--split spatialMedian "),
+            "{:?}",
+            job.notes
+        );
+        assert!(job.notes[2].starts_with("--winwidth"), "{:?}", job.notes);
+        assert!(job.notes[3].contains("2x2"), "{:?}", job.notes);
+    }
+
+    #[test]
+    fn rgb_parsing() {
+        assert_eq!(parse_rgb("0.2,0.5,1"), Ok(Rgb([0.2, 0.5, 1.0])));
+        assert_eq!(parse_rgb("0.2 0.5 1"), Ok(Rgb([0.2, 0.5, 1.0])));
+        assert!(parse_rgb("1,2").unwrap_err().contains("2 values"));
+        assert!(parse_rgb("1,2,3,4").is_err());
+        assert!(parse_rgb("-1,0,0").is_err());
+        assert!(parse_rgb("").is_err());
+    }
+}
