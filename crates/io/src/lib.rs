@@ -1,1 +1,114 @@
-//! placeholder
+//! Glint's I/O: the course's XML and JSON scene files into the renderer's `SceneParts`, OBJ
+//! meshes and PNG textures with them, and the rendered film out as PNG or EXR.
+//!
+//! Loading runs in three stages (DESIGN.md, habits 1-2):
+//! 1. **parse**: XML (roxmltree) or JSON (jsonc-parser) into one located tree (`tree.rs`), the
+//!    JSON files being a mechanical conversion of the XML ones;
+//! 2. **read**: the tree into a `SceneDesc` in the course's vocabulary (`desc.rs`), checking
+//!    every value where it was written;
+//! 3. **build**: the description into `SceneParts`, resolving names, loading assets and
+//!    composing transforms (`build.rs`).
+//!
+//! Errors stop the load with a `Diagnostic` naming `file:line:col`; everything the loader can
+//! work around (unknown keys, dangling references, missing files) is returned as warnings next
+//! to the scene.
+//!
+//! ```no_run
+//! let loaded = glint_io::load_scene(std::path::Path::new("oneSphere.xml"))?;
+//! for warning in &loaded.warnings {
+//!     eprintln!("{warning}");
+//! }
+//! let scene = glint_render::Scene::new(loaded.parts);
+//! # Ok::<(), glint_io::SceneError>(())
+//! ```
+
+#![forbid(unsafe_code)]
+
+mod build;
+mod desc;
+mod diagnostic;
+mod image_io;
+mod json;
+mod obj;
+mod read;
+mod tree;
+mod values;
+mod xml;
+
+use std::path::Path;
+
+pub use diagnostic::{Diagnostic, SceneError, Severity};
+pub use image_io::{write_image, ImageWriteError};
+
+use diagnostic::Diagnostics;
+use read::Format;
+
+/// A loaded scene and the warnings met on the way.
+#[derive(Debug)]
+pub struct LoadedScene {
+    pub parts: glint_render::SceneParts,
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// Loads a course scene file, XML or JSON (told apart by content, then by extension). Assets
+/// (OBJ meshes, textures, environment maps) are found relative to the file's directory.
+pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
+    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    match String::from_utf8(bytes) {
+        Ok(text) => load_scene_from_text(&text, path),
+        Err(error) => {
+            let valid_up_to = error.utf8_error().valid_up_to();
+            let valid = String::from_utf8_lossy(&error.as_bytes()[..valid_up_to]).into_owned();
+            let diagnostics = Diagnostics::new(path, &valid);
+            Err(diagnostics.error(
+                diagnostics.span_at(valid_up_to),
+                "the file is not UTF-8 text",
+            ))
+        }
+    }
+}
+
+/// Loads a scene from its text. `path` names it in diagnostics and locates its assets.
+pub fn load_scene_from_text(text: &str, path: &Path) -> Result<LoadedScene, SceneError> {
+    // A byte-order mark is not part of line 1's columns.
+    let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    let mut diagnostics = Diagnostics::new(path, text);
+    let format = detect_format(text, path, &diagnostics)?;
+    let root = match format {
+        Format::Xml => xml::parse(text, &diagnostics)?,
+        Format::Json => json::parse(text, &diagnostics)?,
+    };
+    let desc = read::read_document(&root, format, &mut diagnostics)?;
+    let base_directory = path.parent().unwrap_or(Path::new(""));
+    let parts = build::build(&desc, base_directory, &mut diagnostics)?;
+    Ok(LoadedScene {
+        parts,
+        warnings: diagnostics.into_warnings(),
+    })
+}
+
+/// XML starts with `<`, JSON with `{`; otherwise the extension decides.
+fn detect_format(text: &str, path: &Path, diagnostics: &Diagnostics) -> Result<Format, SceneError> {
+    match text.trim_start().chars().next() {
+        Some('<') => return Ok(Format::Xml),
+        Some('{') | Some('[') => return Ok(Format::Json),
+        _ => {}
+    }
+    let extension = path
+        .extension()
+        .map(|extension| extension.to_string_lossy().to_lowercase());
+    match extension.as_deref() {
+        Some("xml") => Ok(Format::Xml),
+        Some("json") => Ok(Format::Json),
+        _ => {
+            let offset = text.len() - text.trim_start().len();
+            Err(diagnostics.error(
+                diagnostics.span_at(offset),
+                "not a scene file: expected XML (starting with `<`) or JSON (starting with `{`)",
+            ))
+        }
+    }
+}

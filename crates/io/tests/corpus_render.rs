@@ -51,10 +51,18 @@ fn every_corpus_scene_loads_and_renders_without_nan() {
     let Some(dir) = corpus_dir() else { return };
     let mut files = Vec::new();
     scene_files(&dir, &mut files);
-    assert!(files.len() > 80, "expected the whole corpus, found {}", files.len());
+    assert!(
+        files.len() > 80,
+        "expected the whole corpus, found {}",
+        files.len()
+    );
     let mut failures = Vec::new();
     for path in &files {
-        let relative = path.strip_prefix(&dir).unwrap().to_string_lossy().replace('\\', "/");
+        let relative = path
+            .strip_prefix(&dir)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
         let loaded = match glint_io::load_scene(path) {
             Ok(loaded) => loaded,
             Err(e) => {
@@ -68,7 +76,9 @@ fn every_corpus_scene_loads_and_renders_without_nan() {
                 .iter()
                 .any(|w| w.message.contains(asset) && w.line > 0 && w.column > 0);
             if !warned {
-                failures.push(format!("{relative}: no located warning about missing {asset}"));
+                failures.push(format!(
+                    "{relative}: no located warning about missing {asset}"
+                ));
             }
         }
         let scene = Scene::new(loaded.parts);
@@ -87,6 +97,10 @@ fn every_corpus_scene_loads_and_renders_without_nan() {
         }
         println!("{relative}: ok ({} rays)", stats.rays);
     }
-    assert!(failures.is_empty(), "corpus failures:\n{}", failures.join("\n"));
+    assert!(
+        failures.is_empty(),
+        "corpus failures:\n{}",
+        failures.join("\n")
+    );
     println!("{} corpus scenes loaded and rendered", files.len());
 }

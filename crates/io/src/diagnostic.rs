@@ -1,0 +1,331 @@
+//! Diagnostics that point into scene files: `file:line:col`, the offending line and a caret,
+//! the way compilers report. Errors stop the load (`SceneError`); warnings are collected and
+//! handed back with the scene so the application decides how to show them.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use crate::desc::Span;
+
+/// How bad a diagnostic is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Severity {
+    /// The scene cannot be loaded.
+    Error,
+    /// The scene loads, but something in it was ignored or replaced by a fallback.
+    Warning,
+}
+
+/// One message about a place in a scene file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Diagnostic {
+    pub severity: Severity,
+    /// The scene file (as it was named to the loader).
+    pub path: PathBuf,
+    /// 1-based line.
+    pub line: u32,
+    /// 1-based column, counted in characters.
+    pub column: u32,
+    pub message: String,
+    /// The text of the offending line (without its line break), for display. `Display` shows
+    /// an excerpt around the column when the line is very long.
+    pub source_line: Option<String>,
+}
+
+impl fmt::Display for Diagnostic {
+    fn fmt(&self, formatter: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let label = match self.severity {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        };
+        write!(
+            formatter,
+            "{}:{}:{}: {label}: {}",
+            self.path.display(),
+            self.line,
+            self.column,
+            self.message
+        )?;
+        if let Some(source_line) = &self.source_line {
+            let (shown, caret_offset) =
+                excerpt_around(source_line, self.column.saturating_sub(1) as usize);
+            // Reuse the line's own tabs in front of the caret so it lines up however wide the
+            // terminal draws a tab.
+            let caret_indent: String = shown
+                .chars()
+                .take(caret_offset)
+                .map(|character| if character == '\t' { '\t' } else { ' ' })
+                .collect();
+            write!(formatter, "\n{shown}\n{caret_indent}^")?;
+        }
+        Ok(())
+    }
+}
+
+/// Lines longer than this are shown as an excerpt around the column (one course file is a
+/// single line of 89,000 characters).
+const SHOWN_LINE_LIMIT: usize = 120;
+
+/// The part of `line` to display and the caret's character offset in it.
+fn excerpt_around(line: &str, column_index: usize) -> (String, usize) {
+    let characters: Vec<char> = line.chars().collect();
+    if characters.len() <= SHOWN_LINE_LIMIT {
+        return (line.to_owned(), column_index);
+    }
+    let start = column_index
+        .saturating_sub(SHOWN_LINE_LIMIT / 2)
+        .min(characters.len() - SHOWN_LINE_LIMIT);
+    let end = start + SHOWN_LINE_LIMIT;
+    let mut shown = String::new();
+    let mut caret_offset = column_index - start;
+    if start > 0 {
+        shown.push_str("...");
+        caret_offset += 3;
+    }
+    shown.extend(&characters[start..end]);
+    if end < characters.len() {
+        shown.push_str("...");
+    }
+    (shown, caret_offset)
+}
+
+/// Why a scene could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    /// The scene file itself could not be read.
+    #[error("cannot read scene file {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    /// A syntax error or an invalid value, with its location.
+    #[error("{0}")]
+    Invalid(Diagnostic),
+}
+
+impl SceneError {
+    /// The located diagnostic, when the error has one.
+    pub fn diagnostic(&self) -> Option<&Diagnostic> {
+        match self {
+            SceneError::Io { .. } => None,
+            SceneError::Invalid(diagnostic) => Some(diagnostic),
+        }
+    }
+}
+
+/// Byte offsets to 1-based line and character column. roxmltree's `text_pos_at` rescans the
+/// document from the start on every call, which is quadratic over scenes with thousands of
+/// shapes; this index answers each query with a binary search.
+pub(crate) struct LineIndex<'text> {
+    text: &'text str,
+    line_starts: Vec<usize>,
+}
+
+impl<'text> LineIndex<'text> {
+    pub fn new(text: &'text str) -> LineIndex<'text> {
+        let mut line_starts = vec![0];
+        line_starts.extend(
+            text.bytes()
+                .enumerate()
+                .filter(|&(_, byte)| byte == b'\n')
+                .map(|(offset, _)| offset + 1),
+        );
+        LineIndex { text, line_starts }
+    }
+
+    pub fn span_at(&self, offset: usize) -> Span {
+        let mut offset = offset.min(self.text.len());
+        while !self.text.is_char_boundary(offset) {
+            offset -= 1;
+        }
+        let line_index = self.line_starts.partition_point(|&start| start <= offset) - 1;
+        let line_start = self.line_starts[line_index];
+        let column = self.text[line_start..offset].chars().count() + 1;
+        Span {
+            line: u32::try_from(line_index + 1).unwrap_or(u32::MAX),
+            column: u32::try_from(column).unwrap_or(u32::MAX),
+        }
+    }
+
+    /// The text of 1-based `line`, without its line break.
+    pub fn line_text(&self, line: u32) -> Option<&'text str> {
+        let index = (line as usize).checked_sub(1)?;
+        let start = *self.line_starts.get(index)?;
+        let end = self
+            .line_starts
+            .get(index + 1)
+            .map_or(self.text.len(), |&next| next - 1);
+        Some(self.text[start..end].trim_end_matches('\r'))
+    }
+}
+
+/// The collector every stage reports into: it knows the file and its text, so a `Span` is all a
+/// caller needs to give.
+pub(crate) struct Diagnostics<'text> {
+    path: PathBuf,
+    lines: LineIndex<'text>,
+    warnings: Vec<Diagnostic>,
+}
+
+impl<'text> Diagnostics<'text> {
+    pub fn new(path: &Path, text: &'text str) -> Diagnostics<'text> {
+        Diagnostics {
+            path: path.to_path_buf(),
+            lines: LineIndex::new(text),
+            warnings: Vec::new(),
+        }
+    }
+
+    pub fn span_at(&self, offset: usize) -> Span {
+        self.lines.span_at(offset)
+    }
+
+    fn diagnostic(&self, severity: Severity, span: Span, message: String) -> Diagnostic {
+        Diagnostic {
+            severity,
+            path: self.path.clone(),
+            line: span.line,
+            column: span.column,
+            message,
+            source_line: self.lines.line_text(span.line).map(str::to_owned),
+        }
+    }
+
+    pub fn warn(&mut self, span: Span, message: impl Into<String>) {
+        let diagnostic = self.diagnostic(Severity::Warning, span, message.into());
+        self.warnings.push(diagnostic);
+    }
+
+    pub fn error(&self, span: Span, message: impl Into<String>) -> SceneError {
+        SceneError::Invalid(self.diagnostic(Severity::Error, span, message.into()))
+    }
+
+    pub fn into_warnings(self) -> Vec<Diagnostic> {
+        self.warnings
+    }
+}
+
+/// " (did you mean `x`?)" when one of `candidates` is a plausible intended spelling of `word`:
+/// equal ignoring case, or within an edit distance of about a third of its length.
+pub(crate) fn did_you_mean<'a>(
+    word: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> String {
+    let word_lower = word.to_lowercase();
+    let allowed = (word.chars().count() / 3).max(1);
+    let best = candidates
+        .into_iter()
+        .filter(|candidate| *candidate != word)
+        .map(|candidate| {
+            (
+                edit_distance(&word_lower, &candidate.to_lowercase()),
+                candidate,
+            )
+        })
+        .filter(|&(distance, _)| distance <= allowed)
+        // Ties go to the alphabetically first candidate, so messages do not depend on the
+        // order of a hash map.
+        .min();
+    match best {
+        Some((_, candidate)) => format!(" (did you mean `{candidate}`?)"),
+        None => String::new(),
+    }
+}
+
+/// Edit distance over characters where swapping two neighbours counts as one edit (optimal
+/// string alignment), since `bleu` for `blue` is a typical slip.
+fn edit_distance(a: &str, b: &str) -> usize {
+    let a: Vec<char> = a.chars().collect();
+    let b: Vec<char> = b.chars().collect();
+    let mut table = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in table.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in table[0].iter_mut().enumerate() {
+        *cell = j;
+    }
+    for i in 1..=a.len() {
+        for j in 1..=b.len() {
+            let substitution = table[i - 1][j - 1] + usize::from(a[i - 1] != b[j - 1]);
+            let mut best = substitution
+                .min(table[i - 1][j] + 1)
+                .min(table[i][j - 1] + 1);
+            if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                best = best.min(table[i - 2][j - 2] + 1);
+            }
+            table[i][j] = best;
+        }
+    }
+    table[a.len()][b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn line_index_counts_characters_from_one() {
+        let index = LineIndex::new("ab\ncé d\r\nxyz");
+        assert_eq!(index.span_at(0), Span { line: 1, column: 1 });
+        assert_eq!(index.span_at(3), Span { line: 2, column: 1 });
+        // 'é' is two bytes but one column.
+        assert_eq!(index.span_at(6), Span { line: 2, column: 3 });
+        assert_eq!(index.line_text(2), Some("cé d"));
+        assert_eq!(index.line_text(3), Some("xyz"));
+        assert_eq!(index.line_text(4), None);
+        assert_eq!(index.span_at(100), Span { line: 3, column: 4 });
+    }
+
+    #[test]
+    fn suggestions_need_a_close_candidate() {
+        assert_eq!(
+            did_you_mean("Mirrored", ["Lambertian", "Mirror"]),
+            " (did you mean `Mirror`?)"
+        );
+        assert_eq!(
+            did_you_mean("cameras", ["camera", "shape"]),
+            " (did you mean `camera`?)"
+        );
+        assert_eq!(did_you_mean("monster", ["center", "radius"]), "");
+        assert_eq!(did_you_mean("bleu", ["blue"]), " (did you mean `blue`?)");
+        assert_eq!(
+            did_you_mean("envmapprefix", ["envMapPrefix"]),
+            " (did you mean `envMapPrefix`?)"
+        );
+    }
+
+    #[test]
+    fn display_puts_a_caret_under_the_column() {
+        let diagnostic = Diagnostic {
+            severity: Severity::Warning,
+            path: PathBuf::from("scene.xml"),
+            line: 3,
+            column: 5,
+            message: "something".into(),
+            source_line: Some("\tab cd".into()),
+        };
+        assert_eq!(
+            diagnostic.to_string(),
+            "scene.xml:3:5: warning: something\n\tab cd\n\t   ^"
+        );
+    }
+
+    #[test]
+    fn long_lines_are_shown_around_the_column() {
+        let line = format!("{}X{}", "a".repeat(500), "b".repeat(500));
+        let diagnostic = Diagnostic {
+            severity: Severity::Error,
+            path: PathBuf::from("long.json"),
+            line: 1,
+            column: 501,
+            message: "here".into(),
+            source_line: Some(line),
+        };
+        let shown = diagnostic.to_string();
+        let lines: Vec<&str> = shown.lines().collect();
+        assert!(lines[1].len() < 130);
+        let caret = lines[2].find('^').unwrap();
+        assert_eq!(lines[1].as_bytes()[caret], b'X');
+    }
+}

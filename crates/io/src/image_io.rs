@@ -1,0 +1,372 @@
+//! Images in and out: textures and environment maps read as linear RGB, and the rendered film
+//! written atomically as PNG or EXR.
+
+use std::fs::File;
+use std::io::{BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use glint_render::film::Film;
+use glint_render::{Color, CubeMap, Image};
+
+/// Reads a texture or environment-map image. The course applies no gamma anywhere
+/// (FORMAT.md 1.3), so a texel is its 8-bit value / 255; alpha is dropped.
+pub(crate) fn load_image(path: &Path) -> Result<Image, String> {
+    let reader = image::ImageReader::open(path)
+        .map_err(|error| error.to_string())?
+        .with_guessed_format()
+        .map_err(|error| error.to_string())?;
+    let decoded = reader.decode().map_err(|error| error.to_string())?;
+    let rgb = decoded.to_rgb8();
+    let (width, height) = rgb.dimensions();
+    let texels = rgb
+        .pixels()
+        .map(|pixel| {
+            Color::new(
+                f32::from(pixel[0]) / 255.0,
+                f32::from(pixel[1]) / 255.0,
+                f32::from(pixel[2]) / 255.0,
+            )
+        })
+        .collect();
+    Ok(Image {
+        width,
+        height,
+        texels,
+    })
+}
+
+/// The six file names of a cube map given by `envMapPrefix` (FORMAT.md 2.1), in the face order
+/// of `CubeMap`: +X, -X, +Y, -Y, +Z, -Z.
+pub(crate) fn cube_face_paths(prefix: &str) -> [String; 6] {
+    ["posX", "negX", "posY", "negY", "posZ", "negZ"].map(|face| format!("{prefix}{face}.png"))
+}
+
+/// Cuts a vertical-cross environment map (FORMAT.md 3.7: `envMapVertCross`, 3 columns x 4 rows
+/// of square faces) into the six faces of a `CubeMap`.
+///
+/// Layout (FORMAT.md A14), columns 0-2 left to right, rows 0-3 top to bottom:
+/// ```text
+///        +Y
+///    -X  +Z  +X
+///        -Y
+///        -Z   (stored upside down)
+/// ```
+/// With `CubeMap`'s OpenGL convention the middle row lines up edge to edge (the right edge of
+/// +Z is the left edge of +X, and so on), +Y's bottom edge meets +Z's top edge and -Y's top edge
+/// meets +Z's bottom edge, so those five regions are the faces as stored. The -Z region hangs
+/// below -Y, so in the cross its top edge is the y = -1 edge and x grows to the right; the
+/// OpenGL -Z face has y = +1 at the top and x growing to the left. The region is therefore the
+/// face turned by 180°, and we turn it back.
+pub(crate) fn cut_vertical_cross(cross: &Image) -> Result<[Image; 6], String> {
+    let face_size = cross.width / 3;
+    if face_size == 0 || cross.width != face_size * 3 || cross.height != face_size * 4 {
+        return Err(format!(
+            "a vertical cross is 3 x 4 square faces, but the image is {} x {} pixels",
+            cross.width, cross.height
+        ));
+    }
+    let region = |column: u32, row: u32, rotated: bool| -> Image {
+        let mut texels = Vec::with_capacity((face_size * face_size) as usize);
+        for y in 0..face_size {
+            for x in 0..face_size {
+                let (source_x, source_y) = if rotated {
+                    (face_size - 1 - x, face_size - 1 - y)
+                } else {
+                    (x, y)
+                };
+                texels.push(cross.texel(column * face_size + source_x, row * face_size + source_y));
+            }
+        }
+        Image {
+            width: face_size,
+            height: face_size,
+            texels,
+        }
+    };
+    Ok([
+        region(2, 1, false), // +X
+        region(0, 1, false), // -X
+        region(1, 0, false), // +Y
+        region(1, 2, false), // -Y
+        region(1, 1, false), // +Z
+        region(1, 3, true),  // -Z
+    ])
+}
+
+/// Loads the six faces named by `envMapPrefix`, resolved against `directory`.
+pub(crate) fn load_cube_map(directory: &Path, prefix: &str) -> Result<CubeMap, String> {
+    let mut faces = Vec::with_capacity(6);
+    for name in cube_face_paths(prefix) {
+        let path = directory.join(&name);
+        let face = load_image(&path)
+            .map_err(|error| format!("cannot read face `{name}` ({}): {error}", path.display()))?;
+        faces.push(face);
+    }
+    let faces: [Image; 6] = faces
+        .try_into()
+        .map_err(|_| "a cube map needs six faces".to_owned())?;
+    Ok(CubeMap { faces })
+}
+
+/// Why an image could not be written.
+#[derive(Debug, thiserror::Error)]
+pub enum ImageWriteError {
+    #[error(
+        "cannot write {}: unsupported image format `{extension}` (use .png or .exr)",
+        path.display()
+    )]
+    UnsupportedExtension { path: PathBuf, extension: String },
+    #[error("cannot write {}: the film is {width} x {height} but holds {pixels} pixels", path.display())]
+    InvalidFilm {
+        path: PathBuf,
+        width: u32,
+        height: u32,
+        pixels: usize,
+    },
+    #[error("cannot write {}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot encode {}: {source}", path.display())]
+    Encode {
+        path: PathBuf,
+        #[source]
+        source: image::ImageError,
+    },
+}
+
+#[derive(Clone, Copy)]
+enum OutputFormat {
+    Png,
+    Exr,
+}
+
+/// Writes the film to `path`: `.png` as 8-bit RGB with the course's conversion (clamp,
+/// floor(c·255), no gamma: `Film::to_rgb8_course`), `.exr` as linear RGB f32.
+///
+/// The image is written to a temporary file in the same directory and renamed over `path` only
+/// when complete, so a failure never leaves a truncated or empty file behind.
+pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
+    let extension = path
+        .extension()
+        .map(|extension| extension.to_string_lossy().to_lowercase())
+        .unwrap_or_default();
+    let format = match extension.as_str() {
+        "png" => OutputFormat::Png,
+        "exr" => OutputFormat::Exr,
+        _ => {
+            return Err(ImageWriteError::UnsupportedExtension {
+                path: path.to_path_buf(),
+                extension: if extension.is_empty() {
+                    "(none)".to_owned()
+                } else {
+                    format!(".{extension}")
+                },
+            })
+        }
+    };
+    let expected_pixels = film.width as usize * film.height as usize;
+    if film.pixels.len() != expected_pixels || expected_pixels == 0 {
+        return Err(ImageWriteError::InvalidFilm {
+            path: path.to_path_buf(),
+            width: film.width,
+            height: film.height,
+            pixels: film.pixels.len(),
+        });
+    }
+    let io_error = |source: std::io::Error| ImageWriteError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let directory = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let mut temporary = tempfile::Builder::new()
+        .prefix(".glint-")
+        .suffix(".partial")
+        .tempfile_in(directory)
+        .map_err(io_error)?;
+    {
+        let mut writer = BufWriter::new(temporary.as_file_mut());
+        encode(format, film, &mut writer).map_err(|source| ImageWriteError::Encode {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        writer.flush().map_err(io_error)?;
+    }
+    temporary.as_file().sync_all().map_err(io_error)?;
+    set_readable_permissions(temporary.as_file(), path).map_err(io_error)?;
+    // The temporary file is removed when `temporary` drops on any error above.
+    temporary
+        .persist(path)
+        .map_err(|error| io_error(error.error))?;
+    Ok(())
+}
+
+fn encode(
+    format: OutputFormat,
+    film: &Film,
+    writer: &mut BufWriter<&mut File>,
+) -> Result<(), image::ImageError> {
+    let dimension_error = || {
+        image::ImageError::Parameter(image::error::ParameterError::from_kind(
+            image::error::ParameterErrorKind::DimensionMismatch,
+        ))
+    };
+    match format {
+        OutputFormat::Png => {
+            let buffer = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8_course())
+                .ok_or_else(dimension_error)?;
+            buffer.write_to(writer, image::ImageFormat::Png)
+        }
+        OutputFormat::Exr => {
+            let buffer = image::Rgb32FImage::from_raw(film.width, film.height, film.to_rgb_f32())
+                .ok_or_else(dimension_error)?;
+            buffer.write_to(writer, image::ImageFormat::OpenExr)
+        }
+    }
+}
+
+/// Temporary files are created private (0600); the output should get the permissions of the file
+/// it replaces, or the usual 0644 for a new one.
+#[cfg(unix)]
+fn set_readable_permissions(file: &File, target: &Path) -> std::io::Result<()> {
+    use std::os::unix::fs::PermissionsExt;
+    let permissions = match std::fs::metadata(target) {
+        Ok(existing) => existing.permissions(),
+        Err(_) => std::fs::Permissions::from_mode(0o644),
+    };
+    file.set_permissions(permissions)
+}
+
+#[cfg(not(unix))]
+fn set_readable_permissions(_file: &File, _target: &Path) -> std::io::Result<()> {
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glint_render::Vec3;
+
+    fn solid(size: u32, color: Color) -> Image {
+        Image {
+            width: size,
+            height: size,
+            texels: vec![color; (size * size) as usize],
+        }
+    }
+
+    /// A cross whose every region has its own colour, with the region's top-left texel marked
+    /// by its column and row so orientation can be checked.
+    fn marked_cross(size: u32) -> Image {
+        let mut texels = Vec::new();
+        for y in 0..4 * size {
+            for x in 0..3 * size {
+                let (column, row) = (x / size, y / size);
+                let mut color = Vec3::new(column as f32, row as f32, 0.0);
+                if x % size == 0 && y % size == 0 {
+                    color.z = 1.0; // top-left corner of the region as stored
+                }
+                texels.push(color);
+            }
+        }
+        Image {
+            width: 3 * size,
+            height: 4 * size,
+            texels,
+        }
+    }
+
+    #[test]
+    fn vertical_cross_faces_come_out_in_cube_map_order() {
+        let size = 4;
+        let faces = cut_vertical_cross(&marked_cross(size)).unwrap();
+        let region_of = |face: &Image| {
+            let texel = face.texel(1, 1);
+            (texel.x as u32, texel.y as u32)
+        };
+        // +X, -X, +Y, -Y, +Z, -Z.
+        let expected = [(2, 1), (0, 1), (1, 0), (1, 2), (1, 1), (1, 3)];
+        for (face, expected) in faces.iter().zip(expected) {
+            assert_eq!((face.width, face.height), (size, size));
+            assert_eq!(region_of(face), expected);
+        }
+        // The first five are stored upright: the marked corner stays top-left.
+        for face in &faces[..5] {
+            assert_eq!(face.texel(0, 0).z, 1.0);
+        }
+        // -Z is turned by 180°: its stored top-left corner ends up bottom-right.
+        assert_eq!(faces[5].texel(0, 0).z, 0.0);
+        assert_eq!(faces[5].texel(size - 1, size - 1).z, 1.0);
+    }
+
+    #[test]
+    fn vertical_cross_needs_three_by_four_squares() {
+        let wrong = solid(6, Vec3::ONE);
+        assert!(cut_vertical_cross(&wrong).is_err());
+        let empty = Image {
+            width: 0,
+            height: 0,
+            texels: Vec::new(),
+        };
+        assert!(cut_vertical_cross(&empty).is_err());
+    }
+
+    #[test]
+    fn cube_map_files_are_named_in_face_order() {
+        assert_eq!(
+            cube_face_paths("images/reef_"),
+            [
+                "images/reef_posX.png",
+                "images/reef_negX.png",
+                "images/reef_posY.png",
+                "images/reef_negY.png",
+                "images/reef_posZ.png",
+                "images/reef_negZ.png",
+            ]
+        );
+    }
+
+    #[test]
+    fn cube_map_faces_are_seen_along_their_axes() {
+        let directory = tempfile::tempdir().unwrap();
+        let colors = [
+            [255u8, 0, 0],
+            [0, 255, 0],
+            [0, 0, 255],
+            [255, 255, 0],
+            [0, 255, 255],
+            [255, 0, 255],
+        ];
+        for (name, color) in cube_face_paths("sky_").iter().zip(colors) {
+            image::RgbImage::from_pixel(2, 2, image::Rgb(color))
+                .save(directory.path().join(name))
+                .unwrap();
+        }
+        let map = load_cube_map(directory.path(), "sky_").unwrap();
+        let directions = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
+        for (direction, color) in directions.into_iter().zip(colors) {
+            let expected = Vec3::new(
+                f32::from(color[0]) / 255.0,
+                f32::from(color[1]) / 255.0,
+                f32::from(color[2]) / 255.0,
+            );
+            assert_eq!(
+                map.lookup(direction),
+                expected,
+                "looking along {direction:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn missing_cube_map_face_names_the_file() {
+        let directory = tempfile::tempdir().unwrap();
+        let error = load_cube_map(directory.path(), "data/reef_").unwrap_err();
+        assert!(error.contains("data/reef_posX.png"), "{error}");
+    }
+}

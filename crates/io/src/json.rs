@@ -1,0 +1,131 @@
+//! Course JSON (FORMAT.md 3) into the located tree, with jsonc-parser: its AST keeps the byte
+//! range of every value, which serde-style parsers throw away. Comments and trailing commas are
+//! accepted, as hand-edited files sometimes have them.
+
+use jsonc_parser::ast;
+use jsonc_parser::common::Ranged;
+
+use crate::diagnostic::{Diagnostics, SceneError};
+use crate::tree::{Node, Value};
+
+/// Parses `text` and returns the top-level value as a node with an empty key.
+pub(crate) fn parse(text: &str, diagnostics: &Diagnostics) -> Result<Node, SceneError> {
+    check_nesting(text, diagnostics)?;
+    let result = jsonc_parser::parse_to_ast(
+        text,
+        &jsonc_parser::CollectOptions::default(),
+        &jsonc_parser::ParseOptions::default(),
+    )
+    .map_err(|error| {
+        diagnostics.error(
+            diagnostics.span_at(error.range().start),
+            format!("malformed JSON: {}", error.kind()),
+        )
+    })?;
+    let Some(value) = result.value else {
+        return Err(diagnostics.error(
+            diagnostics.span_at(text.len()),
+            "malformed JSON: the file holds no value",
+        ));
+    };
+    let span = diagnostics.span_at(value.start());
+    Ok(Node::new("", span, span, convert(&value, diagnostics)))
+}
+
+/// Far deeper than any scene needs (the course's deepest is 5). jsonc-parser descends
+/// recursively, so a file nested thousands deep would overflow the stack before it could report
+/// anything; such files are refused up front.
+pub(crate) const MAX_NESTING: usize = 100;
+
+/// Counts brackets outside strings and comments, and fails where the nesting gets too deep.
+fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError> {
+    let bytes = text.as_bytes();
+    let mut depth = 0usize;
+    let mut index = 0;
+    while index < bytes.len() {
+        match bytes[index] {
+            quote @ (b'"' | b'\'') => {
+                index += 1;
+                while index < bytes.len() && bytes[index] != quote {
+                    index += if bytes[index] == b'\\' { 2 } else { 1 };
+                }
+            }
+            b'/' if bytes.get(index + 1) == Some(&b'/') => {
+                while index < bytes.len() && bytes[index] != b'\n' {
+                    index += 1;
+                }
+            }
+            b'/' if bytes.get(index + 1) == Some(&b'*') => {
+                index += 2;
+                while index < bytes.len() && !bytes[index..].starts_with(b"*/") {
+                    index += 1;
+                }
+                index += 1;
+            }
+            b'{' | b'[' => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Err(diagnostics.error(
+                        diagnostics.span_at(index),
+                        format!("nested more than {MAX_NESTING} levels deep; not a scene file"),
+                    ));
+                }
+            }
+            b'}' | b']' => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+        index += 1;
+    }
+    Ok(())
+}
+
+fn convert(value: &ast::Value, diagnostics: &Diagnostics) -> Value {
+    match value {
+        ast::Value::StringLit(string) => Value::Text(string.value.to_string()),
+        ast::Value::NumberLit(number) => Value::Number(number.value.to_owned()),
+        ast::Value::BooleanLit(boolean) => Value::Bool(boolean.value),
+        ast::Value::NullKeyword(_) => Value::Null,
+        ast::Value::Array(array) => Value::List(
+            array
+                .elements
+                .iter()
+                .map(|element| {
+                    let span = diagnostics.span_at(element.start());
+                    Node::new("", span, span, convert(element, diagnostics))
+                })
+                .collect(),
+        ),
+        ast::Value::Object(object) => {
+            let mut entries = Vec::new();
+            for property in &object.properties {
+                let name = property.name.as_str();
+                let key_span = diagnostics.span_at(property.name.start());
+                match &property.value {
+                    // The converter's repeated elements (FORMAT.md 3.1): one entry per element.
+                    ast::Value::Array(array)
+                        if array
+                            .elements
+                            .iter()
+                            .any(|element| matches!(element, ast::Value::Object(_))) =>
+                    {
+                        for element in &array.elements {
+                            entries.push(Node::new(
+                                name,
+                                key_span,
+                                diagnostics.span_at(element.start()),
+                                convert(element, diagnostics),
+                            ));
+                        }
+                    }
+                    value => entries.push(Node::new(
+                        name,
+                        key_span,
+                        diagnostics.span_at(value.start()),
+                        convert(value, diagnostics),
+                    )),
+                }
+            }
+            Value::Object(entries)
+        }
+    }
+}

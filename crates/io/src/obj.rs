@@ -1,0 +1,106 @@
+//! OBJ meshes with tobj. The course meshes hold only `v` and `f` records (FORMAT.md 4.6); normals
+//! and texture coordinates are not used, and materials (`mtllib`, `usemtl`) are ignored because
+//! the course gives one shader per mesh.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::Path;
+
+use glint_render::Vec3;
+
+/// The triangles of an OBJ file, polygons fan-triangulated (`al.obj` has faces of 3 to 23
+/// vertices). Errors are messages for a warning.
+pub(crate) fn load_triangles(path: &Path) -> Result<Vec<[Vec3; 3]>, String> {
+    let file = File::open(path).map_err(|error| error.to_string())?;
+    let mut reader = BufReader::new(file);
+    // `..Default::default()` is needless today, but tobj's optional features (merging,
+    // reordering) add fields, and feature unification could turn them on.
+    #[allow(clippy::needless_update)]
+    let options = tobj::LoadOptions {
+        // tobj triangulates a polygon as the fan (v0, vi, vi+1).
+        triangulate: true,
+        // Only positions are used, so whether indices are unified does not matter.
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    // Never open the material library: the course ignores OBJ materials.
+    let (models, _materials) =
+        tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default()))
+            .map_err(|error| format!("not a readable OBJ file ({error})"))?;
+    let mut triangles = Vec::new();
+    for model in &models {
+        let positions = &model.mesh.positions;
+        let vertex = |index: u32| -> Option<Vec3> {
+            let start = index as usize * 3;
+            let coordinates = positions.get(start..start + 3)?;
+            Some(Vec3::new(coordinates[0], coordinates[1], coordinates[2]))
+                .filter(|vertex| vertex.is_finite())
+        };
+        for face in model.mesh.indices.chunks_exact(3) {
+            match (vertex(face[0]), vertex(face[1]), vertex(face[2])) {
+                (Some(a), Some(b), Some(c)) => triangles.push([a, b, c]),
+                _ => {
+                    return Err(format!(
+                        "a face in `{}` uses a vertex that does not exist or is not finite",
+                        model.name
+                    ))
+                }
+            }
+        }
+    }
+    Ok(triangles)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn polygons_become_fans() {
+        let directory = tempfile::tempdir().unwrap();
+        let path = directory.path().join("quad.obj");
+        std::fs::write(
+            &path,
+            "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 2 0\nusemtl x\nf 1 2 3 4 5\n",
+        )
+        .unwrap();
+        let triangles = load_triangles(&path).unwrap();
+        assert_eq!(triangles.len(), 3);
+        assert_eq!(
+            triangles[0],
+            [Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0)]
+        );
+        assert_eq!(triangles[2][0], Vec3::ZERO);
+        assert_eq!(triangles[2][2], Vec3::new(0.0, 2.0, 0.0));
+    }
+
+    #[test]
+    fn missing_file_is_an_error_message() {
+        let error = load_triangles(Path::new("/nonexistent/file.obj")).unwrap_err();
+        assert!(error.contains("No such file"), "{error}");
+    }
+
+    #[test]
+    fn malformed_obj_files_do_not_panic() {
+        let directory = tempfile::tempdir().unwrap();
+        let cases = [
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -5 1 2\n",
+            "v a b c\nf 1 2 3\n",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/2/3 2/9/9 3//7\n",
+            "f\nv\nvt 1\nvn\n",
+            "\u{0}\u{1}binary",
+            "v 1e40 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        ];
+        for (index, contents) in cases.iter().enumerate() {
+            let path = directory.path().join(format!("case{index}.obj"));
+            std::fs::write(&path, contents).unwrap();
+            let _ = load_triangles(&path);
+        }
+        let path = directory.path().join("case7.obj");
+        assert!(load_triangles(&path).unwrap_err().contains("not finite"));
+    }
+}

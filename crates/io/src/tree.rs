@@ -1,0 +1,70 @@
+//! One located tree for both file formats. The course's JSON files were made by a mechanical
+//! XML-to-JSON conversion (FORMAT.md 3.1): attributes became `_`-prefixed keys, element text
+//! became strings and repeated elements became arrays. Undoing that conversion here lets one
+//! reader (`read.rs`) interpret both formats, so XML and JSON twins cannot drift apart.
+//!
+//! The mapping:
+//! * XML attribute `name="x"` and JSON key `"_name": "x"` are both an entry `name` (leading
+//!   underscores are dropped: JL26 accepts `type` as well as `_type`, FORMAT.md 3.2);
+//! * an XML element with only text is a `Text` entry; one with attributes or child elements is
+//!   an `Object` whose entries are its attributes, then its children, then its text as `#text`;
+//! * a JSON array of objects is expanded into repeated entries with the array's key, exactly
+//!   as repeated XML elements (so `"light": {...}` and `"light": [{...}]` read alike, 3.2);
+//!   other arrays (`"center": [1, 2, 3]`) stay a `List`.
+
+use crate::desc::Span;
+
+/// Key under which an XML element's text is kept when the element also has attributes or
+/// children (`<diffuse tex="earth">1 1 1</diffuse>`, `<rotate axis="X">45</rotate>`).
+pub(crate) const TEXT_KEY: &str = "#text";
+
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) struct Node {
+    /// The key with leading underscores removed; empty for list elements.
+    pub key: String,
+    /// The key as written, for messages.
+    pub raw_key: String,
+    /// Where the key (XML: the element or attribute) starts.
+    pub key_span: Span,
+    /// Where the value starts.
+    pub span: Span,
+    pub value: Value,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub(crate) enum Value {
+    /// XML text or attribute value, or a JSON string.
+    Text(String),
+    /// A JSON number literal, still as text.
+    Number(String),
+    Bool(bool),
+    Null,
+    /// A JSON array that is not a list of objects.
+    List(Vec<Node>),
+    /// XML element with attributes or children, or a JSON object.
+    Object(Vec<Node>),
+}
+
+impl Node {
+    pub fn new(raw_key: &str, key_span: Span, span: Span, value: Value) -> Node {
+        Node {
+            key: raw_key.trim_start_matches('_').to_owned(),
+            raw_key: raw_key.to_owned(),
+            key_span,
+            span,
+            value,
+        }
+    }
+
+    /// How the value reads in a message ("a number", "an object").
+    pub fn kind_name(&self) -> &'static str {
+        match self.value {
+            Value::Text(_) => "text",
+            Value::Number(_) => "a number",
+            Value::Bool(_) => "a boolean",
+            Value::Null => "null",
+            Value::List(_) => "a list",
+            Value::Object(_) => "an object",
+        }
+    }
+}

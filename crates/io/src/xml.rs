@@ -1,0 +1,157 @@
+//! Course XML (FORMAT.md 2) into the located tree, with roxmltree.
+
+use crate::desc::Span;
+use crate::diagnostic::{Diagnostics, SceneError};
+use crate::tree::{Node, Value, TEXT_KEY};
+
+/// Parses `text` and returns the root element as a node keyed by its tag name.
+pub(crate) fn parse(text: &str, diagnostics: &Diagnostics) -> Result<Node, SceneError> {
+    check_nesting(text, diagnostics)?;
+    let document = roxmltree::Document::parse(text).map_err(|error| {
+        let span = match error {
+            // roxmltree has no position for these and says 1:1; the problem is where the text
+            // stops (a truncated file).
+            roxmltree::Error::UnexpectedEndOfStream | roxmltree::Error::UnclosedRootNode => {
+                diagnostics.span_at(text.len())
+            }
+            _ => {
+                let position = error.pos();
+                Span {
+                    line: position.row,
+                    column: position.col,
+                }
+            }
+        };
+        // roxmltree puts " at line:col" into its messages; the diagnostic says where already.
+        let message = error
+            .to_string()
+            .replace(&format!(" at {}", error.pos()), "");
+        diagnostics.error(span, format!("malformed XML: {message}"))
+    })?;
+    convert_element(document.root_element(), text, diagnostics, 0)
+}
+
+/// Far deeper than any scene needs (the course's deepest is 4). roxmltree and the conversion
+/// below descend recursively, so a file nested thousands deep would overflow the stack before
+/// it could report anything; such files are refused up front.
+const MAX_NESTING: usize = 100;
+
+/// Counts open and close tags outside comments, CDATA and declarations, and fails where the
+/// nesting gets too deep. Malformed markup is left for roxmltree to report.
+fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError> {
+    let bytes = text.as_bytes();
+    let skip_past = |from: usize, pattern: &[u8]| -> usize {
+        bytes[from..]
+            .windows(pattern.len())
+            .position(|window| window == pattern)
+            .map_or(bytes.len(), |position| from + position + pattern.len())
+    };
+    let mut depth = 0usize;
+    let mut index = 0;
+    while let Some(offset) = bytes[index..].iter().position(|&byte| byte == b'<') {
+        let start = index + offset;
+        let rest = &bytes[start..];
+        if rest.starts_with(b"<!--") {
+            index = skip_past(start, b"-->");
+        } else if rest.starts_with(b"<![CDATA[") {
+            index = skip_past(start, b"]]>");
+        } else if rest.starts_with(b"<?") || rest.starts_with(b"<!") {
+            index = skip_past(start, b">");
+        } else if rest.starts_with(b"</") {
+            depth = depth.saturating_sub(1);
+            index = skip_past(start, b">");
+        } else {
+            // An open tag: find its end outside quoted attribute values.
+            let mut end = start + 1;
+            let mut quote = None;
+            while end < bytes.len() {
+                match (quote, bytes[end]) {
+                    (None, b'"' | b'\'') => quote = Some(bytes[end]),
+                    (Some(open), byte) if byte == open => quote = None,
+                    (None, b'>') => break,
+                    _ => {}
+                }
+                end += 1;
+            }
+            let self_closing = end < bytes.len() && bytes[end - 1] == b'/';
+            if !self_closing {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Err(diagnostics.error(
+                        diagnostics.span_at(start),
+                        format!(
+                            "elements nested more than {MAX_NESTING} levels deep; not a scene file"
+                        ),
+                    ));
+                }
+            }
+            index = (end + 1).min(bytes.len());
+        }
+    }
+    Ok(())
+}
+
+fn convert_element(
+    element: roxmltree::Node,
+    text: &str,
+    diagnostics: &Diagnostics,
+    depth: usize,
+) -> Result<Node, SceneError> {
+    let element_span = diagnostics.span_at(element.range().start);
+    if depth > MAX_NESTING {
+        return Err(diagnostics.error(
+            element_span,
+            format!("elements nested more than {MAX_NESTING} levels deep; not a scene file"),
+        ));
+    }
+    let mut entries = Vec::new();
+    for attribute in element.attributes() {
+        entries.push(Node::new(
+            attribute.name(),
+            diagnostics.span_at(attribute.range().start),
+            diagnostics.span_at(attribute.range_value().start),
+            Value::Text(attribute.value().to_owned()),
+        ));
+    }
+    let mut element_text = String::new();
+    let mut text_offset = None;
+    for child in element.children() {
+        if child.is_element() {
+            entries.push(convert_element(child, text, diagnostics, depth + 1)?);
+        } else if child.is_text() {
+            let content = child.text().unwrap_or_default();
+            if text_offset.is_none() && !content.trim().is_empty() {
+                // Point at the first character of the value, not at the whitespace before it.
+                let raw = &text[child.range()];
+                let leading = raw.len() - raw.trim_start().len();
+                text_offset = Some(child.range().start + leading);
+            }
+            element_text.push_str(content);
+        }
+    }
+    let trimmed = element_text.trim();
+    let has_structure = !entries.is_empty();
+    let tag = element.tag_name().name();
+    if !has_structure {
+        let span = text_offset.map_or(element_span, |offset| diagnostics.span_at(offset));
+        return Ok(Node::new(
+            tag,
+            element_span,
+            span,
+            Value::Text(trimmed.to_owned()),
+        ));
+    }
+    if let Some(offset) = text_offset {
+        let span = diagnostics.span_at(offset);
+        let mut text_node = Node::new(TEXT_KEY, span, span, Value::Text(trimmed.to_owned()));
+        // Messages about the text name the element it belongs to.
+        text_node.raw_key = tag.to_owned();
+        entries.push(text_node);
+    }
+    Ok(Node::new(
+        tag,
+        element_span,
+        element_span,
+        Value::Object(entries),
+    ))
+}
