@@ -350,7 +350,26 @@ fn ray_color(
             let kd = resolve(scene, diffuse, &si);
             diffuse_surface(scene, &si, n, kd, depth, ctx)
         }
-        Material::Emissive { radiance, .. } => {
+        Material::Emissive {
+            radiance, light, ..
+        } => {
+            // An area light's rectangle emits along its normal only and is not a solid
+            // object: seen from behind, rays pass through it (a camera placed in a light's
+            // plane, as in threeEggs_SoftShadows.xml, must not see the light's back).
+            let area_normal = light.and_then(|i| match scene.lights.get(i as usize) {
+                Some(Light::Area { normal, .. }) => Some(*normal),
+                _ => None,
+            });
+            if area_normal.is_some_and(|normal| d.dot(normal) >= 0.0) {
+                ctx.rays += 1;
+                return ray_color(
+                    scene,
+                    &Ray::spawn(si.point, ray.direction),
+                    depth,
+                    count_emission,
+                    ctx,
+                );
+            }
             if count_emission {
                 *radiance
             } else {
