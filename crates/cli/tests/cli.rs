@@ -493,6 +493,35 @@ fn negative_radius_fails_with_its_location_and_source_line() {
 }
 
 #[test]
+fn a_word_where_a_vector_belongs_fails_with_its_location() {
+    let scene = SPHERE_JSON.replace("\"center\": \"0 0 -5\"", "\"center\": \"0 zero -5\"");
+    let (text, (line, _)) = assert_bad_scene("scene.json", &scene);
+    assert_eq!(line, line_of(&scene, "0 zero -5"), "{text}");
+}
+
+#[test]
+fn a_missing_obj_is_a_located_warning_and_the_render_goes_on() {
+    let dir = scene_dir();
+    let scene = SPHERE_XML.replace(
+        "</scene>",
+        "  <instance name=\"ghost\" type=\"mesh\">\n    <file>objFiles/nowhere.obj</file>\n  </instance>\n  \
+         <shape name=\"g\" type=\"instance\" id=\"ghost\">\n    <shader ref=\"blue\"/>\n  </shape>\n</scene>",
+    );
+    std::fs::write(dir.path().join("mesh.xml"), &scene).unwrap();
+    let output = glint_in(
+        dir.path(),
+        &["-i", "mesh.xml", "-o", "mesh.png", "-w", "8", "-h", "8"],
+    );
+    assert_exit(&output, 0);
+    let text = stderr(&output);
+    assert!(text.contains("warning: "), "{text}");
+    assert!(text.contains("nowhere.obj"), "{text}");
+    let (line, _) = location(&text, "mesh.xml").unwrap_or_else(|| panic!("no location:\n{text}"));
+    assert_eq!(line, line_of(&scene, "nowhere.obj"), "{text}");
+    assert!(dir.path().join("mesh.png").exists());
+}
+
+#[test]
 fn failed_run_leaves_an_existing_output_unchanged() {
     let dir = scene_dir();
     let bad = SPHERE_XML.replace("<radius>1</radius>", "<radius>-1</radius>");
