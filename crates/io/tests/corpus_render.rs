@@ -104,3 +104,30 @@ fn every_corpus_scene_loads_and_renders_without_nan() {
     );
     println!("{} corpus scenes loaded and rendered", files.len());
 }
+
+/// Our own example scenes (the README renders one) load without a single warning.
+#[test]
+fn example_scenes_load_cleanly() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    let mut files = Vec::new();
+    scene_files(&dir, &mut files);
+    assert!(!files.is_empty(), "no example scenes in {}", dir.display());
+    for path in files {
+        let loaded = glint_io::load_scene(&path)
+            .unwrap_or_else(|e| panic!("{} failed to load: {e}", path.display()));
+        assert!(
+            loaded.warnings.is_empty(),
+            "{}: {:?}",
+            path.display(),
+            loaded.warnings
+        );
+        let scene = Scene::new(loaded.parts);
+        let settings = RenderSettings {
+            width: 16,
+            height: 12,
+            ..RenderSettings::default()
+        };
+        let (film, _) = render(&scene, &settings, &|_, _| true).expect("not cancelled");
+        assert!(film.pixels.iter().any(|p| p.max_component() > 0.0));
+    }
+}
