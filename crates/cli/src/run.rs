@@ -72,15 +72,9 @@ pub fn located(diagnostic: &Diagnostic) -> String {
         diagnostic.column,
         diagnostic.message
     );
-    if let Some(source_line) = &diagnostic.source_line {
-        // The line's own tabs go in front of the caret, so it lines up however wide the
-        // terminal draws a tab.
-        let indent: String = source_line
-            .chars()
-            .take(diagnostic.column.saturating_sub(1) as usize)
-            .map(|c| if c == '\t' { '\t' } else { ' ' })
-            .collect();
-        text.push_str(&format!("\n{source_line}\n{indent}^"));
+    if let Some(excerpt) = diagnostic.source_excerpt() {
+        text.push('\n');
+        text.push_str(&excerpt);
     }
     text
 }

@@ -46,19 +46,29 @@ impl fmt::Display for Diagnostic {
             self.column,
             self.message
         )?;
-        if let Some(source_line) = &self.source_line {
-            let (shown, caret_offset) =
-                excerpt_around(source_line, self.column.saturating_sub(1) as usize);
-            // Reuse the line's own tabs in front of the caret so it lines up however wide the
-            // terminal draws a tab.
-            let caret_indent: String = shown
-                .chars()
-                .take(caret_offset)
-                .map(|character| if character == '\t' { '\t' } else { ' ' })
-                .collect();
-            write!(formatter, "\n{shown}\n{caret_indent}^")?;
+        if let Some(excerpt) = self.source_excerpt() {
+            write!(formatter, "\n{excerpt}")?;
         }
         Ok(())
+    }
+}
+
+impl Diagnostic {
+    /// The offending line and, below it, a caret under the column: two lines for display, or
+    /// `None` when the source line is unknown. A long line is cut to an excerpt around the
+    /// column.
+    pub fn source_excerpt(&self) -> Option<String> {
+        let source_line = self.source_line.as_ref()?;
+        let (shown, caret_offset) =
+            excerpt_around(source_line, self.column.saturating_sub(1) as usize);
+        // Reuse the line's own tabs in front of the caret so it lines up however wide the
+        // terminal draws a tab.
+        let caret_indent: String = shown
+            .chars()
+            .take(caret_offset)
+            .map(|character| if character == '\t' { '\t' } else { ' ' })
+            .collect();
+        Some(format!("{shown}\n{caret_indent}^"))
     }
 }
 
