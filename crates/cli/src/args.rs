@@ -253,7 +253,6 @@ pub struct Job {
 
 /// Output formats by extension, lower case. `glint_io::write_image` decides by the same rule;
 /// checking here turns a typo into an immediate usage error instead of one after the render.
-const OUTPUT_EXTENSIONS: [&str; 2] = ["png", "exr"];
 
 impl Cli {
     /// Resolves the arguments into a `Job`. `available_threads` is the default for `-n`.
@@ -343,17 +342,12 @@ fn default_output(scene: &Path) -> Result<PathBuf, UsageError> {
 }
 
 fn check_output_extension(output: &Path) -> Result<(), UsageError> {
-    let extension = output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    match extension {
-        Some(e) if OUTPUT_EXTENSIONS.contains(&e.as_str()) => Ok(()),
-        _ => Err(UsageError(format!(
+    glint_io::output_format(output).map(|_| ()).map_err(|_| {
+        UsageError(format!(
             "cannot write '{}': the output must end in .png or .exr",
             output.display()
-        ))),
-    }
+        ))
+    })
 }
 
 #[cfg(test)]

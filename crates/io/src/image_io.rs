@@ -137,36 +137,40 @@ pub enum ImageWriteError {
     },
 }
 
-#[derive(Clone, Copy)]
-enum OutputFormat {
+/// The image formats `write_image` writes, chosen by the file name's extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum OutputFormat {
+    /// `.png`: 8-bit RGB with the course's conversion.
     Png,
+    /// `.exr`: linear RGB f32.
     Exr,
 }
 
-/// Writes the film to `path`: `.png` as 8-bit RGB with the course's conversion (clamp,
-/// floor(c·255), no gamma: `Film::to_rgb8_course`), `.exr` as linear RGB f32.
-///
-/// The image is written to a temporary file in the same directory and renamed over `path` only
-/// when complete, so a failure never leaves a truncated or empty file behind.
-pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
+/// The format `write_image` would use for `path`, or the error it would give: lets a caller
+/// reject a bad output name before rendering.
+pub fn output_format(path: &Path) -> Result<OutputFormat, ImageWriteError> {
     let extension = path
         .extension()
         .map(|extension| extension.to_string_lossy().to_lowercase())
         .unwrap_or_default();
-    let format = match extension.as_str() {
-        "png" => OutputFormat::Png,
-        "exr" => OutputFormat::Exr,
-        _ => {
-            return Err(ImageWriteError::UnsupportedExtension {
-                path: path.to_path_buf(),
-                extension: if extension.is_empty() {
-                    "(none)".to_owned()
-                } else {
-                    format!(".{extension}")
-                },
-            })
-        }
-    };
+    match extension.as_str() {
+        "png" => Ok(OutputFormat::Png),
+        "exr" => Ok(OutputFormat::Exr),
+        _ => Err(ImageWriteError::UnsupportedExtension {
+            path: path.to_path_buf(),
+            extension: if extension.is_empty() {
+                "(none)".to_owned()
+            } else {
+                format!(".{extension}")
+            },
+        }),
+    }
+}
+
+/// Writes the film to `path`: `.png` as 8-bit RGB with the course's conversion (clamp,
+/// floor(c·255), no gamma: `Film::to_rgb8_course`), `.exr` as linear RGB f32.
+pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
+    let format = output_format(path)?;
     let expected_pixels = film.width as usize * film.height as usize;
     if film.pixels.len() != expected_pixels || expected_pixels == 0 {
         return Err(ImageWriteError::InvalidFilm {

@@ -38,7 +38,7 @@ mod xml;
 use std::path::Path;
 
 pub use diagnostic::{Diagnostic, SceneError, Severity};
-pub use image_io::{write_image, ImageWriteError};
+pub use image_io::{output_format, write_image, ImageWriteError, OutputFormat};
 
 use diagnostic::Diagnostics;
 use read::Format;
