@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""Equal quality, who is faster: Glint's path tracer against Mitsuba 3 on the Cornell box.
+
+For the Cornell box of ../shared/refs/cornell at 256x256, in one run on this machine:
+  1. Mitsuba 3 (llvm_ad_rgb, path tracer, unbounded length) renders 64 spp through
+     ../shared/bench/make_cornell_ref.py, which times mi.render(mi.load_dict(scene)); best of
+     --repeats + 1 runs (the first also compiles Dr.Jit's kernels, later ones find them cached).
+  2. Its error E_M = relMSE(mitsuba_64, reference_4096), with
+     relMSE(a, r) = mean over pixels and channels of (a - r)^2 / (r^2 + 0.01)
+     (the same measure as crates/render/tests/path_cornell.rs).
+  3. Glint finds the sample count N at which its own error reaches E_M: one probe render at 64 spp
+     gives its per-sample variance, errors are modelled as a/N + c with c the reference's own
+     noise (estimated from Mitsuba's figures), N is predicted, then raised by 5% until the error
+     measured against the reference is at or below E_M.
+  4. Glint renders N spp --repeats times, alternating with Mitsuba's runs; the best wall time of
+     the whole process (scene load, BVH build, render, EXR write) is compared with Mitsuba's best
+     time.
+Prints both times and their ratio (below 1: Glint reaches Mitsuba's quality in less time).
+
+Glint runs as `glint render SCENE --integrator path --spp N --seed S -w 256 -h 256 -o OUT.exr`.
+
+Usage: bench/cornell_vs_mitsuba.py [--repeats 5] [--skip-setup]
+Needs: ../shared/bench/setup-peers.sh (run first unless --skip-setup), cargo.
+"""
+import argparse, math, os, re, shutil, subprocess, sys, tempfile, time
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SHARED = os.path.normpath(os.path.join(ROOT, '..', 'shared'))
+SCENE = os.path.join(SHARED, 'refs', 'cornell', 'cornell.json')
+REFERENCE = os.path.join(SHARED, 'refs', 'cornell', 'mitsuba_256_4096spp.exr')
+REFERENCE_SPP = 4096
+MITSUBA_SPP = 64
+SIZE = 256
+
+
+def run(cmd, **kwargs):
+    return subprocess.run(cmd, check=True, text=True, capture_output=True, **kwargs)
+
+
+def read_exr(path):
+    import mitsuba as mi
+    import numpy as np
+    return np.array(mi.Bitmap(path), dtype=np.float64)[:, :, :3]
+
+
+def relative_mse(image, reference):
+    return float(((image - reference) ** 2 / (reference ** 2 + 0.01)).mean())
+
+
+def run_mitsuba(out_dir):
+    """Renders the 64-spp image and returns Mitsuba's own timing of it and the EXR's path."""
+    result = run([sys.executable, os.path.join(SHARED, 'bench', 'make_cornell_ref.py'),
+                  '--spp', str(MITSUBA_SPP), '--size', str(SIZE), '--out', out_dir])
+    seconds = float(re.search(r'spp: ([0-9.]+) s', result.stdout).group(1))
+    return seconds, os.path.join(out_dir, f'mitsuba_{SIZE}_{MITSUBA_SPP}spp.exr')
+
+
+class Glint:
+    """Runs Glint's path tracer on the Cornell box through the release CLI."""
+
+    def __init__(self):
+        run(['cargo', 'build', '--release', '--quiet', '-p', 'glint'], cwd=ROOT)
+        self.cli = os.path.join(ROOT, 'target', 'release', 'glint')
+        self.how = 'glint CLI'
+
+    def render(self, spp, seed, out):
+        """Renders and returns the process's wall time."""
+        command = [self.cli, 'render', SCENE, '--integrator', 'path', '--spp', str(spp),
+                   '--seed', str(seed), '-w', str(SIZE), '-h', str(SIZE), '-o', out]
+        start = time.perf_counter()
+        run(command)
+        return time.perf_counter() - start
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument('--repeats', type=int, default=5)
+    ap.add_argument('--skip-setup', action='store_true')
+    args = ap.parse_args()
+    if not args.skip_setup:
+        subprocess.run(['bash', os.path.join(SHARED, 'bench', 'setup-peers.sh')], check=True,
+                       stdout=subprocess.DEVNULL)
+    import mitsuba as mi
+    mi.set_variant('scalar_rgb')
+    reference = read_exr(REFERENCE)
+    work = tempfile.mkdtemp(prefix='cornell_bench_')
+    try:
+        # The first run also compiles Dr.Jit's kernels (later runs find them cached); its image
+        # sets the target error.
+        first_seconds, mitsuba_exr = run_mitsuba(work)
+        target = relative_mse(read_exr(mitsuba_exr), reference)
+        # Mitsuba's error is a_M (1/64 + 1/4096) for per-sample variance a_M; the reference's
+        # share of every error measured against it is c = a_M / 4096.
+        reference_noise = target / (1 + MITSUBA_SPP / REFERENCE_SPP) * MITSUBA_SPP / REFERENCE_SPP
+
+        glint = Glint()
+        probe_exr = os.path.join(work, 'glint_probe.exr')
+        glint.render(MITSUBA_SPP, 1, probe_exr)
+        probe = relative_mse(read_exr(probe_exr), reference)
+        spp = max(1, math.ceil(MITSUBA_SPP * max(probe - reference_noise, 1e-12)
+                               / max(target - reference_noise, 1e-12)))
+        tried = []
+        while True:
+            out = os.path.join(work, f'glint_{spp}.exr')
+            glint.render(spp, 1, out)
+            error = relative_mse(read_exr(out), reference)
+            tried.append((spp, error))
+            if error <= target or len(tried) >= 12:
+                break
+            spp = math.ceil(spp * 1.05)
+        # Timed runs alternate between the two renderers, so a change in the machine's load
+        # hits both; each keeps its best time.
+        mitsuba_seconds, glint_seconds = first_seconds, math.inf
+        for _ in range(args.repeats):
+            mitsuba_seconds = min(mitsuba_seconds, run_mitsuba(work)[0])
+            glint_seconds = min(glint_seconds,
+                                glint.render(spp, 1, os.path.join(work, 'timed.exr')))
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+    reached = tried[-1][1] <= target
+    print(f'Cornell box {SIZE}x{SIZE}, 2 cores, best of {args.repeats}; relMSE against '
+          f'Mitsuba {REFERENCE_SPP} spp (includes its noise, ~{reference_noise:.2e})')
+    print(f'  Mitsuba 3 {mi.__version__} llvm_ad_rgb, {MITSUBA_SPP} spp: relMSE {target:.4e}, '
+          f'{mitsuba_seconds:.2f} s')
+    print(f'  Glint ({glint.how}): probe {MITSUBA_SPP} spp relMSE {probe:.4e}; tried '
+          + ', '.join(f'{s} spp -> {e:.4e}' for s, e in tried))
+    print(f'  Glint, {spp} spp: relMSE {tried[-1][1]:.4e}, {glint_seconds:.2f} s'
+          + ('' if reached else '  (did NOT reach the target)'))
+    print(f'time ratio Glint / Mitsuba at equal error: {glint_seconds / mitsuba_seconds:.3f}')
+
+
+if __name__ == '__main__':
+    main()

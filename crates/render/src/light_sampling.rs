@@ -1,0 +1,992 @@
+//! Lights as physical emitters, prepared once per render for the path tracer: which light to
+//! sample (by emitted power, O(log n)), where on it, with what density per unit solid angle,
+//! and how much radiance it sends.
+//!
+//! - Area lights (rectangles), emitting triangles and spheres emit radiance `intensity`, on one
+//!   side only: along an area light's `normal`, along a triangle's geometric normal
+//!   (v1 − v0) × (v2 − v0), outward from a sphere. Rectangles and triangles are sampled
+//!   uniformly by area and converted to solid angle (pdf_area · r² / cos θ_light); spheres by
+//!   the cone they subtend (uniform in solid angle, pbrt's `Sphere::Sample(ctx)`).
+//! - Point lights are Dirac deltas of intensity I: radiance I / r² arrives.
+//! - The background is an infinite light: a constant colour sampled uniformly over the sphere,
+//!   a cube map (six faces or a vertical cross cut into faces by the loader) sampled in
+//!   proportion to luminance × texel solid angle with a row/column piecewise-constant
+//!   distribution (pbrt's `PiecewiseConstant2D`, here over the cube's texels).
+
+use crate::light::Light;
+use crate::material::Material;
+use crate::math::{Color, Vec3};
+use crate::sampling::{sample_uniform_sphere, sample_uniform_triangle};
+use crate::scene::{Background, Scene};
+use crate::texture::CubeMap;
+
+use std::f32::consts::{PI, TAU};
+
+/// A point chosen on a light for one shadow ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSample {
+    /// Radiance arriving at the reference point from the light along `direction` (for a point
+    /// light I / r²), before visibility.
+    pub radiance: Color,
+    /// Unit direction from the reference point towards the light.
+    pub direction: Vec3,
+    /// The point on the light (meaningless for the environment: see `distance`).
+    pub position: Vec3,
+    /// Distance to `position`; infinite for the environment.
+    pub distance: f32,
+    /// Density per unit solid angle (for a point light: 1), times the probability of having
+    /// chosen this light when it comes from `LightSampler::sample`.
+    pub pdf: f32,
+    /// Point lights: no BSDF sample can find them, so no MIS weight.
+    pub is_delta: bool,
+    /// Whether a BSDF-sampled ray can hit this light (it has emissive geometry or is the
+    /// environment); if not, light sampling is the only estimator and takes the full weight.
+    pub reachable_by_bsdf: bool,
+}
+
+#[derive(Clone, Debug)]
+enum PreparedLight {
+    Point {
+        position: Vec3,
+        intensity: Color,
+    },
+    Rectangle {
+        center: Vec3,
+        u_edge: Vec3,
+        v_edge: Vec3,
+        normal: Vec3,
+        area: f32,
+        radiance: Color,
+    },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+        radiance: Color,
+    },
+    Triangles {
+        /// Range in `LightSampler::triangles`.
+        first: u32,
+        count: u32,
+        area: f32,
+        radiance: Color,
+    },
+    Environment,
+}
+
+#[derive(Clone, Copy, Debug)]
+struct PreparedTriangle {
+    v0: Vec3,
+    edge1: Vec3,
+    edge2: Vec3,
+    /// Unit geometric normal, (v1 − v0) × (v2 − v0) normalised.
+    normal: Vec3,
+    /// Cumulative share of the light's area up to and including this triangle.
+    cumulative: f32,
+}
+
+/// The lights of a scene, prepared for sampling. Build it once per render
+/// (`LightSampler::new`); sampling then neither allocates nor loops over lights.
+#[derive(Clone, Debug)]
+pub struct LightSampler {
+    lights: Vec<PreparedLight>,
+    /// Whether BSDF sampling can reach each light.
+    reachable: Vec<bool>,
+    selection_probability: Vec<f32>,
+    /// `selection_cdf[i]` is the probability of choosing a light before `i`; one more entry
+    /// than lights, the last 1.
+    selection_cdf: Vec<f32>,
+    triangles: Vec<PreparedTriangle>,
+    environment: Option<EnvironmentDistribution>,
+}
+
+impl LightSampler {
+    /// Prepares the scene's lights (index i here is `scene.lights[i]`) and, when the background
+    /// is not black, the environment as one more light at index `scene.lights.len()`.
+    pub fn new(scene: &Scene) -> LightSampler {
+        let mut lights = Vec::with_capacity(scene.lights.len() + 1);
+        let mut triangles = Vec::new();
+        let mut power = Vec::with_capacity(scene.lights.len() + 1);
+        let mut reachable = vec![false; scene.lights.len()];
+        for material in &scene.materials {
+            if let Material::Emissive {
+                light: Some(index), ..
+            } = material
+            {
+                if let Some(flag) = reachable.get_mut(*index as usize) {
+                    *flag = true;
+                }
+            }
+        }
+        for light in &scene.lights {
+            let (prepared, phi) = match light {
+                Light::Point {
+                    position,
+                    intensity,
+                } => (
+                    PreparedLight::Point {
+                        position: *position,
+                        intensity: *intensity,
+                    },
+                    4.0 * PI * mean(*intensity),
+                ),
+                Light::Area {
+                    position,
+                    normal,
+                    width,
+                    length,
+                    intensity,
+                } => {
+                    let (u_edge, v_edge) = Light::area_edges(*normal, *width, *length);
+                    let area = u_edge.cross(v_edge).length();
+                    (
+                        PreparedLight::Rectangle {
+                            center: *position,
+                            u_edge,
+                            v_edge,
+                            normal: normal.normalized(),
+                            area,
+                            radiance: *intensity,
+                        },
+                        PI * area * mean(*intensity),
+                    )
+                }
+                Light::Sphere {
+                    center,
+                    radius,
+                    intensity,
+                } => {
+                    let radius = radius.abs();
+                    (
+                        PreparedLight::Sphere {
+                            center: *center,
+                            radius,
+                            radiance: *intensity,
+                        },
+                        PI * 4.0 * PI * radius * radius * mean(*intensity),
+                    )
+                }
+                Light::Triangles {
+                    triangles: list,
+                    intensity,
+                } => {
+                    let first = triangles.len() as u32;
+                    let mut total = 0.0f64;
+                    for &[v0, v1, v2] in list {
+                        let cross = (v1 - v0).cross(v2 - v0);
+                        let area = 0.5 * cross.length();
+                        total += area as f64;
+                        triangles.push(PreparedTriangle {
+                            v0,
+                            edge1: v1 - v0,
+                            edge2: v2 - v0,
+                            normal: cross.normalized(),
+                            cumulative: total as f32,
+                        });
+                    }
+                    let added = &mut triangles[first as usize..];
+                    for triangle in added.iter_mut() {
+                        triangle.cumulative = if total > 0.0 {
+                            (triangle.cumulative as f64 / total) as f32
+                        } else {
+                            0.0
+                        };
+                    }
+                    if let Some(last) = added.last_mut() {
+                        last.cumulative = 1.0;
+                    }
+                    (
+                        PreparedLight::Triangles {
+                            first,
+                            count: list.len() as u32,
+                            area: total as f32,
+                            radiance: *intensity,
+                        },
+                        PI * total as f32 * mean(*intensity),
+                    )
+                }
+            };
+            lights.push(prepared);
+            power.push(if phi.is_finite() { phi.max(0.0) } else { 0.0 });
+        }
+        let environment = EnvironmentDistribution::new(&scene.background);
+        if let Some(env) = &environment {
+            // pbrt-v4's power of an infinite light: what it sends through a disk the size of
+            // the scene, π r² ∫ L dω.
+            let bounds = scene.bounds();
+            let radius = if bounds.is_empty() {
+                1.0
+            } else {
+                0.5 * (bounds.max - bounds.min).length()
+            };
+            lights.push(PreparedLight::Environment);
+            reachable.push(true);
+            power.push(PI * radius * radius * env.integral);
+        }
+        let total: f64 = power.iter().map(|&p| p as f64).sum();
+        let selection_probability: Vec<f32> = power
+            .iter()
+            .map(|&p| {
+                if total > 0.0 {
+                    (p as f64 / total) as f32
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let mut selection_cdf = Vec::with_capacity(power.len() + 1);
+        let mut running = 0.0f64;
+        selection_cdf.push(0.0);
+        for &p in &power {
+            running += p as f64;
+            selection_cdf.push(if total > 0.0 {
+                (running / total) as f32
+            } else {
+                0.0
+            });
+        }
+        if total > 0.0 {
+            if let Some(last) = selection_cdf.last_mut() {
+                *last = 1.0;
+            }
+        }
+        LightSampler {
+            lights,
+            reachable,
+            selection_probability,
+            selection_cdf,
+            triangles,
+            environment,
+        }
+    }
+
+    /// Number of sampled lights, the environment included.
+    pub fn light_count(&self) -> usize {
+        self.lights.len()
+    }
+
+    /// Index of the environment light, if the background emits.
+    pub fn environment_index(&self) -> Option<usize> {
+        self.environment.as_ref().map(|_| self.lights.len() - 1)
+    }
+
+    /// Probability that `sample` chooses light `index`.
+    pub fn selection_probability(&self, index: usize) -> f32 {
+        self.selection_probability
+            .get(index)
+            .copied()
+            .unwrap_or(0.0)
+    }
+
+    /// Whether BSDF-sampled rays can hit light `index`.
+    pub fn reachable_by_bsdf(&self, index: usize) -> bool {
+        self.reachable.get(index).copied().unwrap_or(false)
+    }
+
+    /// Chooses a light by power with `u.0`, then a point on it with `u.0` remapped to [0, 1)
+    /// within the chosen light's share, and `u.1`, as seen from `reference`. Reusing `u.0`
+    /// keeps a stratified `u` stratified over the union of the lights (the two triangles of a
+    /// quad light are sampled as one quad), at the cost of log2(lights) bits of its precision.
+    /// `None` when nothing can arrive (no lights, or the reference is behind the chosen
+    /// one-sided emitter).
+    #[inline]
+    pub fn sample(&self, scene: &Scene, reference: Vec3, u: (f32, f32)) -> Option<LightSample> {
+        let (index, probability, remapped) = sample_cdf(&self.selection_cdf, u.0)?;
+        let mut sample = self.sample_light(scene, index, reference, (remapped, u.1))?;
+        sample.pdf *= probability;
+        Some(sample)
+    }
+
+    /// A point on light `index` as seen from `reference`; the pdf is per unit solid angle of
+    /// this light alone (no selection probability).
+    pub fn sample_light(
+        &self,
+        scene: &Scene,
+        index: usize,
+        reference: Vec3,
+        u: (f32, f32),
+    ) -> Option<LightSample> {
+        let reachable_by_bsdf = self.reachable_by_bsdf(index);
+        match self.lights.get(index)? {
+            PreparedLight::Point {
+                position,
+                intensity,
+            } => {
+                let to_light = *position - reference;
+                let distance_squared = to_light.length_squared();
+                if distance_squared <= 0.0 {
+                    return None;
+                }
+                let distance = distance_squared.sqrt();
+                Some(LightSample {
+                    radiance: *intensity / distance_squared,
+                    direction: to_light / distance,
+                    position: *position,
+                    distance,
+                    pdf: 1.0,
+                    is_delta: true,
+                    reachable_by_bsdf: false,
+                })
+            }
+            PreparedLight::Rectangle {
+                center,
+                u_edge,
+                v_edge,
+                normal,
+                area,
+                radiance,
+            } => {
+                let position = *center + *u_edge * (u.0 - 0.5) + *v_edge * (u.1 - 0.5);
+                area_sample(reference, position, *normal, 1.0 / area, *radiance).map(|s| {
+                    LightSample {
+                        reachable_by_bsdf,
+                        ..s
+                    }
+                })
+            }
+            PreparedLight::Triangles {
+                first,
+                count,
+                area,
+                radiance,
+            } => {
+                let list = &self.triangles[*first as usize..(*first + *count) as usize];
+                if list.is_empty() {
+                    return None;
+                }
+                let chosen = list
+                    .partition_point(|t| t.cumulative <= u.0)
+                    .min(list.len() - 1);
+                let start = if chosen == 0 {
+                    0.0
+                } else {
+                    list[chosen - 1].cumulative
+                };
+                let width = list[chosen].cumulative - start;
+                if width <= 0.0 {
+                    return None;
+                }
+                let u0 = ((u.0 - start) / width).clamp(0.0, 1.0);
+                let triangle = &list[chosen];
+                let (b1, b2) = sample_uniform_triangle(u0, u.1);
+                let position = triangle.v0 + triangle.edge1 * b1 + triangle.edge2 * b2;
+                area_sample(reference, position, triangle.normal, 1.0 / area, *radiance).map(|s| {
+                    LightSample {
+                        reachable_by_bsdf,
+                        ..s
+                    }
+                })
+            }
+            PreparedLight::Sphere {
+                center,
+                radius,
+                radiance,
+            } => {
+                let cone = SphereCone::new(reference, *center, *radius)?;
+                let local = sample_uniform_cone(u.0, u.1, cone.cos_theta_max);
+                let direction = cone.frame_to_world(local);
+                // Distance to the near intersection along the sampled direction; the square
+                // root is clamped so rounding at the cone's rim cannot produce NaN.
+                let cos_theta = local.z;
+                let sin2_theta = (1.0 - cos_theta * cos_theta).max(0.0);
+                let distance = cone.distance * cos_theta
+                    - (radius * radius - cone.distance * cone.distance * sin2_theta)
+                        .max(0.0)
+                        .sqrt();
+                let position = reference + direction * distance;
+                Some(LightSample {
+                    radiance: *radiance,
+                    direction,
+                    position,
+                    distance,
+                    pdf: uniform_cone_pdf(cone.cos_theta_max),
+                    is_delta: false,
+                    reachable_by_bsdf,
+                })
+            }
+            PreparedLight::Environment => {
+                let env = self.environment.as_ref()?;
+                let (direction, pdf) = env.sample(u)?;
+                Some(LightSample {
+                    radiance: scene.background_radiance(direction),
+                    direction,
+                    position: reference + direction,
+                    distance: f32::INFINITY,
+                    pdf,
+                    is_delta: false,
+                    reachable_by_bsdf: true,
+                })
+            }
+        }
+    }
+
+    /// Density per unit solid angle with which `sample_light(index, reference, ..)` returns
+    /// `direction` (unit). Intersects the light's own geometry, so it costs O(triangles) for
+    /// meshes: for tests and tools; the integrator uses `pdf_emitter_hit`.
+    pub fn pdf_light_direction(&self, index: usize, reference: Vec3, direction: Vec3) -> f32 {
+        match self.lights.get(index) {
+            None | Some(PreparedLight::Point { .. }) => 0.0,
+            Some(PreparedLight::Rectangle {
+                center,
+                u_edge,
+                v_edge,
+                normal,
+                area,
+                ..
+            }) => {
+                let cos_light = -direction.dot(*normal);
+                if cos_light <= 0.0 {
+                    return 0.0;
+                }
+                let distance = (*center - reference).dot(*normal) / direction.dot(*normal);
+                if distance <= 0.0 || !distance.is_finite() {
+                    return 0.0;
+                }
+                let offset = reference + direction * distance - *center;
+                let s = offset.dot(*u_edge) / u_edge.length_squared();
+                let t = offset.dot(*v_edge) / v_edge.length_squared();
+                if s.abs() > 0.5 || t.abs() > 0.5 {
+                    return 0.0;
+                }
+                distance * distance / (cos_light * area)
+            }
+            Some(PreparedLight::Triangles {
+                first, count, area, ..
+            }) => {
+                let list = &self.triangles[*first as usize..(*first + *count) as usize];
+                list.iter()
+                    .filter_map(|triangle| {
+                        let cos_light = -direction.dot(triangle.normal);
+                        if cos_light <= 0.0 {
+                            return None;
+                        }
+                        let distance = intersect_triangle(reference, direction, triangle)?;
+                        Some(distance * distance / (cos_light * area))
+                    })
+                    .sum()
+            }
+            Some(PreparedLight::Sphere { center, radius, .. }) => {
+                match SphereCone::new(reference, *center, *radius) {
+                    Some(cone) if direction.dot(cone.axis) >= cone.cos_theta_max => {
+                        uniform_cone_pdf(cone.cos_theta_max)
+                    }
+                    _ => 0.0,
+                }
+            }
+            Some(PreparedLight::Environment) => self
+                .environment
+                .as_ref()
+                .map_or(0.0, |env| env.pdf(direction)),
+        }
+    }
+
+    /// Density per unit solid angle, selection included, with which `sample` would have chosen
+    /// the point `hit_point` (surface normal `hit_normal`) on light `index` from `reference`:
+    /// the light-sampling side of the MIS weight when a BSDF sample hits an emitter.
+    #[inline]
+    pub fn pdf_emitter_hit(
+        &self,
+        index: usize,
+        reference: Vec3,
+        hit_point: Vec3,
+        hit_normal: Vec3,
+    ) -> f32 {
+        let probability = self.selection_probability(index);
+        if probability <= 0.0 {
+            return 0.0;
+        }
+        let to_hit = hit_point - reference;
+        let distance_squared = to_hit.length_squared();
+        let direction = to_hit / distance_squared.sqrt();
+        let pdf = match &self.lights[index] {
+            PreparedLight::Rectangle { normal, area, .. } => {
+                let cos_light = direction.dot(*normal).abs();
+                distance_squared / (cos_light * area)
+            }
+            PreparedLight::Triangles { area, .. } => {
+                let cos_light = direction.dot(hit_normal).abs();
+                distance_squared / (cos_light * area)
+            }
+            PreparedLight::Sphere { center, radius, .. } => {
+                match SphereCone::new(reference, *center, *radius) {
+                    Some(cone) => uniform_cone_pdf(cone.cos_theta_max),
+                    None => 0.0,
+                }
+            }
+            PreparedLight::Point { .. } | PreparedLight::Environment => 0.0,
+        };
+        if pdf.is_finite() {
+            pdf * probability
+        } else {
+            0.0
+        }
+    }
+
+    /// Density per unit solid angle, selection included, with which `sample` picks `direction`
+    /// (unit) on the environment.
+    #[inline]
+    pub fn pdf_environment(&self, direction: Vec3) -> f32 {
+        match (&self.environment, self.environment_index()) {
+            (Some(env), Some(index)) => env.pdf(direction) * self.selection_probability(index),
+            _ => 0.0,
+        }
+    }
+
+    /// What light `index` emits from a surface point with normal `surface_normal` along the
+    /// ray direction `travel` that hit it: `Some(intensity)` on its emitting side, `None`
+    /// behind it (one-sided emitters).
+    #[inline]
+    pub fn emission_towards(
+        &self,
+        index: usize,
+        travel: Vec3,
+        surface_normal: Vec3,
+    ) -> Option<Color> {
+        match self.lights.get(index) {
+            Some(PreparedLight::Rectangle {
+                normal, radiance, ..
+            }) => (travel.dot(*normal) < 0.0).then_some(*radiance),
+            Some(
+                PreparedLight::Triangles { radiance, .. } | PreparedLight::Sphere { radiance, .. },
+            ) => (travel.dot(surface_normal) < 0.0).then_some(*radiance),
+            // Not emitters with a surface: nothing to add, nothing to hide.
+            _ => Some(Color::ZERO),
+        }
+    }
+}
+
+#[inline]
+fn mean(c: Color) -> f32 {
+    (c.x + c.y + c.z) / 3.0
+}
+
+/// A point sampled by area on a one-sided planar emitter, converted to solid angle.
+#[inline]
+fn area_sample(
+    reference: Vec3,
+    position: Vec3,
+    normal: Vec3,
+    pdf_area: f32,
+    radiance: Color,
+) -> Option<LightSample> {
+    let to_light = position - reference;
+    let distance_squared = to_light.length_squared();
+    if distance_squared <= 0.0 {
+        return None;
+    }
+    let distance = distance_squared.sqrt();
+    let direction = to_light / distance;
+    let cos_light = -direction.dot(normal);
+    if cos_light <= 0.0 {
+        return None;
+    }
+    let pdf = pdf_area * distance_squared / cos_light;
+    if !pdf.is_finite() {
+        return None;
+    }
+    Some(LightSample {
+        radiance,
+        direction,
+        position,
+        distance,
+        pdf,
+        is_delta: false,
+        reachable_by_bsdf: false,
+    })
+}
+
+/// Möller-Trumbore: distance along unit `direction` to the triangle, if it is hit.
+fn intersect_triangle(origin: Vec3, direction: Vec3, triangle: &PreparedTriangle) -> Option<f32> {
+    let p = direction.cross(triangle.edge2);
+    let determinant = triangle.edge1.dot(p);
+    if determinant.abs() < 1e-12 {
+        return None;
+    }
+    let inverse = 1.0 / determinant;
+    let s = origin - triangle.v0;
+    let b1 = s.dot(p) * inverse;
+    if !(0.0..=1.0).contains(&b1) {
+        return None;
+    }
+    let q = s.cross(triangle.edge1);
+    let b2 = direction.dot(q) * inverse;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return None;
+    }
+    let t = triangle.edge2.dot(q) * inverse;
+    (t > 0.0).then_some(t)
+}
+
+/// The cone of directions under which a sphere is seen from outside it.
+struct SphereCone {
+    axis: Vec3,
+    distance: f32,
+    cos_theta_max: f32,
+}
+
+impl SphereCone {
+    /// `None` from inside the sphere (or on it), where its outward emission cannot arrive.
+    #[inline]
+    fn new(reference: Vec3, center: Vec3, radius: f32) -> Option<SphereCone> {
+        let to_center = center - reference;
+        let distance_squared = to_center.length_squared();
+        if distance_squared <= radius * radius {
+            return None;
+        }
+        let distance = distance_squared.sqrt();
+        let sin2_theta_max = radius * radius / distance_squared;
+        Some(SphereCone {
+            axis: to_center / distance,
+            distance,
+            cos_theta_max: (1.0 - sin2_theta_max).max(0.0).sqrt(),
+        })
+    }
+
+    #[inline]
+    fn frame_to_world(&self, local: Vec3) -> Vec3 {
+        crate::bsdf::Frame::from_normal(self.axis).to_world(local)
+    }
+}
+
+/// A direction uniform in the cone of half-angle θmax around +z.
+#[inline]
+pub fn sample_uniform_cone(u1: f32, u2: f32, cos_theta_max: f32) -> Vec3 {
+    let cos_theta = 1.0 - u1 * (1.0 - cos_theta_max);
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let (sin_phi, cos_phi) = (TAU * u2).sin_cos();
+    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
+}
+
+/// Density of `sample_uniform_cone` per unit solid angle.
+#[inline]
+pub fn uniform_cone_pdf(cos_theta_max: f32) -> f32 {
+    1.0 / (TAU * (1.0 - cos_theta_max))
+}
+
+/// Density of `sampling::sample_uniform_sphere` per unit solid angle.
+#[inline]
+pub fn uniform_sphere_pdf() -> f32 {
+    1.0 / (4.0 * PI)
+}
+
+/// Face index, and (s, t) in [0, 1]² on it, that `CubeMap::lookup` reads for direction `d`:
+/// the OpenGL selection table (the same as `texture.rs`; a test keeps the two in step).
+#[inline]
+pub fn cube_face_coordinates(d: Vec3) -> Option<(usize, f32, f32)> {
+    let a = d.abs();
+    let (face, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
+        if d.x > 0.0 {
+            (0, -d.z, -d.y, a.x)
+        } else {
+            (1, d.z, -d.y, a.x)
+        }
+    } else if a.y >= a.z {
+        if d.y > 0.0 {
+            (2, d.x, d.z, a.y)
+        } else {
+            (3, d.x, -d.z, a.y)
+        }
+    } else if d.z > 0.0 {
+        (4, d.x, -d.y, a.z)
+    } else {
+        (5, -d.x, -d.y, a.z)
+    };
+    if ma <= 0.0 || !ma.is_finite() {
+        return None;
+    }
+    Some((face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)))
+}
+
+/// The (unnormalised) direction through point (s, t) of cube face `face`: the inverse of
+/// `cube_face_coordinates`.
+#[inline]
+pub fn cube_face_direction(face: usize, s: f32, t: f32) -> Vec3 {
+    let sc = 2.0 * s - 1.0;
+    let tc = 2.0 * t - 1.0;
+    match face {
+        0 => Vec3::new(1.0, -tc, -sc),
+        1 => Vec3::new(-1.0, -tc, sc),
+        2 => Vec3::new(sc, 1.0, tc),
+        3 => Vec3::new(sc, -1.0, -tc),
+        4 => Vec3::new(sc, -tc, 1.0),
+        _ => Vec3::new(-sc, -tc, -1.0),
+    }
+}
+
+/// Solid angle per unit (s, t) area at a point of a cube face: the face is the square
+/// [−1, 1]² at distance 1, so dω = 4 ds dt / (1 + a² + b²)^{3/2} with a = 2s − 1, b = 2t − 1.
+#[inline]
+fn cube_solid_angle_per_area(s: f32, t: f32) -> f32 {
+    let a = 2.0 * s - 1.0;
+    let b = 2.0 * t - 1.0;
+    let r2 = 1.0 + a * a + b * b;
+    4.0 / (r2 * r2.sqrt())
+}
+
+/// The environment's sampling distribution.
+#[derive(Clone, Debug)]
+struct EnvironmentDistribution {
+    /// ∫ L dω by channel mean, for choosing between lights by power.
+    integral: f32,
+    cube: Option<CubeDistribution>,
+}
+
+/// Rows of all six faces stacked (face 0's rows first), each row a piecewise-constant
+/// distribution over its texels.
+#[derive(Clone, Debug)]
+struct CubeDistribution {
+    /// Face sizes (width, height); empty faces have no rows.
+    sizes: [(u32, u32); 6],
+    /// Index of each face's first row; entry 6 is the row count.
+    first_row: [u32; 7],
+    /// Cumulative probability of the rows before row r; rows + 1 entries.
+    row_cdf: Vec<f32>,
+    /// Per row: width + 1 cumulative probabilities within the row; row r starts at
+    /// `column_start[r]`.
+    column_cdf: Vec<f32>,
+    column_start: Vec<u32>,
+}
+
+impl EnvironmentDistribution {
+    fn new(background: &Background) -> Option<EnvironmentDistribution> {
+        match background {
+            Background::Color(c) => {
+                let integral = 4.0 * PI * mean(c.max(Color::ZERO));
+                (integral > 0.0 && c.is_finite()).then_some(EnvironmentDistribution {
+                    integral,
+                    cube: None,
+                })
+            }
+            Background::CubeMap(map) => {
+                CubeDistribution::new(map).map(|(cube, integral)| EnvironmentDistribution {
+                    integral,
+                    cube: Some(cube),
+                })
+            }
+        }
+    }
+
+    #[inline]
+    fn sample(&self, u: (f32, f32)) -> Option<(Vec3, f32)> {
+        match &self.cube {
+            None => Some((sample_uniform_sphere(u.0, u.1), uniform_sphere_pdf())),
+            Some(cube) => cube.sample(u),
+        }
+    }
+
+    #[inline]
+    fn pdf(&self, direction: Vec3) -> f32 {
+        match &self.cube {
+            None => uniform_sphere_pdf(),
+            Some(cube) => cube.pdf(direction),
+        }
+    }
+}
+
+/// Finds the bin of `u` in a cumulative table (`cdf[0] = 0`, increasing) and returns it with
+/// its probability and `u` remapped to [0, 1) within it.
+#[inline]
+fn sample_cdf(cdf: &[f32], u: f32) -> Option<(usize, f32, f32)> {
+    let bins = cdf.len().checked_sub(1)?;
+    if bins == 0 {
+        return None;
+    }
+    let index = cdf[1..].partition_point(|&c| c <= u).min(bins - 1);
+    let probability = cdf[index + 1] - cdf[index];
+    if probability <= 0.0 {
+        return None;
+    }
+    let remapped = ((u - cdf[index]) / probability).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+    Some((index, probability, remapped))
+}
+
+impl CubeDistribution {
+    /// The distribution and ∫ L dω (channel mean); `None` for a black map.
+    fn new(map: &CubeMap) -> Option<(CubeDistribution, f32)> {
+        let mut sizes = [(0u32, 0u32); 6];
+        let mut first_row = [0u32; 7];
+        for (face, image) in map.faces.iter().enumerate() {
+            let usable = image.width > 0
+                && image.height > 0
+                && image.texels.len() >= (image.width * image.height) as usize;
+            sizes[face] = if usable {
+                (image.width, image.height)
+            } else {
+                (0, 0)
+            };
+            first_row[face + 1] = first_row[face] + sizes[face].1;
+        }
+        let rows = first_row[6] as usize;
+        let mut row_weight = Vec::with_capacity(rows);
+        let mut column_cdf = Vec::new();
+        let mut column_start = Vec::with_capacity(rows);
+        for (face, image) in map.faces.iter().enumerate() {
+            let (width, height) = sizes[face];
+            for y in 0..height {
+                column_start.push(column_cdf.len() as u32);
+                let start = column_cdf.len();
+                column_cdf.push(0.0f32);
+                let mut running = 0.0f64;
+                for x in 0..width {
+                    let s = (x as f32 + 0.5) / width as f32;
+                    let t = (y as f32 + 0.5) / height as f32;
+                    let texel = image.texels[(y * width + x) as usize];
+                    let luminance = texel.luminance();
+                    let luminance = if luminance.is_finite() {
+                        luminance.max(0.0)
+                    } else {
+                        0.0
+                    };
+                    // Luminance times the texel's solid angle: the share of light it sends.
+                    running += luminance as f64 * cube_solid_angle_per_area(s, t) as f64
+                        / (width as f64 * height as f64);
+                    column_cdf.push(running as f32);
+                }
+                let row = &mut column_cdf[start..];
+                if running > 0.0 {
+                    for c in row.iter_mut() {
+                        *c = (*c as f64 / running) as f32;
+                    }
+                    if let Some(last) = row.last_mut() {
+                        *last = 1.0;
+                    }
+                }
+                row_weight.push(running);
+            }
+        }
+        let total: f64 = row_weight.iter().sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        let mut row_cdf = Vec::with_capacity(rows + 1);
+        row_cdf.push(0.0f32);
+        let mut running = 0.0f64;
+        for w in &row_weight {
+            running += w;
+            row_cdf.push((running / total) as f32);
+        }
+        if let Some(last) = row_cdf.last_mut() {
+            *last = 1.0;
+        }
+        // ∫ L dω by channel mean, from the same per-texel solid angles.
+        let mut integral = 0.0f64;
+        for (face, image) in map.faces.iter().enumerate() {
+            let (width, height) = sizes[face];
+            for y in 0..height {
+                for x in 0..width {
+                    let s = (x as f32 + 0.5) / width as f32;
+                    let t = (y as f32 + 0.5) / height as f32;
+                    let texel = image.texels[(y * width + x) as usize].max(Color::ZERO);
+                    integral += mean(texel) as f64 * cube_solid_angle_per_area(s, t) as f64
+                        / (width as f64 * height as f64);
+                }
+            }
+        }
+        Some((
+            CubeDistribution {
+                sizes,
+                first_row,
+                row_cdf,
+                column_cdf,
+                column_start,
+            },
+            integral as f32,
+        ))
+    }
+
+    fn row_columns(&self, row: usize, width: u32) -> &[f32] {
+        let start = self.column_start[row] as usize;
+        &self.column_cdf[start..start + width as usize + 1]
+    }
+
+    #[inline]
+    fn sample(&self, u: (f32, f32)) -> Option<(Vec3, f32)> {
+        let (row, row_probability, t_offset) = sample_cdf(&self.row_cdf, u.0)?;
+        let face = self.first_row[1..].partition_point(|&first| first as usize <= row);
+        let (width, height) = *self.sizes.get(face)?;
+        let y = row as u32 - self.first_row[face];
+        let (x, column_probability, s_offset) = sample_cdf(self.row_columns(row, width), u.1)?;
+        let s = (x as f32 + s_offset) / width as f32;
+        let t = (y as f32 + t_offset) / height as f32;
+        let direction = cube_face_direction(face, s, t).normalized();
+        let pdf_area = row_probability * column_probability * (width * height) as f32;
+        let pdf = pdf_area / cube_solid_angle_per_area(s, t);
+        (pdf > 0.0 && pdf.is_finite()).then_some((direction, pdf))
+    }
+
+    #[inline]
+    fn pdf(&self, direction: Vec3) -> f32 {
+        let Some((face, s, t)) = cube_face_coordinates(direction) else {
+            return 0.0;
+        };
+        let (width, height) = self.sizes[face];
+        if width == 0 || height == 0 {
+            return 0.0;
+        }
+        // The texel `CubeMap::lookup` reads (its truncation and clamping).
+        let x = ((s * width as f32) as u32).min(width - 1);
+        let y = ((t * height as f32) as u32).min(height - 1);
+        let row = (self.first_row[face] + y) as usize;
+        let row_probability = self.row_cdf[row + 1] - self.row_cdf[row];
+        let columns = self.row_columns(row, width);
+        let column_probability = columns[x as usize + 1] - columns[x as usize];
+        row_probability * column_probability * (width * height) as f32
+            / cube_solid_angle_per_area(s, t)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::texture::Image;
+
+    fn distinct_cube(size: u32) -> CubeMap {
+        let face = |f: u32| Image {
+            width: size,
+            height: size,
+            texels: (0..size * size)
+                .map(|i| Vec3::new(f as f32, (i % size) as f32, (i / size) as f32))
+                .collect(),
+        };
+        CubeMap {
+            faces: [face(0), face(1), face(2), face(3), face(4), face(5)],
+        }
+    }
+
+    #[test]
+    fn cube_coordinates_match_cube_map_lookup() {
+        let size = 7;
+        let map = distinct_cube(size);
+        let mut rng = crate::sampling::Rng::new(3, 1);
+        for _ in 0..20_000 {
+            let d = sample_uniform_sphere(rng.next_f32(), rng.next_f32());
+            let (face, s, t) = cube_face_coordinates(d).unwrap();
+            let x = ((s * size as f32) as u32).min(size - 1);
+            let y = ((t * size as f32) as u32).min(size - 1);
+            assert_eq!(
+                map.lookup(d),
+                Vec3::new(face as f32, x as f32, y as f32),
+                "{d:?}"
+            );
+            // And the inverse map returns the direction.
+            let back = cube_face_direction(face, s, t).normalized();
+            assert!((back - d).length() < 1e-5, "{d:?} {back:?}");
+        }
+    }
+
+    #[test]
+    fn cube_face_solid_angles_sum_to_sphere() {
+        let n = 200;
+        let mut sum = 0.0f64;
+        for i in 0..n {
+            for j in 0..n {
+                let s = (i as f32 + 0.5) / n as f32;
+                let t = (j as f32 + 0.5) / n as f32;
+                sum += cube_solid_angle_per_area(s, t) as f64 / (n * n) as f64;
+            }
+        }
+        assert!(
+            (6.0 * sum - 4.0 * std::f64::consts::PI).abs() < 1e-3,
+            "{sum}"
+        );
+    }
+}

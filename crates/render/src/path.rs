@@ -1,0 +1,366 @@
+//! The physically based path tracer (`--integrator path`): unidirectional path tracing with
+//! next-event estimation on every light, multiple importance sampling between BSDF and light
+//! sampling (Veach's power heuristic), Russian roulette and a depth cap. It solves the
+//! rendering equation with the BSDFs of `bsdf.rs` and the emitters of `light_sampling.rs`, and
+//! is checked against Mitsuba 3 (`tests/path_cornell.rs`).
+//!
+//! The structure is pbrt-v4's `PathIntegrator::Li` (`src/pbrt/cpu/integrators.cpp`) and
+//! Mitsuba 3's `path` plugin: one loop over path vertices, emission at each hit weighted against
+//! the light-sampling density, one light sample per non-specular vertex weighted against the
+//! BSDF density.
+//!
+//! Every random number is a function of (seed, pixel, sample, dimension) (`path_sampler.rs`:
+//! scrambled Sobol' points stratified over the pixel's samples, then the sample's own PCG
+//! stream, keyed as the course renderer keys it), so the image is bit-identical for any thread
+//! count, and nothing on the per-sample path allocates: the BSDF lives on the stack and the
+//! light distributions are built once by `PathIntegrator::new`.
+
+use crate::bsdf::{Bsdf, Frame};
+use crate::film::Film;
+use crate::integrator::{Integrator, SampleContext};
+use crate::light_sampling::LightSampler;
+use crate::material::Material;
+use crate::math::{Color, Vec3};
+use crate::path_sampler::{PathSampler, SobolSampler};
+use crate::ray::Ray;
+use crate::render::{render_tiles, Cancelled, RenderSettings, RenderStats};
+use crate::scene::Scene;
+
+/// Path-length controls of the path tracer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PathSettings {
+    /// The most scattering events on a path: 0 shows only what the camera sees emitting, 1 is
+    /// direct lighting. The default is large enough to be unbounded in practice (Russian
+    /// roulette ends paths long before) and only stops pathological scenes, such as a closed
+    /// box of perfect mirrors, where roulette never fires.
+    pub max_depth: u32,
+    /// Russian roulette starts once a path has this many bounces (Mitsuba 3's `rr_depth`).
+    pub russian_roulette_depth: u32,
+}
+
+impl Default for PathSettings {
+    fn default() -> Self {
+        PathSettings {
+            max_depth: 1024,
+            russian_roulette_depth: 5,
+        }
+    }
+}
+
+/// What the camera ray's first hit contributes to the denoiser features.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FirstHit {
+    /// The surface's reflectance (`Bsdf::albedo`), an emitter's radiance clamped to [0, 1] if
+    /// it does not reflect, the background clamped to [0, 1] where the ray escapes.
+    pub albedo: Color,
+    /// World-space geometric normal facing the camera; zero where the ray escapes.
+    pub normal: Vec3,
+}
+
+/// The beauty image and the first-hit feature images a denoiser takes (OIDN's `color`,
+/// `albedo` and `normal`), all linear and averaged over the pixel's samples.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PathOutput {
+    pub beauty: Film,
+    pub albedo: Film,
+    pub normal: Film,
+}
+
+/// The path tracer with its per-render preprocessing (light selection by power, triangle and
+/// environment distributions).
+#[derive(Clone, Debug)]
+pub struct PathIntegrator {
+    lights: LightSampler,
+    settings: PathSettings,
+}
+
+/// Veach's power heuristic with β = 2 for one sample from each strategy.
+#[inline]
+fn power_heuristic(pdf: f32, other_pdf: f32) -> f32 {
+    let a = pdf * pdf;
+    let b = other_pdf * other_pdf;
+    if a.is_infinite() {
+        return 1.0;
+    }
+    if a + b > 0.0 {
+        a / (a + b)
+    } else {
+        0.0
+    }
+}
+
+impl PathIntegrator {
+    pub fn new(scene: &Scene, settings: PathSettings) -> PathIntegrator {
+        PathIntegrator {
+            lights: LightSampler::new(scene),
+            settings,
+        }
+    }
+
+    pub fn lights(&self) -> &LightSampler {
+        &self.lights
+    }
+
+    pub fn settings(&self) -> &PathSettings {
+        &self.settings
+    }
+
+    /// Radiance arriving along `camera_ray` (whose direction need not be unit), with random
+    /// numbers from `sampler` (dimensions from `FIRST_PATH_DIMENSION` on; the camera's are
+    /// below). Adds the rays it traces to `rays` and fills `first_hit`.
+    pub fn trace<S: PathSampler>(
+        &self,
+        scene: &Scene,
+        camera_ray: &Ray,
+        sampler: &mut S,
+        rays: &mut u64,
+        first_hit: &mut FirstHit,
+    ) -> Color {
+        // Unit directions make every hit's t a distance (Beer's law, light pdfs).
+        let mut ray = Ray {
+            direction: camera_ray.direction.normalized(),
+            ..*camera_ray
+        };
+        let mut radiance = Color::ZERO;
+        let mut throughput = Color::ONE;
+        // Product of η² over refractions: Russian roulette looks at throughput × this, so the
+        // 1/η² a refraction puts on radiance does not kill paths inside glass (pbrt-v4).
+        let mut eta_scale = 1.0f32;
+        // How the current ray was chosen: after a camera ray or a specular bounce, emission is
+        // counted in full; otherwise it is weighted against light sampling with `bsdf_pdf`.
+        let mut specular_bounce = true;
+        let mut bsdf_pdf = 0.0f32;
+        let mut depth = 0u32;
+        loop {
+            // Each vertex draws its numbers from its own block of dimensions, so a pixel's
+            // samples are stratified against each other vertex by vertex.
+            let dimension = FIRST_PATH_DIMENSION + DIMENSIONS_PER_VERTEX * depth;
+            *rays += 1;
+            let Some(hit) = scene.intersect(&ray) else {
+                let background = scene.background_radiance(ray.direction);
+                if depth == 0 {
+                    first_hit.albedo = background.clamp01();
+                }
+                if background != Color::ZERO {
+                    let weight = if specular_bounce {
+                        1.0
+                    } else {
+                        power_heuristic(bsdf_pdf, self.lights.pdf_environment(ray.direction))
+                    };
+                    radiance += throughput.mul_elem(background) * weight;
+                }
+                break;
+            };
+            let si = scene.surface(&ray, &hit);
+            let material = scene.materials.get(si.material as usize);
+
+            // Light emitted by the surface towards the ray's origin. Emitters are one-sided, and
+            // their back reflects nothing either: the surface material of an emitter only
+            // reflects on its emitting side. That is Mitsuba's behaviour (its BSDFs are
+            // one-sided unless wrapped in `twosided`), and it matters where the back of a light
+            // can be seen, such as the gap between the Cornell box's light and its ceiling.
+            let mut behind_emitter = false;
+            if let Some(Material::Emissive {
+                radiance: emitted,
+                light,
+                ..
+            }) = material
+            {
+                let light_index = light
+                    .map(|index| index as usize)
+                    .filter(|&index| index < scene.lights.len());
+                let emitted = match light_index {
+                    Some(index) => self
+                        .lights
+                        .emission_towards(index, ray.direction, si.normal),
+                    // An emitter no light samples: one-sided along its geometric normal.
+                    None => (ray.direction.dot(si.normal) < 0.0).then_some(*emitted),
+                };
+                match emitted {
+                    Some(emitted) if emitted != Color::ZERO => {
+                        let weight = match light_index {
+                            Some(index) if !specular_bounce => {
+                                let light_pdf = self
+                                    .lights
+                                    .pdf_emitter_hit(index, ray.origin, si.point, si.normal);
+                                power_heuristic(bsdf_pdf, light_pdf)
+                            }
+                            _ => 1.0,
+                        };
+                        radiance += throughput.mul_elem(emitted) * weight;
+                    }
+                    Some(_) => {}
+                    None => behind_emitter = true,
+                }
+                if depth == 0 {
+                    first_hit.albedo = emitted.unwrap_or(Color::ZERO).clamp01();
+                }
+            }
+
+            // Beer's law for the segment that just travelled inside a dielectric: the ray meets
+            // the surface from behind its outward normal.
+            if let Some(Material::Dielectric { attenuation, .. }) = material {
+                if ray.direction.dot(si.normal) > 0.0 {
+                    let distance = hit.t;
+                    throughput =
+                        throughput.mul_elem(attenuation.map(|a| a.max(0.0).powf(distance)));
+                }
+            }
+
+            let frame = Frame::from_normal(si.normal);
+            let wo = frame.to_local(-ray.direction);
+            let bsdf = if behind_emitter {
+                Bsdf::BLACK
+            } else {
+                Bsdf::from_material(&scene.materials, &scene.textures, si.material, si.uv)
+            };
+            if depth == 0 {
+                first_hit.normal = if wo.z < 0.0 { -si.normal } else { si.normal };
+                if !bsdf.is_black() {
+                    first_hit.albedo = bsdf.albedo();
+                }
+            }
+            if depth >= self.settings.max_depth || bsdf.is_black() || wo.z == 0.0 {
+                break;
+            }
+
+            // Next-event estimation: one light, chosen by power, one point on it.
+            if bsdf.has_non_specular() {
+                let u_light = sampler.sample_2d(dimension);
+                if let Some(sample) = self.lights.sample(scene, si.point, u_light) {
+                    let wi = frame.to_local(sample.direction);
+                    let (f, scattering_pdf) = bsdf.eval_and_pdf(wo, wi);
+                    if f != Color::ZERO && sample.radiance != Color::ZERO {
+                        let shadow = if sample.distance.is_infinite() {
+                            Ray::spawn(si.point, sample.direction)
+                        } else {
+                            Ray::spawn_to(si.point, sample.position)
+                        };
+                        *rays += 1;
+                        if !scene.occluded(&shadow) {
+                            let weight = if sample.is_delta || !sample.reachable_by_bsdf {
+                                1.0
+                            } else {
+                                power_heuristic(sample.pdf, scattering_pdf)
+                            };
+                            radiance += throughput.mul_elem(f).mul_elem(sample.radiance)
+                                * (wi.z.abs() * weight / sample.pdf);
+                        }
+                    }
+                }
+            }
+
+            // Continue the path by sampling the BSDF.
+            let u_lobe = if bsdf.uses_lobe_sample() {
+                sampler.sample_1d(dimension + 2)
+            } else {
+                0.5
+            };
+            let u_direction = sampler.sample_2d(dimension + 3);
+            let Some(sample) = bsdf.sample(wo, u_lobe, u_direction) else {
+                break;
+            };
+            throughput = throughput.mul_elem(sample.weight);
+            if throughput == Color::ZERO || !throughput.is_finite() {
+                break;
+            }
+            specular_bounce = sample.is_specular;
+            bsdf_pdf = sample.pdf;
+            eta_scale *= sample.eta * sample.eta;
+            ray = Ray::spawn(si.point, frame.to_world(sample.wi));
+            depth += 1;
+
+            // Russian roulette (Mitsuba 3: survive with min(max throughput · η², 0.95)).
+            if depth >= self.settings.russian_roulette_depth {
+                let survival = ((throughput * eta_scale).max_component()).min(0.95);
+                if sampler.sample_1d(dimension + 5) >= survival {
+                    break;
+                }
+                throughput = throughput / survival;
+            }
+        }
+        radiance
+    }
+}
+
+impl Integrator for PathIntegrator {
+    fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color {
+        let mut rays = 0;
+        let mut first_hit = FirstHit::default();
+        let color = self.trace(scene, ray, &mut ctx.rng, &mut rays, &mut first_hit);
+        // The render loop counted the camera ray already.
+        ctx.rays += rays.saturating_sub(1);
+        color
+    }
+}
+
+/// Dimensions 0 and 1 place the sample in its pixel (uniformly over the pixel: a box filter,
+/// as Mitsuba's reference renders use); the path's own start here.
+pub const FIRST_PATH_DIMENSION: u32 = 2;
+/// Per path vertex: light and point on it (2), lobe, direction (2), roulette.
+const DIMENSIONS_PER_VERTEX: u32 = 6;
+
+/// Renders `scene` with the path tracer: `settings.rays_per_pixel` samples per pixel (exactly
+/// that many: `--spp`), `settings.path` for path lengths. Returns the beauty image with albedo
+/// and normal feature images. `progress(tiles_done, tiles_total)` may cancel, as in `render`.
+/// Samples that come out NaN or infinite are dropped from the average and counted in
+/// `RenderStats::nan_samples`.
+pub fn render_with_aovs(
+    scene: &Scene,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(usize, usize) -> bool + Sync),
+) -> Result<(PathOutput, RenderStats), Cancelled> {
+    let integrator = PathIntegrator::new(scene, settings.path);
+    let (width, height) = (settings.width, settings.height);
+    let aspect = settings.aspect.unwrap_or(width as f32 / height as f32);
+    let samples = settings.samples_per_pixel();
+    let (pixels, stats) = render_tiles(settings, progress, |x, y, counters| {
+        let pixel_index = y as u64 * width as u64 + x as u64;
+        // The camera's j counts rows from the bottom; film row 0 is the top.
+        let j = height - 1 - y;
+        let mut sum = Color::ZERO;
+        let mut albedo = Color::ZERO;
+        let mut normal = Vec3::ZERO;
+        let mut valid = 0u32;
+        for s in 0..samples {
+            let mut sampler = SobolSampler::new(settings.seed, pixel_index, s, samples);
+            let (ox, oy) = sampler.sample_2d(0);
+            let ray = scene
+                .camera
+                .ray(x as f32 + ox, j as f32 + oy, width, height, aspect);
+            let mut first_hit = FirstHit::default();
+            let c = integrator.trace(
+                scene,
+                &ray,
+                &mut sampler,
+                &mut counters.rays,
+                &mut first_hit,
+            );
+            albedo += first_hit.albedo;
+            normal += first_hit.normal;
+            if c.is_finite() {
+                sum += c;
+                valid += 1;
+            } else {
+                counters.dropped_sample(pixel_index);
+            }
+        }
+        let beauty = if valid > 0 {
+            sum / valid as f32
+        } else {
+            Color::ZERO
+        };
+        [beauty, albedo / samples as f32, normal / samples as f32]
+    })?;
+    let film = |layer: usize| Film {
+        width,
+        height,
+        pixels: pixels.iter().map(|p| p[layer]).collect(),
+    };
+    let output = PathOutput {
+        beauty: film(0),
+        albedo: film(1),
+        normal: film(2),
+    };
+    Ok((output, stats))
+}

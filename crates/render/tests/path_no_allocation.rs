@@ -1,0 +1,214 @@
+//! The path tracer's per-sample work allocates nothing (ARCHITECTURE.md invariant): every
+//! material, every kind of light and a cube-map environment, traced through a counting global
+//! allocator. Alone in its test binary so no other test allocates on the counted thread.
+
+// The one unsafe item: a global allocator must implement the unsafe `GlobalAlloc` trait. It
+// forwards to `System` unchanged and only counts.
+#![allow(unsafe_code)]
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
+
+use glint_render::path::FirstHit;
+use glint_render::sampling::Rng;
+use glint_render::{
+    Background, Camera, Color, CubeMap, GeometryDesc, Image, Instance, Light, Material,
+    PathIntegrator, PathSettings, Projection, Scene, SceneParts, Shape, Vec3,
+};
+
+struct CountingAllocator;
+
+thread_local! {
+    static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+}
+
+unsafe impl GlobalAlloc for CountingAllocator {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.with(|count| count.set(count.get() + 1));
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` came from `System.alloc` with this layout.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.with(|count| count.set(count.get() + 1));
+        // SAFETY: as for `dealloc`; `new_size` is passed through.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: CountingAllocator = CountingAllocator;
+
+fn every_feature_scene() -> Scene {
+    let face = |value: f32| Image {
+        width: 4,
+        height: 4,
+        texels: (0..16)
+            .map(|i| Color::splat(value + i as f32 * 0.1))
+            .collect(),
+    };
+    let materials = vec![
+        Material::Diffuse {
+            diffuse: Color::splat(0.7).into(),
+        },
+        Material::BlinnPhong {
+            diffuse: Color::splat(0.4).into(),
+            specular: Color::splat(0.4).into(),
+            phong_exponent: 32.0,
+            mirror_coef: 0.2,
+        },
+        Material::Phong {
+            diffuse: Color::splat(0.4).into(),
+            specular: Color::splat(0.4).into(),
+            phong_exponent: 16.0,
+        },
+        Material::Mirror { roughness: 0.2 },
+        Material::Glaze {
+            diffuse: Color::splat(0.5).into(),
+            mirror_coef: 0.3,
+        },
+        Material::BlinnPhongMirrored {
+            diffuse: Color::splat(0.4).into(),
+            specular: Color::splat(0.3).into(),
+            phong_exponent: 16.0,
+            mirror_coef: 0.3,
+            roughness: 0.1,
+        },
+        Material::Dielectric {
+            refractive_index: 1.5,
+            attenuation: Color::new(0.9, 0.8, 0.7),
+        },
+        Material::CoolToWarm {
+            diffuse: Color::splat(0.5).into(),
+        },
+        Material::Emissive {
+            radiance: Color::splat(2.0),
+            surface: Some(0),
+            light: Some(1),
+        },
+    ];
+    let spheres: Vec<Shape> = (0..8)
+        .map(|i| Shape::Sphere {
+            center: Vec3::new(-2.1 + 0.6 * i as f32, 0.0, 0.0),
+            radius: 0.28,
+        })
+        .collect();
+    let emitter = [
+        Vec3::new(-0.5, 1.5, -0.5),
+        Vec3::new(0.5, 1.5, -0.5),
+        Vec3::new(0.0, 1.5, 0.5),
+    ];
+    Scene::new(SceneParts {
+        camera: Camera::new(
+            Projection::Perspective,
+            Vec3::new(0.0, 0.5, 4.0),
+            -Vec3::Z,
+            1.0,
+            1.2,
+        ),
+        materials,
+        textures: vec![],
+        lights: vec![
+            Light::Point {
+                position: Vec3::new(1.0, 2.0, 1.0),
+                intensity: Color::splat(3.0),
+            },
+            Light::Triangles {
+                triangles: vec![emitter],
+                intensity: Color::splat(2.0),
+            },
+            Light::Area {
+                position: Vec3::new(0.0, 2.0, 1.0),
+                normal: -Vec3::Y,
+                width: 0.5,
+                length: 0.5,
+                intensity: Color::splat(4.0),
+            },
+            Light::Sphere {
+                center: Vec3::new(2.0, 1.5, 0.0),
+                radius: 0.2,
+                intensity: Color::splat(5.0),
+            },
+        ],
+        background: Background::CubeMap(Box::new(CubeMap {
+            faces: [
+                face(0.1),
+                face(0.2),
+                face(1.0),
+                face(0.0),
+                face(0.3),
+                face(0.4),
+            ],
+        })),
+        geometries: vec![
+            GeometryDesc {
+                materials: (0..8).collect(),
+                shapes: spheres,
+            },
+            GeometryDesc {
+                shapes: vec![
+                    Shape::Box {
+                        min: Vec3::new(-3.0, -0.4, -2.0),
+                        max: Vec3::new(3.0, -0.3, 2.0),
+                    },
+                    Shape::Triangle { vertices: emitter },
+                ],
+                materials: vec![0, 8],
+            },
+        ],
+        instances: vec![
+            Instance {
+                geometry: 0,
+                transform: None,
+                material: None,
+                casts_shadow: true,
+            },
+            Instance {
+                geometry: 1,
+                transform: None,
+                material: None,
+                casts_shadow: true,
+            },
+        ],
+    })
+}
+
+#[test]
+fn tracing_paths_does_not_allocate() {
+    let scene = every_feature_scene();
+    let integrator = PathIntegrator::new(&scene, PathSettings::default());
+    let (width, height) = (48u32, 32u32);
+    let mut sum = Color::ZERO;
+    let mut rays = 0;
+    let before = ALLOCATIONS.with(Cell::get);
+    for y in 0..height {
+        for x in 0..width {
+            for s in 0..4 {
+                let mut rng = Rng::for_sample(1, (y * width + x) as u64, s);
+                let ray = scene.camera.ray(
+                    x as f32 + rng.next_f32(),
+                    y as f32 + rng.next_f32(),
+                    width,
+                    height,
+                    width as f32 / height as f32,
+                );
+                let mut first_hit = FirstHit::default();
+                sum += integrator.trace(&scene, &ray, &mut rng, &mut rays, &mut first_hit);
+            }
+        }
+    }
+    let allocations = ALLOCATIONS.with(Cell::get) - before;
+    assert!(sum.is_finite() && sum.max_component() > 0.0);
+    assert!(rays > (width * height * 4) as u64);
+    assert_eq!(
+        allocations, 0,
+        "{allocations} allocations while tracing {rays} rays"
+    );
+    // The counter does see allocations on this thread.
+    let probe = ALLOCATIONS.with(Cell::get);
+    drop(std::hint::black_box(Box::new(7u64)));
+    assert_eq!(ALLOCATIONS.with(Cell::get), probe + 1);
+}
