@@ -6,6 +6,7 @@
 #![forbid(unsafe_code)]
 
 mod args;
+mod bench;
 mod run;
 
 use std::io::IsTerminal;
@@ -20,7 +21,19 @@ use crate::run::{Failure, Interrupt, SignalAction, EXIT_INTERRUPTED};
 static INTERRUPT: Interrupt = Interrupt::new();
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let mut cli = Cli::parse();
+    if matches!(cli.command, Some(crate::args::Command::Bench(_))) {
+        let Some(crate::args::Command::Bench(args)) = cli.command.take() else {
+            unreachable!("matched just above");
+        };
+        return match bench::run(args) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(message) => {
+                eprintln!("error: {message}");
+                ExitCode::FAILURE
+            }
+        };
+    }
     let available = std::thread::available_parallelism().map_or(1, |n| n.get());
     let job = match cli.into_job(available) {
         Ok(job) => job,

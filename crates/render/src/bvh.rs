@@ -159,6 +159,127 @@ impl Bvh {
     }
 }
 
+impl Bvh {
+    /// `traverse` for the rays of `lanes` (bit l for `rays[l]`) together, which must share the
+    /// sign of each direction component: then every node has the same near child for all of
+    /// them, and each ray visits exactly the nodes and primitives, in the same order and with
+    /// the same `t_max`, that `traverse` visits for it alone (which decides ties between
+    /// primitives found at the same t). `t_max[l]` starts as ray l's window end;
+    /// `visit(primitive, rays, t_max)` gets the rays that reach the primitive and lowers their
+    /// `t_max` after a hit.
+    #[inline]
+    pub fn traverse_packet(
+        &self,
+        rays: &[Ray; 8],
+        lanes: u8,
+        t_max: &mut [f32; 8],
+        mut visit: impl FnMut(u32, u8, &mut [f32; 8]),
+    ) {
+        if self.nodes.is_empty() || lanes == 0 {
+            return;
+        }
+        let inv = rays.each_ref().map(RayInverse::new);
+        let negative = inv[lanes.trailing_zeros() as usize].negative;
+        debug_assert!((0..8).all(|l| lanes & (1 << l) == 0 || inv[l].negative == negative));
+        let mut stack = [(0u32, 0u8); STACK_SIZE];
+        let mut sp = 0usize;
+        let mut index = 0u32;
+        let mut active = lanes;
+        loop {
+            let node = &self.nodes[index as usize];
+            let mut hit = 0u8;
+            let mut m = active;
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if inv[l].hits(node, rays[l].t_min, t_max[l]) {
+                    hit |= 1 << l;
+                }
+            }
+            if hit != 0 {
+                if node.count > 0 {
+                    for prim in node.offset..node.offset + node.count as u32 {
+                        visit(prim, hit, t_max);
+                    }
+                } else {
+                    let (near, far) = if negative[node.axis as usize] {
+                        (node.offset, index + 1)
+                    } else {
+                        (index + 1, node.offset)
+                    };
+                    stack[sp] = (far, hit);
+                    sp += 1;
+                    index = near;
+                    active = hit;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                break;
+            }
+            sp -= 1;
+            (index, active) = stack[sp];
+        }
+    }
+
+    /// `traverse_any` for the rays of `lanes` together: `visit(primitive, rays)` returns the
+    /// rays it found occluded, which leave the walk. Returns all the rays found occluded.
+    #[inline]
+    pub fn traverse_any_packet(
+        &self,
+        rays: &[Ray; 8],
+        lanes: u8,
+        mut visit: impl FnMut(u32, u8) -> u8,
+    ) -> u8 {
+        let mut done = 0u8;
+        if self.nodes.is_empty() || lanes == 0 {
+            return done;
+        }
+        let inv = rays.each_ref().map(RayInverse::new);
+        let mut stack = [(0u32, 0u8); STACK_SIZE];
+        let mut sp = 0usize;
+        let mut index = 0u32;
+        let mut active = lanes;
+        loop {
+            let node = &self.nodes[index as usize];
+            let mut hit = 0u8;
+            let mut m = active & !done;
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if inv[l].hits(node, rays[l].t_min, rays[l].t_max) {
+                    hit |= 1 << l;
+                }
+            }
+            if hit != 0 {
+                if node.count > 0 {
+                    for prim in node.offset..node.offset + node.count as u32 {
+                        done |= visit(prim, hit & !done);
+                        if hit & !done == 0 {
+                            break;
+                        }
+                    }
+                    if done == lanes {
+                        return done;
+                    }
+                } else {
+                    stack[sp] = (node.offset, hit);
+                    sp += 1;
+                    index += 1;
+                    active = hit;
+                    continue;
+                }
+            }
+            if sp == 0 {
+                break;
+            }
+            sp -= 1;
+            (index, active) = stack[sp];
+        }
+        done
+    }
+}
+
 /// Per-ray constants for the slab test, computed once per traversal.
 struct RayInverse {
     origin: [f32; 3],

@@ -1,6 +1,8 @@
 //! Glint's renderer: geometry, BVH, materials, lights, cameras, integrators and the render
 //! loop. It does no I/O and never prints; `glint-io` builds its `Scene` from scene files.
 
+pub mod accel;
+pub mod bsdf;
 pub mod bvh;
 pub mod camera;
 pub mod geometry;
@@ -22,8 +24,12 @@ pub use texture::{ColorSource, CubeMap, Image, TextureId};
 
 pub mod film;
 pub mod integrator;
+pub mod light_sampling;
+pub mod path;
+pub mod path_sampler;
 pub mod render;
 pub mod sampling;
 
 pub use film::Film;
+pub use path::{render_with_aovs, PathIntegrator, PathOutput, PathSettings};
 pub use render::{render, Cancelled, IntegratorKind, RenderSettings, RenderStats};

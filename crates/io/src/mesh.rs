@@ -1,0 +1,182 @@
+//! Stand-alone triangle meshes (`.obj`, `.ply`), outside any scene file: what `glint bench`
+//! traces and what the acceleration tests and benches load from `../shared/models`.
+
+use std::fs::File;
+use std::io::BufReader;
+use std::path::{Path, PathBuf};
+
+use glint_render::{GeometryDesc, Shape, Vec3};
+
+use crate::ply;
+
+/// An indexed triangle mesh: positions and corner indices into them.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub positions: Vec<Vec3>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+impl Mesh {
+    /// The three corners of triangle `index`.
+    pub fn triangle(&self, index: usize) -> [Vec3; 3] {
+        self.triangles[index].map(|corner| self.positions[corner as usize])
+    }
+
+    /// The triangles as renderer shapes, in file order.
+    pub fn shapes(&self) -> Vec<Shape> {
+        (0..self.triangles.len())
+            .map(|index| Shape::Triangle {
+                vertices: self.triangle(index),
+            })
+            .collect()
+    }
+
+    /// The mesh as one geometry with material 0 on every triangle.
+    pub fn geometry(&self) -> GeometryDesc {
+        let shapes = self.shapes();
+        GeometryDesc {
+            materials: vec![0; shapes.len()],
+            shapes,
+        }
+    }
+}
+
+/// Why a mesh file could not be loaded.
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("cannot read {path}: {source}")]
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    #[error("{path}: {message}")]
+    Format { path: PathBuf, message: String },
+    #[error("{path}: unknown mesh format (expected .obj or .ply)")]
+    UnknownFormat { path: PathBuf },
+}
+
+/// Loads an OBJ (by tobj, polygons fan-triangulated) or PLY (`ply.rs`) mesh, told apart by
+/// the extension.
+pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
+    let extension = path
+        .extension()
+        .map(|extension| extension.to_string_lossy().to_lowercase());
+    let format_error = |message: String| MeshError::Format {
+        path: path.to_path_buf(),
+        message,
+    };
+    match extension.as_deref() {
+        Some("ply") => {
+            let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            let (positions, triangles) = ply::parse(&bytes).map_err(|e| format_error(e.0))?;
+            Ok(Mesh {
+                positions: positions.into_iter().map(Vec3::from_array).collect(),
+                triangles,
+            })
+        }
+        Some("obj") => {
+            let file = File::open(path).map_err(|source| MeshError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
+            load_obj(&mut BufReader::new(file)).map_err(format_error)
+        }
+        _ => Err(MeshError::UnknownFormat {
+            path: path.to_path_buf(),
+        }),
+    }
+}
+
+fn load_obj(reader: &mut impl std::io::BufRead) -> Result<Mesh, String> {
+    #[allow(clippy::needless_update)]
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: false,
+        ignore_points: true,
+        ignore_lines: true,
+        ..Default::default()
+    };
+    let (models, _materials) = tobj::load_obj_buf(reader, &options, |_| Ok(Default::default()))
+        .map_err(|error| format!("not a readable OBJ file ({error})"))?;
+    let mut mesh = Mesh::default();
+    for model in &models {
+        let base = mesh.positions.len() as u32;
+        let positions = &model.mesh.positions;
+        for p in positions.chunks_exact(3) {
+            let p = Vec3::new(p[0], p[1], p[2]);
+            if !p.is_finite() {
+                return Err(format!("a vertex of `{}` is not finite", model.name));
+            }
+            mesh.positions.push(p);
+        }
+        let count = (positions.len() / 3) as u32;
+        for face in model.mesh.indices.chunks_exact(3) {
+            if face.iter().any(|&i| i >= count) {
+                return Err(format!(
+                    "a face in `{}` uses a vertex that does not exist",
+                    model.name
+                ));
+            }
+            mesh.triangles
+                .push([base + face[0], base + face[1], base + face[2]]);
+        }
+    }
+    Ok(mesh)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn obj_and_ply_give_the_same_mesh() {
+        let directory = tempfile::tempdir().unwrap();
+        let obj = directory.path().join("quad.obj");
+        std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+        let ply = directory.path().join("quad.PLY");
+        std::fs::write(
+            &ply,
+            "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+             property float z\nelement face 1\nproperty list uchar int vertex_indices\n\
+             end_header\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n",
+        )
+        .unwrap();
+        let a = load_mesh(&obj).unwrap();
+        let b = load_mesh(&ply).unwrap();
+        assert_eq!(a.triangles.len(), 2);
+        assert_eq!(
+            (0..2).map(|i| a.triangle(i)).collect::<Vec<_>>(),
+            (0..2).map(|i| b.triangle(i)).collect::<Vec<_>>()
+        );
+        assert_eq!(a.geometry().shapes.len(), 2);
+    }
+
+    #[test]
+    fn errors_name_the_file() {
+        let missing = load_mesh(Path::new("/nonexistent/x.ply")).unwrap_err();
+        assert!(
+            missing.to_string().contains("/nonexistent/x.ply"),
+            "{missing}"
+        );
+        assert!(matches!(
+            load_mesh(Path::new("x.stl")),
+            Err(MeshError::UnknownFormat { .. })
+        ));
+    }
+
+    #[test]
+    fn shared_models_load_when_present() {
+        let models = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models");
+        for (name, triangles) in [("bunny.ply", 69_451), ("stanford-bunny.obj", 69_451)] {
+            let path = models.join(name);
+            if !path.exists() {
+                continue;
+            }
+            let mesh = load_mesh(&path).unwrap();
+            assert_eq!(mesh.triangles.len(), triangles, "{name}");
+        }
+    }
+}

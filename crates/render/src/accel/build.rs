@@ -1,0 +1,641 @@
+//! Building the 8-wide BVH: top-down binned SAH, the children of a node found by splitting the
+//! child of largest surface area until there are eight (Embree's `GeneralBVHBuilder` scheme),
+//! with a leaf cost model that counts triangle *blocks* (a leaf of 5 triangles costs two block
+//! tests, like one of 8), then a pass that packs each leaf's triangles into blocks.
+//!
+//! Split search bins primitive centroids into 32 bins on all three axes in one pass; a split
+//! is kept when its SAH cost beats the leaf's, or when the range is too big to be a leaf.
+//! Ranges whose centroids all coincide, and everything below depth `SAH_DEPTH`, are split at the
+//! median by count, which bounds the tree depth (and so the traversal stack) for any input.
+//! Big subtrees are built in parallel on the current rayon pool.
+
+use rayon::prelude::*;
+
+use crate::accel::wide::{ChildRef, Isa, TriangleBlock, WideBvh, WideNode, BLOCK, WIDTH};
+use crate::geometry::{Aabb, Shape};
+use crate::math::Vec3;
+
+/// The deepest a tree gets (levels of nodes below the root), whatever the input.
+pub const MAX_DEPTH: usize = 48;
+/// Below this depth the SAH chooses splits; deeper, median splits by count finish the job in
+/// at most log₂(2²⁷) more levels.
+const SAH_DEPTH: usize = 20;
+const BINS: usize = 32;
+/// Subtrees with more primitives than this are built as parallel tasks.
+const PARALLEL_THRESHOLD: usize = 4096;
+
+/// Build parameters, chosen by what a geometry holds.
+#[derive(Clone, Copy, Debug)]
+struct Config {
+    /// Primitives one intersection test handles (4 for triangle blocks, 1 for other shapes).
+    block: usize,
+    /// Ranges this small always become leaves.
+    min_leaf: usize,
+    /// Ranges larger than this never do.
+    max_leaf: usize,
+    /// Cost of visiting a node relative to one block test.
+    traversal_cost: f32,
+}
+
+impl Config {
+    fn for_shapes(all_triangles: bool) -> Config {
+        if all_triangles {
+            Config {
+                block: BLOCK,
+                min_leaf: 4,
+                max_leaf: 8,
+                traversal_cost: 1.0,
+            }
+        } else {
+            Config {
+                block: 1,
+                min_leaf: 1,
+                max_leaf: 4,
+                traversal_cost: 1.0,
+            }
+        }
+    }
+
+    #[inline]
+    fn blocks(&self, n: usize) -> f32 {
+        n.div_ceil(self.block) as f32
+    }
+}
+
+/// A primitive's box; `lo[3]` holds its index (as bits), `hi[3]` whether it is a triangle.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+struct PrimRef {
+    lo: [f32; 4],
+    hi: [f32; 4],
+}
+
+impl PrimRef {
+    #[inline(always)]
+    fn index(&self) -> usize {
+        self.lo[3].to_bits() as usize
+    }
+    #[inline(always)]
+    fn is_triangle(&self) -> bool {
+        self.hi[3].to_bits() != 0
+    }
+    /// Twice the centroid (the factor does not matter for binning).
+    #[inline(always)]
+    fn centroid(&self) -> [f32; 4] {
+        [
+            self.lo[0] + self.hi[0],
+            self.lo[1] + self.hi[1],
+            self.lo[2] + self.hi[2],
+            0.0,
+        ]
+    }
+}
+
+/// Box as two 4-lane arrays (lane 3 unused), for branch-free min/max the compiler vectorises.
+#[derive(Clone, Copy, Debug)]
+struct Box4 {
+    lo: [f32; 4],
+    hi: [f32; 4],
+}
+
+#[inline(always)]
+fn min4(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    std::array::from_fn(|i| if a[i] < b[i] { a[i] } else { b[i] })
+}
+#[inline(always)]
+fn max4(a: [f32; 4], b: [f32; 4]) -> [f32; 4] {
+    std::array::from_fn(|i| if a[i] > b[i] { a[i] } else { b[i] })
+}
+
+impl Box4 {
+    const EMPTY: Box4 = Box4 {
+        lo: [f32::INFINITY; 4],
+        hi: [f32::NEG_INFINITY; 4],
+    };
+    #[inline(always)]
+    fn grow_box(&mut self, lo: [f32; 4], hi: [f32; 4]) {
+        self.lo = min4(self.lo, lo);
+        self.hi = max4(self.hi, hi);
+    }
+    #[inline(always)]
+    fn grow_point(&mut self, p: [f32; 4]) {
+        self.grow_box(p, p);
+    }
+    #[inline(always)]
+    fn union(self, o: Box4) -> Box4 {
+        Box4 {
+            lo: min4(self.lo, o.lo),
+            hi: max4(self.hi, o.hi),
+        }
+    }
+    #[inline(always)]
+    fn half_area(&self) -> f32 {
+        let d = [
+            self.hi[0] - self.lo[0],
+            self.hi[1] - self.lo[1],
+            self.hi[2] - self.lo[2],
+        ];
+        if !(d[0] >= 0.0 && d[1] >= 0.0 && d[2] >= 0.0) {
+            return 0.0;
+        }
+        d[0] * d[1] + d[1] * d[2] + d[2] * d[0]
+    }
+    fn aabb(&self) -> Aabb {
+        Aabb {
+            min: Vec3::new(self.lo[0], self.lo[1], self.lo[2]),
+            max: Vec3::new(self.hi[0], self.hi[1], self.hi[2]),
+        }
+    }
+}
+
+/// A range of the primitive array waiting to become a subtree, with its split if one was found.
+#[derive(Clone, Copy, Debug)]
+struct Record {
+    start: usize,
+    end: usize,
+    bounds: Box4,
+    centroids: Box4,
+    split: Option<Split>,
+}
+
+impl Record {
+    fn len(&self) -> usize {
+        self.end - self.start
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Split {
+    axis: usize,
+    /// Bins 0..=bin go left.
+    bin: usize,
+    /// SAH of the children: Σ half area · blocks.
+    cost: f32,
+}
+
+/// Maps centroids to bins on each axis.
+#[derive(Clone, Copy, Debug)]
+struct Binner {
+    origin: [f32; 4],
+    scale: [f32; 4],
+    /// Bins in use: fewer for small ranges, as Embree's `BinMapping` does (4 + n/20, at most
+    /// `BINS`), which costs little quality and saves most of the sweep on small ranges.
+    count: usize,
+}
+
+impl Binner {
+    fn new(centroids: &Box4, n: usize) -> Binner {
+        let count = (4 + n / 20).min(BINS);
+        let scale = std::array::from_fn(|a| {
+            let extent = centroids.hi[a] - centroids.lo[a];
+            if a < 3 && extent > 0.0 && extent.is_finite() {
+                // Just under `count` per extent, so the largest centroid lands in the last bin.
+                count as f32 * (1.0 - 2.0 * f32::EPSILON) / extent
+            } else {
+                0.0
+            }
+        });
+        Binner {
+            origin: centroids.lo,
+            scale,
+            count,
+        }
+    }
+    #[inline(always)]
+    fn bins(&self, c: [f32; 4]) -> [usize; 3] {
+        std::array::from_fn(|a| {
+            // `as` saturates (NaN to 0), and the min keeps rounding inside the last bin.
+            (((c[a] - self.origin[a]) * self.scale[a]) as usize).min(self.count - 1)
+        })
+    }
+}
+
+fn find_split(prims: &[PrimRef], record: &Record, config: &Config) -> Option<Split> {
+    let binner = Binner::new(&record.centroids, record.len());
+    let bins = binner.count;
+    if binner.scale[..3].iter().all(|&s| s == 0.0) {
+        return None;
+    }
+    let mut bounds = [[Box4::EMPTY; BINS]; 3];
+    let mut counts = [[0u32; BINS]; 3];
+    for p in &prims[record.start..record.end] {
+        let b = binner.bins(p.centroid());
+        for axis in 0..3 {
+            bounds[axis][b[axis]].grow_box(p.lo, p.hi);
+            counts[axis][b[axis]] += 1;
+        }
+    }
+    let mut best: Option<Split> = None;
+    for axis in 0..3 {
+        if binner.scale[axis] == 0.0 {
+            continue;
+        }
+        let mut right_cost = [0.0f32; BINS];
+        let mut acc = Box4::EMPTY;
+        let mut count = 0usize;
+        for i in (1..bins).rev() {
+            acc = acc.union(bounds[axis][i]);
+            count += counts[axis][i] as usize;
+            right_cost[i] = if count > 0 {
+                acc.half_area() * config.blocks(count)
+            } else {
+                f32::INFINITY
+            };
+        }
+        let mut acc = Box4::EMPTY;
+        let mut count = 0usize;
+        for i in 0..bins - 1 {
+            acc = acc.union(bounds[axis][i]);
+            count += counts[axis][i] as usize;
+            if count == 0 {
+                continue;
+            }
+            let cost = acc.half_area() * config.blocks(count) + right_cost[i + 1];
+            if cost.is_finite() && best.is_none_or_cheaper(cost) {
+                best = Some(Split { axis, bin: i, cost });
+            }
+        }
+    }
+    best
+}
+
+trait CheaperThan {
+    fn is_none_or_cheaper(&self, cost: f32) -> bool;
+}
+
+impl CheaperThan for Option<Split> {
+    fn is_none_or_cheaper(&self, cost: f32) -> bool {
+        match self {
+            None => true,
+            Some(s) => cost < s.cost,
+        }
+    }
+}
+
+/// Bounds and centroid bounds of a range.
+fn measure(prims: &[PrimRef]) -> (Box4, Box4) {
+    let mut bounds = Box4::EMPTY;
+    let mut centroids = Box4::EMPTY;
+    for p in prims {
+        bounds.grow_box(p.lo, p.hi);
+        centroids.grow_point(p.centroid());
+    }
+    (bounds, centroids)
+}
+
+/// Splits a record in two: by its SAH split, else at the median by count on the widest
+/// centroid axis. Both halves are non-empty.
+fn split_record(
+    prims: &mut [PrimRef],
+    record: &Record,
+    config: &Config,
+    depth: usize,
+) -> (Record, Record) {
+    let (start, end) = (record.start, record.end);
+    let mut sides = None;
+    let mid = match record.split {
+        Some(split) => {
+            // Partition, measuring both sides on the way.
+            let binner = Binner::new(&record.centroids, record.len());
+            let axis = split.axis;
+            let (mut left, mut left_c) = (Box4::EMPTY, Box4::EMPTY);
+            let (mut right, mut right_c) = (Box4::EMPTY, Box4::EMPTY);
+            let mut i = start;
+            let mut j = end;
+            while i < j {
+                let p = prims[i];
+                let c = p.centroid();
+                if binner.bins(c)[axis] <= split.bin {
+                    left.grow_box(p.lo, p.hi);
+                    left_c.grow_point(c);
+                    i += 1;
+                } else {
+                    right.grow_box(p.lo, p.hi);
+                    right_c.grow_point(c);
+                    j -= 1;
+                    prims.swap(i, j);
+                }
+            }
+            sides = Some(((left, left_c), (right, right_c)));
+            i
+        }
+        None => start,
+    };
+    let mid = if mid == start || mid == end {
+        sides = None;
+        // Median by count along the widest centroid axis.
+        let c = &record.centroids;
+        let extent = [c.hi[0] - c.lo[0], c.hi[1] - c.lo[1], c.hi[2] - c.lo[2]];
+        let axis = if extent[0] >= extent[1] && extent[0] >= extent[2] {
+            0
+        } else if extent[1] >= extent[2] {
+            1
+        } else {
+            2
+        };
+        let half = (end - start) / 2;
+        prims[start..end].select_nth_unstable_by(half, |a, b| {
+            a.centroid()[axis].total_cmp(&b.centroid()[axis])
+        });
+        start + half
+    } else {
+        mid
+    };
+    let make = |prims: &[PrimRef], s: usize, e: usize, measured: Option<(Box4, Box4)>| {
+        let (bounds, centroids) = measured.unwrap_or_else(|| measure(&prims[s..e]));
+        let mut r = Record {
+            start: s,
+            end: e,
+            bounds,
+            centroids,
+            split: None,
+        };
+        if r.len() > config.min_leaf && depth < SAH_DEPTH {
+            r.split = find_split(prims, &r, config);
+        }
+        r
+    };
+    let (left, right) = match sides {
+        Some((l, r)) => (Some(l), Some(r)),
+        None => (None, None),
+    };
+    (make(prims, start, mid, left), make(prims, mid, end, right))
+}
+
+/// Nodes of a subtree: inner references are indices into `nodes`; leaves still name primitive
+/// ranges (global positions in the primitive array), turned into blocks by `pack`.
+struct Subtree {
+    nodes: Vec<WideNode>,
+    root: ChildRef,
+}
+
+struct Builder {
+    config: Config,
+}
+
+impl Builder {
+    fn leaf(
+        &self,
+        prims: &mut [PrimRef],
+        base: usize,
+        record: &Record,
+        nodes: &mut Vec<WideNode>,
+    ) -> ChildRef {
+        let (start, end) = (record.start, record.end);
+        // Triangles first, other shapes after: a leaf holds one kind only.
+        let mut i = start;
+        let mut j = end;
+        while i < j {
+            if prims[i].is_triangle() {
+                i += 1;
+            } else {
+                j -= 1;
+                prims.swap(i, j);
+            }
+        }
+        let tri = ChildRef::triangles((base + start) as u32, (i - start).max(1) as u32);
+        let other = ChildRef::shapes((base + i) as u32, (end - i).max(1) as u32);
+        if i == end {
+            return tri;
+        }
+        if i == start {
+            return other;
+        }
+        // Mixed: a small node holding the two leaves.
+        let mut node = WideNode::EMPTY;
+        let (tb, _) = measure(&prims[start..i]);
+        let (ob, _) = measure(&prims[i..end]);
+        node.set_child(0, tri, &tb.aabb());
+        node.set_child(1, other, &ob.aabb());
+        nodes.push(node);
+        ChildRef::node((nodes.len() - 1) as u32)
+    }
+
+    /// Builds the subtree of `record` (positions relative to `prims`, whose first element is
+    /// global position `base`), appending its nodes to `nodes`.
+    fn subtree(
+        &self,
+        prims: &mut [PrimRef],
+        base: usize,
+        record: Record,
+        depth: usize,
+        nodes: &mut Vec<WideNode>,
+    ) -> ChildRef {
+        let n = record.len();
+        let config = &self.config;
+        let area = record.bounds.half_area();
+        let leaf_cost = area * config.blocks(n);
+        let split_cost = record
+            .split
+            .map_or(f32::INFINITY, |s| config.traversal_cost * area + s.cost);
+        let too_deep = depth >= MAX_DEPTH && n <= WIDTH;
+        if n <= config.min_leaf || (n <= config.max_leaf && leaf_cost <= split_cost) || too_deep {
+            return self.leaf(prims, base, &record, nodes);
+        }
+        // Fill up to eight children by splitting the one of largest area (past the SAH depth:
+        // the largest by count, which halves the depth still needed at every level).
+        let median_mode = depth >= SAH_DEPTH;
+        let mut slots = [record; WIDTH];
+        let mut len = 1;
+        while len < WIDTH {
+            let mut best: Option<usize> = None;
+            let mut best_key = -1.0f32;
+            for (k, c) in slots[..len].iter().enumerate() {
+                if c.len() <= config.min_leaf {
+                    continue;
+                }
+                let key = if median_mode {
+                    c.len() as f32
+                } else {
+                    c.bounds.half_area()
+                };
+                if key > best_key {
+                    best_key = key;
+                    best = Some(k);
+                }
+            }
+            let Some(k) = best else { break };
+            let (left, right) = split_record(prims, &slots[k], config, depth + 1);
+            slots[k] = left;
+            slots[len] = right;
+            len += 1;
+        }
+        let children = &mut slots[..len];
+        children.sort_unstable_by_key(|c| c.start);
+
+        let node_index = nodes.len();
+        nodes.push(WideNode::EMPTY);
+        if n > PARALLEL_THRESHOLD {
+            // Each child on its own slice and node array, then appended and relocated.
+            let mut slices: Vec<(&mut [PrimRef], usize, Record)> =
+                Vec::with_capacity(children.len());
+            let mut rest = prims;
+            let mut offset = 0;
+            for c in children.iter() {
+                let (_, tail) = rest.split_at_mut(c.start - offset);
+                let (mine, tail) = tail.split_at_mut(c.len());
+                let local = Record {
+                    start: 0,
+                    end: c.len(),
+                    ..*c
+                };
+                slices.push((mine, base + c.start, local));
+                rest = tail;
+                offset = c.end;
+            }
+            let subtrees: Vec<Subtree> = slices
+                .into_par_iter()
+                .map(|(slice, child_base, local)| {
+                    let mut sub = Vec::new();
+                    let root = self.subtree(slice, child_base, local, depth + 1, &mut sub);
+                    Subtree { nodes: sub, root }
+                })
+                .collect();
+            for (slot, (sub, c)) in subtrees.into_iter().zip(children.iter()).enumerate() {
+                let offset = nodes.len() as u32;
+                let relocate = |r: ChildRef| {
+                    if r.is_leaf() {
+                        r
+                    } else {
+                        ChildRef::node(r.0 + offset)
+                    }
+                };
+                for mut node in sub.nodes {
+                    for child in node.children.iter_mut() {
+                        *child = relocate(ChildRef(*child)).0;
+                    }
+                    nodes.push(node);
+                }
+                let root = relocate(sub.root);
+                nodes[node_index].set_child(slot, root, &c.bounds.aabb());
+            }
+        } else {
+            for (slot, c) in children.iter().enumerate() {
+                let child = self.subtree(prims, base, *c, depth + 1, nodes);
+                nodes[node_index].set_child(slot, child, &c.bounds.aabb());
+            }
+        }
+        ChildRef::node(node_index as u32)
+    }
+}
+
+/// Builds the wide BVH of `shapes` on the current rayon pool.
+pub fn build(shapes: &[Shape]) -> WideBvh {
+    let all_triangles = shapes.iter().all(|s| matches!(s, Shape::Triangle { .. }));
+    let config = Config::for_shapes(all_triangles);
+    let mut prims: Vec<PrimRef> = shapes
+        .par_iter()
+        .with_min_len(4096)
+        .enumerate()
+        .map(|(i, s)| {
+            let b = s.bounds();
+            PrimRef {
+                lo: [b.min.x, b.min.y, b.min.z, f32::from_bits(i as u32)],
+                hi: [
+                    b.max.x,
+                    b.max.y,
+                    b.max.z,
+                    f32::from_bits(matches!(s, Shape::Triangle { .. }) as u32),
+                ],
+            }
+        })
+        .collect();
+    let (bounds, centroids) = prims.par_chunks(16384).map(measure).reduce(
+        || (Box4::EMPTY, Box4::EMPTY),
+        |a, b| (a.0.union(b.0), a.1.union(b.1)),
+    );
+    let mut nodes = Vec::new();
+    let root = if prims.is_empty() {
+        ChildRef::EMPTY
+    } else {
+        let mut record = Record {
+            start: 0,
+            end: prims.len(),
+            bounds,
+            centroids,
+            split: None,
+        };
+        if record.len() > config.min_leaf {
+            record.split = find_split(&prims, &record, &config);
+        }
+        let builder = Builder { config };
+        builder.subtree(&mut prims, 0, record, 0, &mut nodes)
+    };
+    pack(
+        shapes,
+        &prims,
+        nodes,
+        root,
+        if prims.is_empty() {
+            Aabb::EMPTY
+        } else {
+            bounds.aabb()
+        },
+    )
+}
+
+/// Turns leaves over primitive ranges into leaves over triangle blocks and shape runs.
+fn pack(
+    shapes: &[Shape],
+    prims: &[PrimRef],
+    mut nodes: Vec<WideNode>,
+    root: ChildRef,
+    bounds: Aabb,
+) -> WideBvh {
+    let mut blocks: Vec<TriangleBlock> = Vec::with_capacity(prims.len() / 3 + 1);
+    let mut lane_source: Vec<u32> = Vec::with_capacity(prims.len() * 4 / 3 + 4);
+    let mut others: Vec<Shape> = Vec::new();
+    let mut other_source: Vec<u32> = Vec::new();
+    let mut convert = |r: ChildRef| -> ChildRef {
+        if !r.is_leaf() || r == ChildRef::EMPTY {
+            return r;
+        }
+        let (start, count) = r.range();
+        // Lanes in the order given, so the lowest lane of a tie is also the lowest index.
+        let mut sorted = [prims[start]; 8];
+        sorted[..count].copy_from_slice(&prims[start..start + count]);
+        let range = &mut sorted[..count];
+        range.sort_unstable_by_key(PrimRef::index);
+        let range = &*range;
+        if r.is_shapes() {
+            let first = others.len() as u32;
+            for p in range {
+                others.push(shapes[p.index()]);
+                other_source.push(p.index() as u32);
+            }
+            ChildRef::shapes(first, count as u32)
+        } else {
+            let first = blocks.len() as u32;
+            for chunk in range.chunks(BLOCK) {
+                let mut block = TriangleBlock::EMPTY;
+                for (lane, p) in chunk.iter().enumerate() {
+                    if let Shape::Triangle { vertices } = &shapes[p.index()] {
+                        block.set(lane, vertices);
+                    }
+                    lane_source.push(p.index() as u32);
+                }
+                for _ in chunk.len()..BLOCK {
+                    lane_source.push(u32::MAX);
+                }
+                blocks.push(block);
+            }
+            ChildRef::triangles(first, count.div_ceil(BLOCK) as u32)
+        }
+    };
+    for node in nodes.iter_mut() {
+        for child in node.children.iter_mut() {
+            *child = convert(ChildRef(*child)).0;
+        }
+    }
+    let root = convert(root);
+    lane_source.extend(other_source);
+    WideBvh {
+        nodes,
+        root,
+        bounds,
+        blocks,
+        shapes: others,
+        source: lane_source,
+        isa: Isa::detect(),
+    }
+}

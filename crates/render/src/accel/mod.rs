@@ -1,0 +1,18 @@
+//! Glint's ray engine for the bottom level of the scene: an 8-wide BVH (`wide.rs`) built by
+//! binned SAH with a block-aware leaf cost (`build.rs`), triangles in blocks of four tested by
+//! the watertight algorithm of Woop, Benthin and Wald (`triangle.rs`), traversed with AVX2
+//! kernels chosen at run time (`simd.rs`, the one module with `unsafe`) or a scalar fallback.
+//! The binary BVH of `crate::bvh` stays as the reference the tests compare against (and as
+//! the top level over instances). `packet.rs` traces eight coherent rays together (camera rays
+//! of a pixel block) with results identical to tracing them one by one. `workload.rs` holds the
+//! fixed ray sets that measure all this.
+
+pub mod build;
+pub mod packet;
+pub mod simd;
+pub mod triangle;
+pub mod wide;
+pub mod workload;
+
+pub use packet::{ALL_LANES, PACKET};
+pub use wide::{Isa, LocalHit, WideBvh};

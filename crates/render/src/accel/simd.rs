@@ -1,0 +1,746 @@
+//! The AVX2 kernels of the 8-wide BVH: one ray against a node's eight boxes in one pass of
+//! 8-lane operations, one ray against a block of four triangles in 4-lane operations, and the
+//! traversal of `wide.rs` instantiated inside `#[target_feature(enable = "avx2,fma")]`
+//! functions so that all of it is compiled for AVX2 (chosen at run time; the scalar kernel of
+//! `wide.rs` serves CPUs without it). Likewise for packets of eight rays (`packet.rs`): the
+//! packet against one child box (lanes are rays), the interval test of a packet against all
+//! eight children (lanes are children), and the packet traversal instantiated for AVX2.
+//!
+//! This is the one module of glint-render allowed `unsafe` (DESIGN.md, Tooling): calling
+//! `target_feature` functions after run-time detection, and reading the uninitialised
+//! traversal stacks below their top. The benchmarks that justified it: `glint bench table`
+//! (`cargo run --release -p glint -- bench table`) and the `accel` criterion bench
+//! (`cargo bench -p glint-render --bench accel`), which time this kernel against
+//! `Isa::Scalar` on the same BVH, and for packets `glint bench table --packets` /
+//! `glint bench rays --packets` (packet against single-ray traversal on the same rays); see
+//! `bench/README.md` for the figures.
+#![allow(unsafe_code)]
+
+use crate::accel::packet::{self, ArrayPacketStack, Lanes, PacketRays, ScalarPacketKernel, PACKET};
+use crate::accel::wide::{self, WideBvh};
+use crate::ray::Ray;
+
+/// Whether this CPU runs the AVX2+FMA kernels.
+#[inline]
+pub fn avx2_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Closest hit with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
+#[inline]
+pub(crate) fn closest(bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
+    #[cfg(target_arch = "x86_64")]
+    if avx2_available() {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above).
+        return unsafe { x86::closest(bvh, ray) };
+    }
+    wide::closest(&wide::ScalarKernel, bvh, ray, &mut wide::ArrayStack::new())
+}
+
+/// Any hit with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
+#[inline]
+pub(crate) fn any(bvh: &WideBvh, ray: &Ray) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if avx2_available() {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above).
+        return unsafe { x86::any(bvh, ray) };
+    }
+    wide::any(&wide::ScalarKernel, bvh, ray, &mut wide::ArrayStack::new())
+}
+
+/// Closest hits of a packet with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
+#[inline]
+pub(crate) fn packet_closest(bvh: &WideBvh, p: &PacketRays) -> (Lanes, [u32; PACKET]) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2_available() {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above).
+        return unsafe { x86::packet_closest(bvh, p) };
+    }
+    packet::closest(&ScalarPacketKernel, bvh, p, &mut ArrayPacketStack::new())
+}
+
+/// Occluded rays of a packet with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
+#[inline]
+pub(crate) fn packet_any(bvh: &WideBvh, p: &PacketRays) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if avx2_available() {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above).
+        return unsafe { x86::packet_any(bvh, p) };
+    }
+    packet::any(&ScalarPacketKernel, bvh, p, &mut ArrayPacketStack::new())
+}
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use std::arch::x86_64::*;
+    use std::mem::MaybeUninit;
+
+    use crate::accel::packet::{self, Lanes, PacketKernel, PacketRays, PacketStack, PACKET};
+    use crate::accel::triangle::WoopRay;
+    use crate::accel::wide::{
+        self, BoxPlanes, Kernel, ScalarKernel, Stack, TriangleBlock, WideBvh, WideNode, BLOCK,
+        FAR_SCALE, STACK_SIZE, WIDTH,
+    };
+    use crate::ray::Ray;
+
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn closest(bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
+        wide::closest(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
+    }
+
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn any(bvh: &WideBvh, ray: &Ray) -> bool {
+        wide::any(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
+    }
+
+    /// A traversal stack that is not cleared for every ray (it is 3 KB).
+    struct UninitStack {
+        entries: [MaybeUninit<(u32, f32)>; STACK_SIZE],
+        len: usize,
+    }
+
+    impl UninitStack {
+        #[inline(always)]
+        fn new() -> Self {
+            UninitStack {
+                entries: [const { MaybeUninit::uninit() }; STACK_SIZE],
+                len: 0,
+            }
+        }
+    }
+
+    impl Stack for UninitStack {
+        #[inline(always)]
+        fn push(&mut self, child: u32, entry: f32) {
+            self.entries[self.len] = MaybeUninit::new((child, entry));
+            self.len += 1;
+        }
+        #[inline(always)]
+        fn pop(&mut self) -> Option<(u32, f32)> {
+            if self.len == 0 {
+                return None;
+            }
+            self.len -= 1;
+            // SAFETY: every entry below `len` was written by `push`.
+            Some(unsafe { self.entries[self.len].assume_init() })
+        }
+    }
+
+    /// Per-ray constants of the box test, broadcast to 8 lanes.
+    struct BoxRay {
+        origin: [__m256; 3],
+        inv_dir: [__m256; 3],
+        near: [usize; 3],
+        far: [usize; 3],
+        t_min: __m256,
+    }
+
+    /// The AVX2 kernel. Its methods are only reached from the `target_feature` functions
+    /// above, into which they are inlined.
+    struct Avx2Kernel;
+
+    impl Kernel for Avx2Kernel {
+        type BoxRay = BoxRay;
+
+        #[inline(always)]
+        fn box_ray(&self, ray: &Ray) -> BoxRay {
+            // SAFETY: only called inside `closest`/`any` above, on a CPU with AVX2.
+            unsafe { box_ray(&BoxPlanes::new(ray)) }
+        }
+
+        #[inline(always)]
+        fn node(&self, node: &WideNode, ray: &BoxRay, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
+            // SAFETY: as above.
+            unsafe { node_test(node, ray, t_max, entry) }
+        }
+
+        #[inline(always)]
+        fn block(
+            &self,
+            block: &TriangleBlock,
+            ray: &WoopRay,
+            t_min: f32,
+            t_max: f32,
+        ) -> Option<(usize, f32)> {
+            // SAFETY: as above.
+            let (mask, t) = unsafe { block_test(block, ray, t_min, t_max) };
+            match mask {
+                0 => None,
+                ZERO_EDGE => ScalarKernel.block(block, ray, t_min, t_max),
+                _ => {
+                    let mut best = (0usize, f32::INFINITY);
+                    let mut m = mask;
+                    while m != 0 {
+                        let lane = m.trailing_zeros() as usize;
+                        m &= m - 1;
+                        if t[lane] < best.1 {
+                            best = (lane, t[lane]);
+                        }
+                    }
+                    Some(best)
+                }
+            }
+        }
+
+        #[inline(always)]
+        fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool {
+            // SAFETY: as above.
+            let (mask, _) = unsafe { block_test(block, ray, t_min, t_max) };
+            match mask {
+                0 => false,
+                ZERO_EDGE => ScalarKernel.block_any(block, ray, t_min, t_max),
+                _ => true,
+            }
+        }
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn box_ray(p: &BoxPlanes) -> BoxRay {
+        BoxRay {
+            origin: p.origin.map(|c| _mm256_set1_ps(c)),
+            inv_dir: p.inv_dir.map(|c| _mm256_set1_ps(c)),
+            near: p.near,
+            far: p.far,
+            t_min: _mm256_set1_ps(p.t_min),
+        }
+    }
+
+    /// The scalar kernel's slab test, eight children at once, same operations in the same
+    /// order.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn node_test(node: &WideNode, r: &BoxRay, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
+        let plane = |row: usize| {
+            // SAFETY: each row is 8 f32 inside the 64-byte aligned node, so 32-byte aligned.
+            unsafe { _mm256_load_ps(node.bounds[row].as_ptr()) }
+        };
+        let slab = |row: usize, axis: usize| {
+            _mm256_mul_ps(_mm256_sub_ps(plane(row), r.origin[axis]), r.inv_dir[axis])
+        };
+        let near_x = slab(r.near[0], 0);
+        let near_y = slab(r.near[1], 1);
+        let near_z = slab(r.near[2], 2);
+        let far_x = slab(r.far[0], 0);
+        let far_y = slab(r.far[1], 1);
+        let far_z = slab(r.far[2], 2);
+        // `max_ps(a, b)`/`min_ps(a, b)` return b when either is NaN: with the running value
+        // second, a NaN slab (a ray in a slab plane) leaves it alone, as in the scalar kernel.
+        let t0 = _mm256_max_ps(
+            near_z,
+            _mm256_max_ps(near_y, _mm256_max_ps(near_x, r.t_min)),
+        );
+        let t1 = _mm256_min_ps(
+            far_z,
+            _mm256_min_ps(far_y, _mm256_min_ps(far_x, _mm256_set1_ps(f32::INFINITY))),
+        );
+        let t1 = _mm256_min_ps(
+            _mm256_mul_ps(t1, _mm256_set1_ps(FAR_SCALE)),
+            _mm256_set1_ps(t_max),
+        );
+        // SAFETY: `entry` is 8 f32 (unaligned store).
+        unsafe { _mm256_storeu_ps(entry.as_mut_ptr(), t0) };
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+    }
+
+    /// Returned by `block_test` when some lane has an edge function of exactly zero: those need
+    /// the f64 check and the tie rule, which the scalar kernel applies.
+    const ZERO_EDGE: u32 = 1 << 8;
+
+    /// The watertight test of `triangle::intersect` on four lanes: the mask of lanes hit within
+    /// [t_min, t_max] and their t (or `ZERO_EDGE`).
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn block_test(
+        block: &TriangleBlock,
+        ray: &WoopRay,
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; BLOCK]) {
+        let load = |corner: usize, axis: usize| {
+            // SAFETY: a row is 4 f32, 16-byte aligned in the 16-byte aligned block.
+            unsafe { _mm_load_ps(block.v[corner][axis].as_ptr()) }
+        };
+        let (kx, ky, kz) = (ray.kx, ray.ky, ray.kz);
+        let ox = _mm_set1_ps(ray.origin[kx]);
+        let oy = _mm_set1_ps(ray.origin[ky]);
+        let oz = _mm_set1_ps(ray.origin[kz]);
+        let sx = _mm_set1_ps(ray.sx);
+        let sy = _mm_set1_ps(ray.sy);
+        let sz = _mm_set1_ps(ray.sz);
+        // `WoopRay::shear`: a = v − o, then x = a[kx] − sx·a[kz], y = a[ky] − sy·a[kz].
+        let shear = |corner: usize| {
+            let ax = _mm_sub_ps(load(corner, kx), ox);
+            let ay = _mm_sub_ps(load(corner, ky), oy);
+            let az = _mm_sub_ps(load(corner, kz), oz);
+            (
+                _mm_sub_ps(ax, _mm_mul_ps(sx, az)),
+                _mm_sub_ps(ay, _mm_mul_ps(sy, az)),
+                az,
+            )
+        };
+        let (ax, ay, az) = shear(0);
+        let (bx, by, bz) = shear(1);
+        let (cx, cy, cz) = shear(2);
+        // `triangle::edge(p, q) = q.x·p.y − q.y·p.x`: U = edge(b, c), V = edge(c, a), W = edge(a, b).
+        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+        let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+        let zero = _mm_setzero_ps();
+        let any_zero = _mm_or_ps(
+            _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
+            _mm_cmpeq_ps(w, zero),
+        );
+        if _mm_movemask_ps(any_zero) != 0 {
+            return (ZERO_EDGE, [0.0; BLOCK]);
+        }
+        let negative = _mm_or_ps(
+            _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
+            _mm_cmplt_ps(w, zero),
+        );
+        let positive = _mm_or_ps(
+            _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
+            _mm_cmpgt_ps(w, zero),
+        );
+        let det = _mm_add_ps(_mm_add_ps(u, v), w);
+        // Not on both sides of an edge, and a non-zero (ordered: not NaN) determinant.
+        let valid = _mm_andnot_ps(
+            _mm_and_ps(negative, positive),
+            _mm_cmp_ps::<_CMP_NEQ_OQ>(det, zero),
+        );
+        if _mm_movemask_ps(valid) == 0 {
+            return (0, [0.0; BLOCK]);
+        }
+        let t_scaled = _mm_add_ps(
+            _mm_add_ps(
+                _mm_mul_ps(u, _mm_mul_ps(sz, az)),
+                _mm_mul_ps(v, _mm_mul_ps(sz, bz)),
+            ),
+            _mm_mul_ps(w, _mm_mul_ps(sz, cz)),
+        );
+        let t = _mm_div_ps(t_scaled, det);
+        let in_window = _mm_and_ps(
+            _mm_cmp_ps::<_CMP_GE_OQ>(t, _mm_set1_ps(t_min)),
+            _mm_cmp_ps::<_CMP_LE_OQ>(t, _mm_set1_ps(t_max)),
+        );
+        let mask = _mm_movemask_ps(_mm_and_ps(valid, in_window)) as u32;
+        let mut out = [0.0f32; BLOCK];
+        // SAFETY: `out` is 4 f32 (unaligned store).
+        unsafe { _mm_storeu_ps(out.as_mut_ptr(), t) };
+        (mask, out)
+    }
+
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn packet_closest(bvh: &WideBvh, p: &PacketRays) -> (Lanes, [u32; PACKET]) {
+        packet::closest(&Avx2PacketKernel, bvh, p, &mut UninitPacketStack::new())
+    }
+
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn packet_any(bvh: &WideBvh, p: &PacketRays) -> u32 {
+        packet::any(&Avx2PacketKernel, bvh, p, &mut UninitPacketStack::new())
+    }
+
+    /// The packet traversal stack, not cleared for every packet (it is 14 KB).
+    struct UninitPacketStack {
+        refs: [MaybeUninit<(u32, u32)>; STACK_SIZE],
+        entries: [MaybeUninit<Lanes>; STACK_SIZE],
+        len: usize,
+    }
+
+    impl UninitPacketStack {
+        #[inline(always)]
+        fn new() -> Self {
+            UninitPacketStack {
+                refs: [const { MaybeUninit::uninit() }; STACK_SIZE],
+                entries: [const { MaybeUninit::uninit() }; STACK_SIZE],
+                len: 0,
+            }
+        }
+    }
+
+    impl PacketStack for UninitPacketStack {
+        #[inline(always)]
+        fn push(&mut self, child: u32, lanes: u32, entry: &Lanes) {
+            self.refs[self.len] = MaybeUninit::new((child, lanes));
+            self.entries[self.len] = MaybeUninit::new(*entry);
+            self.len += 1;
+        }
+        #[inline(always)]
+        fn pop(&mut self) -> Option<(u32, u32, Lanes)> {
+            if self.len == 0 {
+                return None;
+            }
+            self.len -= 1;
+            // SAFETY: every entry below `len` was written by `push`.
+            unsafe {
+                let (child, lanes) = self.refs[self.len].assume_init();
+                Some((child, lanes, self.entries[self.len].assume_init()))
+            }
+        }
+    }
+
+    /// The AVX2 packet kernel. Its methods are only reached from the `target_feature` functions
+    /// above, into which they are inlined.
+    struct Avx2PacketKernel;
+
+    impl PacketKernel for Avx2PacketKernel {
+        #[inline(always)]
+        fn candidates(&self, node: &WideNode, p: &PacketRays, lanes: u32, t_max: &Lanes) -> u32 {
+            // SAFETY: only called inside `packet_closest`/`packet_any`, on a CPU with AVX2.
+            unsafe { packet_candidates(node, p, lanes, t_max) }
+        }
+
+        #[inline(always)]
+        fn child(
+            &self,
+            node: &WideNode,
+            slot: usize,
+            p: &PacketRays,
+            lanes: u32,
+            t_max: &Lanes,
+            entry: &mut Lanes,
+        ) -> u32 {
+            // SAFETY: as above.
+            unsafe { packet_child(node, slot, p, lanes, t_max, entry) }
+        }
+
+        #[inline(always)]
+        fn not_beyond(&self, lanes: u32, entry: &Lanes, t_max: &Lanes) -> u32 {
+            // SAFETY: as above.
+            unsafe { packet_not_beyond(lanes, entry, t_max) }
+        }
+
+        #[inline(always)]
+        fn min_lane(&self, entry: &Lanes) -> f32 {
+            // SAFETY: as above.
+            unsafe { packet_min_lane(entry) }
+        }
+
+        #[inline(always)]
+        fn block(
+            &self,
+            block: &TriangleBlock,
+            p: &PacketRays,
+            lanes: u32,
+            t_max: &Lanes,
+            lane: &mut [u8; PACKET],
+            t: &mut Lanes,
+        ) -> u32 {
+            if let Some(axes) = p.shared_axes {
+                if lanes.count_ones() >= LANES_FOR_PACKET_TRIANGLES {
+                    // SAFETY: as above.
+                    return unsafe { packet_block(block, p, axes, lanes, t_max, lane, t) };
+                }
+            }
+            let mut hits = 0;
+            let mut m = lanes;
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if let Some((k, th)) = Avx2Kernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l])
+                {
+                    lane[l] = k as u8;
+                    t.0[l] = th;
+                    hits |= 1 << l;
+                }
+            }
+            hits
+        }
+
+        #[inline(always)]
+        fn block_any(&self, block: &TriangleBlock, p: &PacketRays, lanes: u32) -> u32 {
+            if let Some(axes) = p.shared_axes {
+                if lanes.count_ones() >= LANES_FOR_PACKET_TRIANGLES {
+                    // SAFETY: as above.
+                    return unsafe { packet_block_any(block, p, axes, lanes) };
+                }
+            }
+            let mut hits = 0;
+            let mut m = lanes;
+            while m != 0 {
+                let l = m.trailing_zeros() as usize;
+                m &= m - 1;
+                if Avx2Kernel.block_any(block, &p.woop(l), p.t_min.0[l], p.t_max.0[l]) {
+                    hits |= 1 << l;
+                }
+            }
+            hits
+        }
+    }
+
+    /// Active rays from which a block is tested with rays in lanes (one pass per triangle)
+    /// rather than ray by ray (one pass per ray).
+    const LANES_FOR_PACKET_TRIANGLES: u32 = 3;
+
+    /// `block_test` with lanes for rays: one triangle (lane `j` of the block) against eight rays
+    /// sharing the sheared frame's axes, the same operations in the same order. Returns the
+    /// rays hit within [t_min, t_max], the rays with an edge function of exactly zero (their
+    /// answer comes from the scalar kernel, as in `block_test`), and t.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_triangle(
+        block: &TriangleBlock,
+        j: usize,
+        p: &PacketRays,
+        [kx, ky, kz]: [usize; 3],
+        t_min: __m256,
+        t_max: __m256,
+    ) -> (__m256, __m256, __m256) {
+        let vertex = |corner: usize, axis: usize| _mm256_set1_ps(block.v[corner][axis][j]);
+        let (ox, oy, oz) = (
+            load(&p.origin[kx]),
+            load(&p.origin[ky]),
+            load(&p.origin[kz]),
+        );
+        let (sx, sy, sz) = (load(&p.shear[0]), load(&p.shear[1]), load(&p.shear[2]));
+        let shear = |corner: usize| {
+            let ax = _mm256_sub_ps(vertex(corner, kx), ox);
+            let ay = _mm256_sub_ps(vertex(corner, ky), oy);
+            let az = _mm256_sub_ps(vertex(corner, kz), oz);
+            (
+                _mm256_sub_ps(ax, _mm256_mul_ps(sx, az)),
+                _mm256_sub_ps(ay, _mm256_mul_ps(sy, az)),
+                az,
+            )
+        };
+        let (ax, ay, az) = shear(0);
+        let (bx, by, bz) = shear(1);
+        let (cx, cy, cz) = shear(2);
+        let u = _mm256_sub_ps(_mm256_mul_ps(cx, by), _mm256_mul_ps(cy, bx));
+        let v = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
+        let w_ = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
+        let zero = _mm256_setzero_ps();
+        let eq = |e: __m256| _mm256_cmp_ps::<_CMP_EQ_OQ>(e, zero);
+        let lt = |e: __m256| _mm256_cmp_ps::<_CMP_LT_OQ>(e, zero);
+        let gt = |e: __m256| _mm256_cmp_ps::<_CMP_GT_OQ>(e, zero);
+        let any_zero = _mm256_or_ps(_mm256_or_ps(eq(u), eq(v)), eq(w_));
+        let negative = _mm256_or_ps(_mm256_or_ps(lt(u), lt(v)), lt(w_));
+        let positive = _mm256_or_ps(_mm256_or_ps(gt(u), gt(v)), gt(w_));
+        let det = _mm256_add_ps(_mm256_add_ps(u, v), w_);
+        let valid = _mm256_andnot_ps(
+            _mm256_and_ps(negative, positive),
+            _mm256_cmp_ps::<_CMP_NEQ_OQ>(det, zero),
+        );
+        let t_scaled = _mm256_add_ps(
+            _mm256_add_ps(
+                _mm256_mul_ps(u, _mm256_mul_ps(sz, az)),
+                _mm256_mul_ps(v, _mm256_mul_ps(sz, bz)),
+            ),
+            _mm256_mul_ps(w_, _mm256_mul_ps(sz, cz)),
+        );
+        let t = _mm256_div_ps(t_scaled, det);
+        let in_window = _mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_GE_OQ>(t, t_min),
+            _mm256_cmp_ps::<_CMP_LE_OQ>(t, t_max),
+        );
+        (_mm256_and_ps(valid, in_window), any_zero, t)
+    }
+
+    /// `Avx2Kernel::block` for the rays of `lanes`, a triangle at a time with rays in lanes.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_block(
+        block: &TriangleBlock,
+        p: &PacketRays,
+        axes: [usize; 3],
+        lanes: u32,
+        t_max: &Lanes,
+        lane: &mut [u8; PACKET],
+        t: &mut Lanes,
+    ) -> u32 {
+        let (t_min_v, t_max_v) = (load(&p.t_min), load(t_max));
+        let mut best_t = _mm256_set1_ps(f32::INFINITY);
+        let mut best_lane = _mm256_setzero_ps();
+        let mut hit_any = _mm256_setzero_ps();
+        let mut zero_any = _mm256_setzero_ps();
+        for j in 0..BLOCK {
+            let (hit, zero, tj) = packet_triangle(block, j, p, axes, t_min_v, t_max_v);
+            // The lowest lane at the smallest t, as `Avx2Kernel::block` picks it.
+            let closer = _mm256_and_ps(hit, _mm256_cmp_ps::<_CMP_LT_OQ>(tj, best_t));
+            best_t = _mm256_blendv_ps(best_t, tj, closer);
+            best_lane = _mm256_blendv_ps(best_lane, _mm256_set1_ps(j as f32), closer);
+            hit_any = _mm256_or_ps(hit_any, hit);
+            zero_any = _mm256_or_ps(zero_any, zero);
+        }
+        let zero_rays = lanes & _mm256_movemask_ps(zero_any) as u32;
+        let mut hits = lanes & !zero_rays & _mm256_movemask_ps(hit_any) as u32;
+        let mut lanes_f = Lanes::INFINITY;
+        // SAFETY: `Lanes` is 8 f32, 32-byte aligned.
+        unsafe {
+            _mm256_store_ps(t.0.as_mut_ptr(), best_t);
+            _mm256_store_ps(lanes_f.0.as_mut_ptr(), best_lane);
+        }
+        let mut m = hits;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            lane[l] = lanes_f.0[l] as u8;
+        }
+        let mut m = zero_rays;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            if let Some((k, th)) = ScalarKernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l]) {
+                lane[l] = k as u8;
+                t.0[l] = th;
+                hits |= 1 << l;
+            }
+        }
+        hits
+    }
+
+    /// `Avx2Kernel::block_any` for the rays of `lanes` within their windows, with rays in lanes.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_block_any(
+        block: &TriangleBlock,
+        p: &PacketRays,
+        axes: [usize; 3],
+        lanes: u32,
+    ) -> u32 {
+        let (t_min_v, t_max_v) = (load(&p.t_min), load(&p.t_max));
+        let mut hit_any = _mm256_setzero_ps();
+        let mut zero_any = _mm256_setzero_ps();
+        for j in 0..BLOCK {
+            let (hit, zero, _) = packet_triangle(block, j, p, axes, t_min_v, t_max_v);
+            hit_any = _mm256_or_ps(hit_any, hit);
+            zero_any = _mm256_or_ps(zero_any, zero);
+        }
+        let zero_rays = lanes & _mm256_movemask_ps(zero_any) as u32;
+        let mut hits = lanes & !zero_rays & _mm256_movemask_ps(hit_any) as u32;
+        let mut m = zero_rays;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            if ScalarKernel.block_any(block, &p.woop(l), p.t_min.0[l], p.t_max.0[l]) {
+                hits |= 1 << l;
+            }
+        }
+        hits
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn load(v: &Lanes) -> __m256 {
+        // SAFETY: `Lanes` is 8 f32, 32-byte aligned.
+        unsafe { _mm256_load_ps(v.0.as_ptr()) }
+    }
+
+    /// All-ones in the lanes whose bit is set in `lanes`.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn lane_mask(lanes: u32) -> __m256 {
+        let bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+        let set = _mm256_and_si256(_mm256_set1_epi32(lanes as i32), bits);
+        _mm256_castsi256_ps(_mm256_cmpeq_epi32(set, bits))
+    }
+
+    /// `ScalarPacketKernel::candidates`: the packet's interval bounds against the eight child
+    /// boxes at once (lanes are children).
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_candidates(node: &WideNode, p: &PacketRays, lanes: u32, t_max: &Lanes) -> u32 {
+        let Some(iv) = &p.interval else {
+            return (1 << WIDTH) - 1;
+        };
+        // The largest t_max over `lanes`.
+        let v = _mm256_blendv_ps(
+            _mm256_set1_ps(f32::NEG_INFINITY),
+            load(t_max),
+            lane_mask(lanes),
+        );
+        let v = _mm256_max_ps(v, _mm256_permute2f128_ps::<1>(v, v));
+        let v = _mm256_max_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+        let t_max_hi = _mm256_max_ps(v, _mm256_permute_ps::<0b10_11_00_01>(v));
+        let plane = |row: usize| {
+            // SAFETY: each row is 8 f32 inside the 64-byte aligned node, so 32-byte aligned.
+            unsafe { _mm256_load_ps(node.bounds[row].as_ptr()) }
+        };
+        let mut t0 = _mm256_set1_ps(iv.t_min_lo);
+        let mut t1 = _mm256_set1_ps(f32::INFINITY);
+        for a in 0..3 {
+            let g_near = _mm256_sub_ps(plane(iv.near[a]), _mm256_set1_ps(iv.origin_near[a]));
+            let g_far = _mm256_sub_ps(plane(iv.far[a]), _mm256_set1_ps(iv.origin_far[a]));
+            let lo = _mm256_set1_ps(iv.inv_lo[a]);
+            let hi = _mm256_set1_ps(iv.inv_hi[a]);
+            let near = _mm256_min_ps(_mm256_mul_ps(g_near, lo), _mm256_mul_ps(g_near, hi));
+            let far = _mm256_max_ps(_mm256_mul_ps(g_far, lo), _mm256_mul_ps(g_far, hi));
+            t0 = _mm256_max_ps(near, t0);
+            t1 = _mm256_min_ps(far, t1);
+        }
+        let t1 = _mm256_min_ps(_mm256_mul_ps(t1, _mm256_set1_ps(FAR_SCALE)), t_max_hi);
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+    }
+
+    /// The single-ray kernel's slab test (`node_test`) of one child box for eight rays (lanes
+    /// are rays): the same operations in the same order, with each ray's near and far planes
+    /// chosen by the sign of its reciprocal direction.
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_child(
+        node: &WideNode,
+        slot: usize,
+        p: &PacketRays,
+        lanes: u32,
+        t_max: &Lanes,
+        entry: &mut Lanes,
+    ) -> u32 {
+        let bound = |row: usize| _mm256_set1_ps(node.bounds[row][slot]);
+        let axis = |a: usize| {
+            let o = load(&p.origin[a]);
+            let inv = load(&p.inv_dir[a]);
+            let lo = _mm256_mul_ps(_mm256_sub_ps(bound(a), o), inv);
+            let hi = _mm256_mul_ps(_mm256_sub_ps(bound(a + 3), o), inv);
+            // Negative direction (sign bit of 1/d): the max plane is near.
+            (_mm256_blendv_ps(lo, hi, inv), _mm256_blendv_ps(hi, lo, inv))
+        };
+        let (near_x, far_x) = axis(0);
+        let (near_y, far_y) = axis(1);
+        let (near_z, far_z) = axis(2);
+        let t0 = _mm256_max_ps(
+            near_z,
+            _mm256_max_ps(near_y, _mm256_max_ps(near_x, load(&p.t_min))),
+        );
+        let t1 = _mm256_min_ps(
+            far_z,
+            _mm256_min_ps(far_y, _mm256_min_ps(far_x, _mm256_set1_ps(f32::INFINITY))),
+        );
+        let t1 = _mm256_min_ps(_mm256_mul_ps(t1, _mm256_set1_ps(FAR_SCALE)), load(t_max));
+        let enter = _mm256_and_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1), lane_mask(lanes));
+        let out = _mm256_blendv_ps(_mm256_set1_ps(f32::INFINITY), t0, enter);
+        // SAFETY: `Lanes` is 8 f32, 32-byte aligned.
+        unsafe { _mm256_store_ps(entry.0.as_mut_ptr(), out) };
+        _mm256_movemask_ps(enter) as u32
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_not_beyond(lanes: u32, entry: &Lanes, t_max: &Lanes) -> u32 {
+        lanes & _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(load(entry), load(t_max))) as u32
+    }
+
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_min_lane(entry: &Lanes) -> f32 {
+        let v = load(entry);
+        let v = _mm256_min_ps(v, _mm256_permute2f128_ps::<1>(v, v));
+        let v = _mm256_min_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
+        let v = _mm256_min_ps(v, _mm256_permute_ps::<0b10_11_00_01>(v));
+        _mm256_cvtss_f32(v)
+    }
+}

@@ -1,0 +1,684 @@
+//! The 8-wide BVH: layout and traversal.
+//!
+//! **Nodes** are 256 bytes, four cache lines, aligned to 64: the eight child boxes stored
+//! structure-of-arrays (`bounds[plane][child]`, planes min x, min y, min z, max x, max y, max z),
+//! so one 8-lane SIMD operation tests one slab plane of all children; then the eight child
+//! references. After Embree's `AABBNode` (`kernels/bvh/bvh_node_aabb.h`). Unused slots hold an
+//! empty box (min +∞, max −∞), which no ray enters.
+//!
+//! **Child references** are `u32`: an inner node's index, or a leaf (top bit set) holding a
+//! range of up to 8 triangle blocks or up to 8 other shapes. See `ChildRef`.
+//!
+//! **Triangles** live in `TriangleBlock`s of four, vertices structure-of-arrays (144 bytes), so
+//! one SIMD pass tests a whole block with the watertight test of `triangle.rs`. A leaf's blocks
+//! are contiguous; lanes left over in a leaf's last block hold NaN vertices, which never hit.
+//! The primitive index of a triangle is `4 · block + lane`; other shapes (spheres, boxes) follow
+//! at `4 · blocks.len() + k`.
+//!
+//! **Traversal** is ordered: the children a ray enters are visited nearest first (one child:
+//! straight on; two: compare; more: sort), the others wait on a stack with their entry distance,
+//! and a popped entry further than the closest hit so far is dropped. `t_max` shrinks with each
+//! hit. The box and block tests are the `Kernel`: AVX2 in `simd.rs` when the CPU has it, the
+//! scalar `ScalarKernel` here otherwise. Both compute the same thing.
+
+use crate::accel::packet::{self, ArrayPacketStack, PacketRays, ScalarPacketKernel, PACKET};
+use crate::accel::triangle::{self, WoopRay};
+use crate::geometry::{Aabb, Shape};
+use crate::math::Vec3;
+use crate::ray::Ray;
+
+/// Children per node.
+pub const WIDTH: usize = 8;
+/// Triangles per block.
+pub const BLOCK: usize = 4;
+
+/// An 8-wide node (see the module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(64))]
+pub struct WideNode {
+    /// `bounds[plane][child]`: planes min x, min y, min z, max x, max y, max z.
+    pub bounds: [[f32; WIDTH]; 6],
+    pub children: [u32; WIDTH],
+    _pad: [u32; WIDTH],
+}
+
+const _: () = assert!(std::mem::size_of::<WideNode>() == 256);
+
+impl WideNode {
+    pub(crate) const EMPTY: WideNode = WideNode {
+        bounds: [
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+        ],
+        children: [ChildRef::EMPTY.0; WIDTH],
+        _pad: [0; WIDTH],
+    };
+
+    pub(crate) fn set_child(&mut self, slot: usize, child: ChildRef, bounds: &Aabb) {
+        for axis in 0..3 {
+            self.bounds[axis][slot] = bounds.min[axis];
+            self.bounds[axis + 3][slot] = bounds.max[axis];
+        }
+        self.children[slot] = child.0;
+    }
+
+    /// The union of the children's boxes.
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for slot in 0..WIDTH {
+            if self.children[slot] != ChildRef::EMPTY.0 {
+                b = b.union(Aabb {
+                    min: Vec3::new(
+                        self.bounds[0][slot],
+                        self.bounds[1][slot],
+                        self.bounds[2][slot],
+                    ),
+                    max: Vec3::new(
+                        self.bounds[3][slot],
+                        self.bounds[4][slot],
+                        self.bounds[5][slot],
+                    ),
+                });
+            }
+        }
+        b
+    }
+}
+
+/// Four triangles, `v[corner][axis][lane]`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C, align(16))]
+pub struct TriangleBlock {
+    pub v: [[[f32; BLOCK]; 3]; 3],
+}
+
+const _: () = assert!(std::mem::size_of::<TriangleBlock>() == 144);
+
+impl TriangleBlock {
+    /// A block whose lanes all miss (NaN vertices).
+    pub(crate) const EMPTY: TriangleBlock = TriangleBlock {
+        v: [[[f32::NAN; BLOCK]; 3]; 3],
+    };
+
+    pub(crate) fn set(&mut self, lane: usize, vertices: &[Vec3; 3]) {
+        for (corner, vertex) in vertices.iter().enumerate() {
+            for axis in 0..3 {
+                self.v[corner][axis][lane] = vertex[axis];
+            }
+        }
+    }
+
+    /// The corners of one lane.
+    #[inline]
+    pub fn triangle(&self, lane: usize) -> [[f32; 3]; 3] {
+        std::array::from_fn(|corner| std::array::from_fn(|axis| self.v[corner][axis][lane]))
+    }
+}
+
+/// A child reference: bit 31 clear, an inner node index; set, a leaf, with bit 30 telling
+/// triangle blocks (0) from shapes (1), bits 27-29 the count minus one (1 to 8 blocks or
+/// shapes) and bits 0-26 the first block or shape.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ChildRef(pub u32);
+
+impl ChildRef {
+    pub const EMPTY: ChildRef = ChildRef(u32::MAX);
+    const LEAF: u32 = 1 << 31;
+    const SHAPES: u32 = 1 << 30;
+    pub const MAX_START: u32 = (1 << 27) - 1;
+
+    pub fn node(index: u32) -> ChildRef {
+        debug_assert!(index < Self::LEAF);
+        ChildRef(index)
+    }
+    pub fn triangles(first_block: u32, blocks: u32) -> ChildRef {
+        debug_assert!((1..=8).contains(&blocks) && first_block <= Self::MAX_START);
+        ChildRef(Self::LEAF | ((blocks - 1) << 27) | first_block)
+    }
+    pub fn shapes(first: u32, count: u32) -> ChildRef {
+        debug_assert!((1..=8).contains(&count) && first <= Self::MAX_START);
+        ChildRef(Self::LEAF | Self::SHAPES | ((count - 1) << 27) | first)
+    }
+    #[inline(always)]
+    pub fn is_leaf(self) -> bool {
+        self.0 & Self::LEAF != 0
+    }
+    #[inline(always)]
+    pub fn is_shapes(self) -> bool {
+        self.0 & Self::SHAPES != 0
+    }
+    /// (first, count) of a leaf.
+    #[inline(always)]
+    pub fn range(self) -> (usize, usize) {
+        (
+            (self.0 & Self::MAX_START) as usize,
+            ((self.0 >> 27) & 7) as usize + 1,
+        )
+    }
+}
+
+/// Which kernel traverses: AVX2+FMA where the CPU has it, else scalar.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Isa {
+    Scalar,
+    Avx2,
+}
+
+impl Isa {
+    /// The best this CPU runs.
+    pub fn detect() -> Isa {
+        if crate::accel::simd::avx2_available() {
+            Isa::Avx2
+        } else {
+            Isa::Scalar
+        }
+    }
+}
+
+/// An 8-wide BVH over one geometry's shapes, with its triangles in blocks.
+#[derive(Clone, Debug)]
+pub struct WideBvh {
+    pub(crate) nodes: Vec<WideNode>,
+    pub(crate) root: ChildRef,
+    pub(crate) bounds: Aabb,
+    pub(crate) blocks: Vec<TriangleBlock>,
+    /// Spheres and boxes (anything but triangles), in leaf order.
+    pub(crate) shapes: Vec<Shape>,
+    /// For each primitive index (block lanes, then shapes), the index of the shape it came
+    /// from in the geometry as given; `u32::MAX` for an unused lane.
+    pub(crate) source: Vec<u32>,
+    pub(crate) isa: Isa,
+}
+
+/// The closest hit inside one bottom-level structure.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LocalHit {
+    pub t: f32,
+    pub primitive: u32,
+    pub b1: f32,
+    pub b2: f32,
+}
+
+impl WideBvh {
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+    pub fn nodes(&self) -> &[WideNode] {
+        &self.nodes
+    }
+    pub fn blocks(&self) -> &[TriangleBlock] {
+        &self.blocks
+    }
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+    /// Chooses the kernel (tests compare the scalar and SIMD kernels).
+    pub fn set_isa(&mut self, isa: Isa) {
+        self.isa = if isa == Isa::Avx2 && Isa::detect() != Isa::Avx2 {
+            Isa::Scalar
+        } else {
+            isa
+        };
+    }
+    /// Number of primitive slots (block lanes, padding included, then shapes).
+    pub fn primitive_slots(&self) -> usize {
+        self.blocks.len() * BLOCK + self.shapes.len()
+    }
+    /// The index in the geometry as given of primitive `primitive`.
+    pub fn source_index(&self, primitive: u32) -> u32 {
+        self.source[primitive as usize]
+    }
+    /// Primitive `primitive` as a shape.
+    pub fn shape(&self, primitive: u32) -> Shape {
+        let p = primitive as usize;
+        let lanes = self.blocks.len() * BLOCK;
+        if p < lanes {
+            let v = self.blocks[p / BLOCK].triangle(p % BLOCK);
+            Shape::Triangle {
+                vertices: v.map(Vec3::from_array),
+            }
+        } else {
+            self.shapes[p - lanes]
+        }
+    }
+    /// Bytes of nodes.
+    pub fn node_bytes(&self) -> usize {
+        self.nodes.len() * std::mem::size_of::<WideNode>()
+    }
+    /// Bytes of primitive data (blocks, shapes, source indices).
+    pub fn primitive_bytes(&self) -> usize {
+        self.blocks.len() * std::mem::size_of::<TriangleBlock>()
+            + self.shapes.len() * std::mem::size_of::<Shape>()
+            + self.source.len() * std::mem::size_of::<u32>()
+    }
+
+    /// The closest hit with t in `[ray.t_min, ray.t_max]`. Ties in t go to the primitive given
+    /// first, so the answer depends neither on the traversal order nor on the structure.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray) -> Option<LocalHit> {
+        if !ray_is_valid(ray) {
+            return None;
+        }
+        let (t, primitive) = match self.isa {
+            Isa::Avx2 => crate::accel::simd::closest(self, ray),
+            Isa::Scalar => closest(&ScalarKernel, self, ray, &mut ArrayStack::new()),
+        }?;
+        Some(self.finish(ray, t, primitive))
+    }
+
+    /// True when any primitive meets the ray with t in `[ray.t_min, ray.t_max]`.
+    #[inline]
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        if !ray_is_valid(ray) {
+            return false;
+        }
+        match self.isa {
+            Isa::Avx2 => crate::accel::simd::any(self, ray),
+            Isa::Scalar => any(&ScalarKernel, self, ray, &mut ArrayStack::new()),
+        }
+    }
+
+    /// Closest hits of the rays in `lanes` (bit l for `rays[l]`) traced together as a packet
+    /// (`packet.rs`): in each such lane exactly what `intersect` returns for that ray alone;
+    /// `None` in the other lanes. For coherent rays (camera rays of a pixel block).
+    #[inline]
+    pub fn intersect_packet(&self, rays: &[Ray; PACKET], lanes: u8) -> [Option<LocalHit>; PACKET] {
+        let p = PacketRays::new(rays, lanes);
+        let (t, prim) = match self.isa {
+            Isa::Avx2 => crate::accel::simd::packet_closest(self, &p),
+            Isa::Scalar => {
+                packet::closest(&ScalarPacketKernel, self, &p, &mut ArrayPacketStack::new())
+            }
+        };
+        std::array::from_fn(|l| {
+            (prim[l] != u32::MAX).then(|| self.finish_with(&rays[l], &p.woop(l), t.0[l], prim[l]))
+        })
+    }
+
+    /// The rays of `lanes` that `occluded` would report occluded, traced as a packet: bit l
+    /// set for `rays[l]`.
+    #[inline]
+    pub fn occluded_packet(&self, rays: &[Ray; PACKET], lanes: u8) -> u8 {
+        let p = PacketRays::new(rays, lanes);
+        (match self.isa {
+            Isa::Avx2 => crate::accel::simd::packet_any(self, &p),
+            Isa::Scalar => packet::any(&ScalarPacketKernel, self, &p, &mut ArrayPacketStack::new()),
+        }) as u8
+    }
+
+    /// Whether primitive `a` comes before `b` in the geometry as given (ties in t go to the
+    /// earlier one, so the answer does not depend on the structure; `b` may be `u32::MAX`).
+    #[inline]
+    pub(crate) fn earlier(&self, a: u32, b: u32) -> bool {
+        b == u32::MAX || self.source[a as usize] < self.source[b as usize]
+    }
+
+    /// Barycentrics for the winner only (traversal keeps t and the index).
+    fn finish(&self, ray: &Ray, t: f32, primitive: u32) -> LocalHit {
+        self.finish_with(ray, &WoopRay::new(ray.origin, ray.direction), t, primitive)
+    }
+
+    /// `finish` with the ray's watertight constants at hand.
+    #[inline]
+    fn finish_with(&self, ray: &Ray, woop: &WoopRay, t: f32, primitive: u32) -> LocalHit {
+        let p = primitive as usize;
+        let (mut b1, mut b2) = (0.0, 0.0);
+        if p < self.blocks.len() * BLOCK {
+            let v = self.blocks[p / BLOCK].triangle(p % BLOCK);
+            if let Some(h) = triangle::intersect(woop, v, t, t) {
+                (b1, b2) = (h.b1, h.b2);
+            }
+        } else if let Some(h) = self.shape(primitive).intersect(&Ray {
+            t_min: t,
+            t_max: t,
+            ..*ray
+        }) {
+            (b1, b2) = (h.b1, h.b2);
+        }
+        LocalHit {
+            t,
+            primitive,
+            b1,
+            b2,
+        }
+    }
+}
+
+/// Rays with NaN or infinite components, or an empty window, meet nothing.
+#[inline(always)]
+fn ray_is_valid(ray: &Ray) -> bool {
+    ray.origin.is_finite() && ray.direction.is_finite() && ray.t_min <= ray.t_max
+}
+
+/// The box and block tests of a traversal.
+pub(crate) trait Kernel {
+    /// Per-ray constants of the box test.
+    type BoxRay;
+    fn box_ray(&self, ray: &Ray) -> Self::BoxRay;
+    /// Tests the ray against a node's eight boxes within [t_min, t_max]: the bit mask of the
+    /// children entered, and each child's entry distance in `entry`.
+    fn node(
+        &self,
+        node: &WideNode,
+        ray: &Self::BoxRay,
+        t_max: f32,
+        entry: &mut [f32; WIDTH],
+    ) -> u32;
+    /// The lowest lane of the block meeting the ray at the smallest t in [t_min, t_max].
+    fn block(
+        &self,
+        block: &TriangleBlock,
+        ray: &WoopRay,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(usize, f32)>;
+    /// Whether any lane meets the ray within [t_min, t_max].
+    fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool;
+}
+
+/// The traversal stack: child references with their entry distances.
+pub(crate) trait Stack {
+    fn push(&mut self, child: u32, entry: f32);
+    fn pop(&mut self) -> Option<(u32, f32)>;
+}
+
+/// Entries a traversal stack needs: at most 7 per level, and the build caps the depth.
+pub(crate) const STACK_SIZE: usize = 7 * crate::accel::build::MAX_DEPTH + 8;
+
+/// A zero-initialised stack (the scalar path; the SIMD path keeps an uninitialised one).
+pub(crate) struct ArrayStack {
+    entries: [(u32, f32); STACK_SIZE],
+    len: usize,
+}
+
+impl ArrayStack {
+    pub(crate) fn new() -> Self {
+        ArrayStack {
+            entries: [(0, 0.0); STACK_SIZE],
+            len: 0,
+        }
+    }
+}
+
+impl Stack for ArrayStack {
+    #[inline(always)]
+    fn push(&mut self, child: u32, entry: f32) {
+        self.entries[self.len] = (child, entry);
+        self.len += 1;
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(u32, f32)> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        Some(self.entries[self.len])
+    }
+}
+
+/// Slab planes of the box test, chosen once per ray by the direction's signs.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BoxPlanes {
+    pub origin: [f32; 3],
+    pub inv_dir: [f32; 3],
+    /// Rows of `WideNode::bounds` holding the near and far plane of each axis.
+    pub near: [usize; 3],
+    pub far: [usize; 3],
+    pub t_min: f32,
+}
+
+/// Scale on the far distance of a box so that rounding in the slab test never culls a box the
+/// ray touches (after pbrt-v4's `1 + 2γ₃`; the binary BVH does the same).
+pub(crate) const FAR_SCALE: f32 = 1.0 + 8.0 * f32::EPSILON;
+
+impl BoxPlanes {
+    #[inline(always)]
+    pub fn new(ray: &Ray) -> BoxPlanes {
+        let d = ray.direction.to_array();
+        // A zero component gives an infinite reciprocal of the zero's sign; a ray lying in a
+        // slab plane then makes 0 · ∞ = NaN there, which the min/max order of the kernels
+        // ignores (the plane counts as inside, as it must for watertightness).
+        let inv_dir = d.map(|c| 1.0 / c);
+        let negative = d.map(|c| c.is_sign_negative());
+        let near = std::array::from_fn(|a| if negative[a] { a + 3 } else { a });
+        let far = std::array::from_fn(|a| if negative[a] { a } else { a + 3 });
+        BoxPlanes {
+            origin: ray.origin.to_array(),
+            inv_dir,
+            near,
+            far,
+            t_min: ray.t_min,
+        }
+    }
+}
+
+/// The portable kernel: the same arithmetic as the SIMD one, a lane at a time.
+pub(crate) struct ScalarKernel;
+
+impl Kernel for ScalarKernel {
+    type BoxRay = BoxPlanes;
+
+    #[inline(always)]
+    fn box_ray(&self, ray: &Ray) -> BoxPlanes {
+        BoxPlanes::new(ray)
+    }
+
+    #[inline(always)]
+    fn node(&self, node: &WideNode, r: &BoxPlanes, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
+        let mut mask = 0;
+        for (i, entry) in entry.iter_mut().enumerate() {
+            let mut t0 = r.t_min;
+            let mut t1 = f32::INFINITY;
+            for a in 0..3 {
+                let near = (node.bounds[r.near[a]][i] - r.origin[a]) * r.inv_dir[a];
+                let far = (node.bounds[r.far[a]][i] - r.origin[a]) * r.inv_dir[a];
+                t0 = if near > t0 { near } else { t0 };
+                t1 = if far < t1 { far } else { t1 };
+            }
+            t1 *= FAR_SCALE;
+            let t1 = if t_max < t1 { t_max } else { t1 };
+            *entry = t0;
+            if t0 <= t1 {
+                mask |= 1 << i;
+            }
+        }
+        mask
+    }
+
+    #[inline(always)]
+    fn block(
+        &self,
+        block: &TriangleBlock,
+        ray: &WoopRay,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(usize, f32)> {
+        let mut best: Option<(usize, f32)> = None;
+        for lane in 0..BLOCK {
+            if let Some(h) = triangle::intersect(ray, block.triangle(lane), t_min, t_max) {
+                match best {
+                    Some((_, t)) if t <= h.t => {}
+                    _ => best = Some((lane, h.t)),
+                }
+            }
+        }
+        best
+    }
+
+    #[inline(always)]
+    fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool {
+        (0..BLOCK)
+            .any(|lane| triangle::intersect(ray, block.triangle(lane), t_min, t_max).is_some())
+    }
+}
+
+/// Closest hit: (t, primitive index). Generic over the kernel and the stack so that the SIMD
+/// module instantiates it inside its `avx2` functions.
+#[inline(always)]
+pub(crate) fn closest<K: Kernel, S: Stack>(
+    kernel: &K,
+    bvh: &WideBvh,
+    ray: &Ray,
+    stack: &mut S,
+) -> Option<(f32, u32)> {
+    let box_ray = kernel.box_ray(ray);
+    let woop = WoopRay::new(ray.origin, ray.direction);
+    let lanes = (bvh.blocks.len() * BLOCK) as u32;
+    let mut best_t = ray.t_max;
+    let mut best_prim = u32::MAX;
+    let mut entry = [0.0f32; WIDTH];
+    let mut current = bvh.root;
+    loop {
+        if !current.is_leaf() {
+            let node = &bvh.nodes[current.0 as usize];
+            let mask = kernel.node(node, &box_ray, best_t, &mut entry);
+            if let Some(next) = choose(mask, node, &entry, stack) {
+                current = next;
+                continue;
+            }
+        } else if current != ChildRef::EMPTY {
+            let (first, count) = current.range();
+            if !current.is_shapes() {
+                for b in first..first + count {
+                    if let Some((lane, t)) = kernel.block(&bvh.blocks[b], &woop, ray.t_min, best_t)
+                    {
+                        let prim = (b * BLOCK + lane) as u32;
+                        if t < best_t || (t == best_t && bvh.earlier(prim, best_prim)) {
+                            best_t = t;
+                            best_prim = prim;
+                        }
+                    }
+                }
+            } else {
+                for s in first..first + count {
+                    let window = Ray {
+                        t_max: best_t,
+                        ..*ray
+                    };
+                    if let Some(h) = bvh.shapes[s].intersect(&window) {
+                        let prim = lanes + s as u32;
+                        if h.t < best_t || (h.t == best_t && bvh.earlier(prim, best_prim)) {
+                            best_t = h.t;
+                            best_prim = prim;
+                        }
+                    }
+                }
+            }
+        }
+        // Next entry that can still hold something nearer than the closest hit.
+        loop {
+            match stack.pop() {
+                None => return (best_prim != u32::MAX).then_some((best_t, best_prim)),
+                Some((child, t_entry)) => {
+                    if t_entry <= best_t {
+                        current = ChildRef(child);
+                        break;
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The child to visit next, the other entered children pushed farthest first.
+#[inline(always)]
+fn choose<S: Stack>(
+    mask: u32,
+    node: &WideNode,
+    entry: &[f32; WIDTH],
+    stack: &mut S,
+) -> Option<ChildRef> {
+    if mask == 0 {
+        return None;
+    }
+    let i0 = mask.trailing_zeros() as usize;
+    let rest = mask & (mask - 1);
+    if rest == 0 {
+        return Some(ChildRef(node.children[i0]));
+    }
+    let i1 = rest.trailing_zeros() as usize;
+    let rest = rest & (rest - 1);
+    if rest == 0 {
+        let (near, far) = if entry[i0] <= entry[i1] {
+            (i0, i1)
+        } else {
+            (i1, i0)
+        };
+        stack.push(node.children[far], entry[far]);
+        return Some(ChildRef(node.children[near]));
+    }
+    // Three or more: sort by entry distance, nearest last, push all but the nearest.
+    let mut sorted = [(0u32, 0.0f32); WIDTH];
+    let mut n = 0;
+    let mut m = mask;
+    while m != 0 {
+        let i = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let item = (node.children[i], entry[i]);
+        let mut k = n;
+        while k > 0 && sorted[k - 1].1 < item.1 {
+            sorted[k] = sorted[k - 1];
+            k -= 1;
+        }
+        sorted[k] = item;
+        n += 1;
+    }
+    for &(child, t) in &sorted[..n - 1] {
+        stack.push(child, t);
+    }
+    Some(ChildRef(sorted[n - 1].0))
+}
+
+/// Any hit within the ray's window (shadow rays): no ordering, the first hit ends the walk.
+#[inline(always)]
+pub(crate) fn any<K: Kernel, S: Stack>(
+    kernel: &K,
+    bvh: &WideBvh,
+    ray: &Ray,
+    stack: &mut S,
+) -> bool {
+    let box_ray = kernel.box_ray(ray);
+    let woop = WoopRay::new(ray.origin, ray.direction);
+    let mut entry = [0.0f32; WIDTH];
+    let mut current = bvh.root;
+    loop {
+        if !current.is_leaf() {
+            let node = &bvh.nodes[current.0 as usize];
+            let mut mask = kernel.node(node, &box_ray, ray.t_max, &mut entry);
+            if mask != 0 {
+                let first = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    stack.push(node.children[i], 0.0);
+                }
+                current = ChildRef(node.children[first]);
+                continue;
+            }
+        } else if current != ChildRef::EMPTY {
+            let (first, count) = current.range();
+            if !current.is_shapes() {
+                for b in first..first + count {
+                    if kernel.block_any(&bvh.blocks[b], &woop, ray.t_min, ray.t_max) {
+                        return true;
+                    }
+                }
+            } else {
+                for s in first..first + count {
+                    if bvh.shapes[s].intersect(ray).is_some() {
+                        return true;
+                    }
+                }
+            }
+        }
+        match stack.pop() {
+            None => return false,
+            Some((child, _)) => current = ChildRef(child),
+        }
+    }
+}

@@ -1,0 +1,155 @@
+//! Watertightness: a ray through a shared edge or vertex of a closed mesh meets exactly one
+//! triangle there (it neither slips through the crack nor counts the surface twice), for the
+//! triangle test alone and for the wide BVH's closest hit with both kernels.
+
+mod accel_common;
+
+use accel_common::*;
+use glint_render::{Ray, Vec3};
+
+/// From outside a convex closed mesh towards `target` on its surface: the ray enters there and
+/// leaves elsewhere, so exactly two triangles are met, and the closest hit is at t = 1.
+fn check_through(
+    tris: &[Tri],
+    wides: &[glint_render::accel::WideBvh],
+    origin: Vec3,
+    target: Vec3,
+    what: &str,
+) {
+    let ray = Ray::new(origin, target - origin);
+    assert_eq!(count_hits(tris, &ray), 2, "{what}: {ray:?}");
+    // Just the entry: exactly one triangle in a thin window around t = 1.
+    let entry = Ray {
+        t_min: 0.999,
+        t_max: 1.001,
+        ..ray
+    };
+    assert_eq!(count_hits(tris, &entry), 1, "{what} (entry): {ray:?}");
+    for wide in wides {
+        let hit = wide
+            .intersect(&ray)
+            .unwrap_or_else(|| panic!("{:?} missed, {what}: {ray:?}", wide.isa()));
+        assert!(
+            (hit.t - 1.0).abs() < 1e-4,
+            "{:?} {what}: t = {}",
+            wide.isa(),
+            hit.t
+        );
+        assert!(wide.occluded(&ray));
+    }
+}
+
+#[test]
+fn rays_through_icosphere_vertices_and_edges() {
+    let tris = icosphere(3, 1.0);
+    let wides = wide_variants(&shapes_of(&tris));
+    let mut r = rng(31);
+    let mut checked = 0;
+    for (k, tri) in tris.iter().enumerate().step_by(3) {
+        let [a, b, _] = tri.map(Vec3::from_array);
+        for (target, what) in [
+            (a, "vertex"),
+            ((a + b) * 0.5, "edge midpoint"),
+            (a + (b - a) * 0.25, "edge point"),
+        ] {
+            // From outside, within 60 degrees of the outward normal (the sphere's radius).
+            let normal = target.normalized();
+            let mut offset = random_unit(&mut r);
+            if offset.dot(normal) < 0.5 {
+                offset = (normal * 2.0 + offset).normalized();
+            }
+            let origin = target + offset * uniform(&mut r, 0.5, 3.0);
+            check_through(
+                &tris,
+                &wides,
+                origin,
+                target,
+                &format!("triangle {k} {what}"),
+            );
+            checked += 1;
+        }
+    }
+    assert!(checked > 1000);
+}
+
+#[test]
+fn axis_rays_exactly_through_grid_edges_and_vertices() {
+    // Vertices and edges of the grid lie on exact binary fractions and the rays run along the
+    // axes, so the edge functions there are exactly zero: the f64 check and the tie rule decide.
+    let n = 8;
+    let tris = grid_cube(n);
+    let wides = wide_variants(&shapes_of(&tris));
+    let step = 2.0 / n as f32;
+    let mut checked = 0;
+    for axis in 0..3 {
+        for i in 1..n {
+            for j in 1..2 * n {
+                // j odd: the middle of an edge of the grid; j even: a grid vertex.
+                let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+                let mut p = [0.0f32; 3];
+                p[u] = -1.0 + step * i as f32;
+                p[v] = -1.0 + 0.5 * step * j as f32;
+                for (side, sign) in [(1.0f32, 1.0f32), (-1.0, -1.0)] {
+                    let mut target = p;
+                    target[axis] = side;
+                    let mut origin = target;
+                    origin[axis] = side + sign * 3.0;
+                    check_through(
+                        &tris,
+                        &wides,
+                        Vec3::from_array(origin),
+                        Vec3::from_array(target),
+                        "grid",
+                    );
+                    // And along the diagonal of the squares (the shared hypotenuse).
+                    checked += 1;
+                }
+            }
+        }
+    }
+    // Rays in general directions through the square diagonals (edges shared inside a face).
+    for i in 0..n {
+        for j in 0..n {
+            let t = 0.375;
+            let target = Vec3::new(
+                -1.0 + step * (i as f32 + t),
+                -1.0 + step * (j as f32 + t),
+                1.0,
+            );
+            for d in [Vec3::new(0.3, -0.2, -1.0), Vec3::new(-0.7, 0.6, -1.0)] {
+                check_through(&tris, &wides, target - d * 2.0, target, "diagonal");
+                checked += 1;
+            }
+        }
+    }
+    assert!(checked > 300);
+}
+
+#[test]
+fn camera_rays_never_leak_through_a_closed_mesh() {
+    // Dense coherent rays at a finely tessellated sphere: every ray whose line passes well
+    // inside the sphere must hit.
+    let tris = icosphere(4, 1.0);
+    let wides = wide_variants(&shapes_of(&tris));
+    let origin = Vec3::new(0.1, 0.2, 4.0);
+    let size = 256;
+    for wide in &wides {
+        let mut misses = 0;
+        for y in 0..size {
+            for x in 0..size {
+                let d = Vec3::new(
+                    -0.3 + 0.6 * (x as f32 + 0.5) / size as f32,
+                    -0.3 + 0.6 * (y as f32 + 0.5) / size as f32,
+                    -1.0,
+                );
+                let ray = Ray::new(origin, d);
+                // Distance of the line from the centre, against the inscribed radius of the mesh.
+                let closest = origin - d * (origin.dot(d) / d.dot(d));
+                if closest.length() < 0.98 && wide.intersect(&ray).is_none() {
+                    misses += 1;
+                }
+            }
+        }
+        assert_eq!(misses, 0, "{:?}", wide.isa());
+    }
+}
