@@ -77,6 +77,8 @@ pub enum Command {
         #[command(flatten)]
         options: Options,
     },
+    /// Measure the ray engine: `glint bench table`, `glint bench rays`, `glint bench make-rays`.
+    Bench(crate::bench::BenchArgs),
 }
 
 /// Options shared by both forms.
@@ -123,7 +125,9 @@ pub struct Options {
     #[arg(long, value_name = "N", default_value_t = 0)]
     pub seed: u64,
 
-    /// The course's ray tracer, or a debug view of the normal at the first hit, (n + 1) / 2.
+    /// `course`: the course's ray tracer. `path`: the physically based path tracer (exactly
+    /// RPP samples per pixel; an .exr output also gets `albedo` and `normal` layers).
+    /// `normals`: a debug view of the normal at the first hit, (n + 1) / 2.
     #[arg(long, visible_alias = "shader", value_name = "NAME", value_enum,
           default_value_t = IntegratorArg::Course)]
     pub integrator: IntegratorArg,
@@ -160,6 +164,7 @@ const COURSE_NO_EFFECT: &str = "Course options accepted for its scripts, with no
 pub enum IntegratorArg {
     // No doc comments on the variants: clap would then list them one per line.
     Course,
+    Path,
     Normals,
 }
 
@@ -168,6 +173,7 @@ impl From<IntegratorArg> for IntegratorKind {
         match arg {
             IntegratorArg::Course => IntegratorKind::Course,
             IntegratorArg::Normals => IntegratorKind::Normals,
+            IntegratorArg::Path => IntegratorKind::Path,
         }
     }
 }
@@ -251,15 +257,15 @@ pub struct Job {
     pub notes: Vec<String>,
 }
 
-/// Output formats by extension, lower case. `glint_io::write_image` decides by the same rule;
-/// checking here turns a typo into an immediate usage error instead of one after the render.
-
 impl Cli {
     /// Resolves the arguments into a `Job`. `available_threads` is the default for `-n`.
     pub fn into_job(self, available_threads: usize) -> Result<Job, UsageError> {
         let (scene, options) =
             match self.command {
                 Some(Command::Render { scene, options }) => (scene, options),
+                Some(Command::Bench(_)) => {
+                    return Err(UsageError("`glint bench` is not a render".to_string()))
+                }
                 None => match self.input {
                     Some(scene) if !scene.as_os_str().is_empty() => (scene, self.options),
                     _ => return Err(UsageError(
@@ -309,7 +315,8 @@ impl Options {
             ..RenderSettings::default()
         };
         let grid = settings.grid_size();
-        if grid * grid != self.rpp {
+        // The path tracer takes exactly RPP samples; the course's grid takes N².
+        if settings.integrator != IntegratorKind::Path && grid * grid != self.rpp {
             notes.push(format!(
                 "-r {} is not a perfect square: using a {grid}x{grid} grid, {} rays per pixel",
                 self.rpp,
@@ -341,6 +348,8 @@ fn default_output(scene: &Path) -> Result<PathBuf, UsageError> {
     }
 }
 
+/// Asks glint-io, which decides the format by the extension, before rendering: a typo becomes
+/// an immediate usage error instead of one after the render.
 fn check_output_extension(output: &Path) -> Result<(), UsageError> {
     glint_io::output_format(output).map(|_| ()).map_err(|_| {
         UsageError(format!(

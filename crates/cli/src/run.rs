@@ -199,17 +199,22 @@ pub fn run(
 
     let settings = &job.settings;
     if job.verbose {
-        let grid = settings.grid_size();
+        let depth = match settings.integrator {
+            IntegratorKind::Path => format!(
+                "path depth {} (roulette from {})",
+                settings.path.max_depth, settings.path.russian_roulette_depth
+            ),
+            _ => format!("depth {}", settings.max_depth),
+        };
         let _ = writeln!(
             err,
-            "loaded {} in {:.2} s\nrendering {}x{}, {} rays per pixel ({grid}x{grid}), depth {}, \
-             seed {}, {} integrator, {} -> {}",
+            "loaded {} in {:.2} s\nrendering {}x{}, {} samples per pixel, {depth}, seed {}, {} \
+             integrator, {} -> {}",
             job.scene.display(),
             load_time.as_secs_f64(),
             settings.width,
             settings.height,
-            grid * grid,
-            settings.max_depth,
+            settings.samples_per_pixel(),
             settings.seed,
             integrator_name(settings.integrator),
             threads_text(job.threads),
@@ -227,14 +232,20 @@ pub fn run(
     };
     interrupt.set_phase(Phase::Rendering);
     let render_start = Instant::now();
-    let result = pool.install(|| glint_render::render(&scene, settings, &progress));
+    // The path tracer also returns albedo and normal layers, which an EXR output keeps.
+    let result = pool.install(|| match settings.integrator {
+        IntegratorKind::Path => glint_render::render_with_aovs(&scene, settings, &progress)
+            .map(|(output, stats)| (output.beauty, Some((output.albedo, output.normal)), stats)),
+        _ => glint_render::render(&scene, settings, &progress)
+            .map(|(film, stats)| (film, None, stats)),
+    });
     let render_time = render_start.elapsed();
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
     // From here on Ctrl-C no longer stops anything; one that came in before is honoured.
     interrupt.set_phase(Phase::Writing);
-    let (film, stats) = match result {
+    let (film, feature_layers, stats) = match result {
         Ok(rendered) if !interrupt.requested() => rendered,
         _ => return Err(Failure::Interrupted),
     };
@@ -257,7 +268,17 @@ pub fn run(
         );
     }
 
-    glint_io::write_image(&job.output, &film).map_err(Failure::Write)?;
+    let write = match (&feature_layers, glint_io::output_format(&job.output)) {
+        (Some((albedo, normal)), Ok(glint_io::OutputFormat::Exr)) => {
+            glint_io::write_image_with_layers(
+                &job.output,
+                &film,
+                &[("albedo", albedo), ("normal", normal)],
+            )
+        }
+        _ => glint_io::write_image(&job.output, &film),
+    };
+    write.map_err(Failure::Write)?;
 
     let _ = writeln!(err, "{}", closing_line(job, &stats, render_time));
     Ok(Summary {
@@ -283,7 +304,6 @@ fn new_progress_bar(width: u32, height: u32) -> ProgressBar {
 /// `rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png`
 pub fn closing_line(job: &Job, stats: &RenderStats, render_time: Duration) -> String {
     let settings = &job.settings;
-    let grid = settings.grid_size();
     let seconds = render_time.as_secs_f64();
     let rate = if seconds > 0.0 {
         stats.rays as f64 / seconds
@@ -294,7 +314,7 @@ pub fn closing_line(job: &Job, stats: &RenderStats, render_time: Duration) -> St
         "rendered {}x{}, {} rpp in {seconds:.2} s: {} rays, {} rays/s, {} -> {}",
         settings.width,
         settings.height,
-        grid * grid,
+        settings.samples_per_pixel(),
         si(stats.rays as f64),
         si(rate),
         threads_text(job.threads),

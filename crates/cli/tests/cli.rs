@@ -333,6 +333,51 @@ fn exr_output_is_linear_float() {
     );
 }
 
+/// `--integrator path` with an .exr output writes the beauty as R, G, B and the denoiser
+/// features as `albedo.*` and `normal.*` channels; the sphere's albedo is its Lambertian
+/// colour and its centre normal faces the camera.
+#[test]
+fn path_tracer_exr_has_albedo_and_normal_layers() {
+    let dir = scene_dir();
+    let output = glint_in(
+        dir.path(),
+        &[
+            "render",
+            "scene.xml",
+            "--integrator",
+            "path",
+            "--spp",
+            "8",
+            "-o",
+            "out.exr",
+            "-w",
+            "9",
+            "-h",
+            "7",
+        ],
+    );
+    assert_exit(&output, 0);
+    assert!(stderr(&output).contains(" 8 rpp"), "{}", stderr(&output));
+    let image = exr::prelude::read_all_flat_layers_from_file(dir.path().join("out.exr")).unwrap();
+    let layer = &image.layer_data[0];
+    let channel = |name: &str| -> Vec<f32> {
+        let channel = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.to_string() == name)
+            .unwrap_or_else(|| panic!("no channel {name}"));
+        channel.sample_data.values_as_f32().collect()
+    };
+    let centre = 3 * 9 + 4;
+    // The test scene's sphere is Lambertian (0, 0, 1).
+    assert_eq!(channel("albedo.B")[centre], 1.0);
+    assert_eq!(channel("albedo.R")[centre], 0.0);
+    assert!(channel("normal.B")[centre] > 0.99);
+    assert!(channel("B")[centre] > 0.0);
+    assert_eq!(channel("R").len(), 9 * 7);
+}
+
 #[test]
 fn normals_shader_shows_the_normal_facing_the_camera() {
     let dir = scene_dir();

@@ -133,9 +133,17 @@ pub enum ImageWriteError {
     Encode {
         path: PathBuf,
         #[source]
-        source: image::ImageError,
+        source: EncodeError,
     },
+    #[error(
+        "cannot write {}: feature layers (albedo, normal) need an .exr output",
+        path.display()
+    )]
+    LayersNeedExr { path: PathBuf },
 }
+
+/// An encoder's own error.
+pub type EncodeError = Box<dyn std::error::Error + Send + Sync>;
 
 /// The image formats `write_image` writes, chosen by the file name's extension.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -170,14 +178,36 @@ pub fn output_format(path: &Path) -> Result<OutputFormat, ImageWriteError> {
 /// Writes the film to `path`: `.png` as 8-bit RGB with the course's conversion (clamp,
 /// floor(c·255), no gamma: `Film::to_rgb8_course`), `.exr` as linear RGB f32.
 pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
+    write_image_with_layers(path, film, &[])
+}
+
+/// Writes `film` as `write_image` does, plus named feature layers (a path tracer's `albedo`
+/// and `normal`, what denoisers take) as channels `NAME.R`, `NAME.G`, `NAME.B` of the same
+/// EXR. Layers need an `.exr` name: asking for them with another format is an error rather
+/// than a silent loss.
+pub fn write_image_with_layers(
+    path: &Path,
+    film: &Film,
+    layers: &[(&str, &Film)],
+) -> Result<(), ImageWriteError> {
     let format = output_format(path)?;
-    let expected_pixels = film.width as usize * film.height as usize;
-    if film.pixels.len() != expected_pixels || expected_pixels == 0 {
-        return Err(ImageWriteError::InvalidFilm {
+    for candidate in std::iter::once(film).chain(layers.iter().map(|(_, layer)| *layer)) {
+        let expected_pixels = film.width as usize * film.height as usize;
+        if candidate.pixels.len() != expected_pixels
+            || expected_pixels == 0
+            || (candidate.width, candidate.height) != (film.width, film.height)
+        {
+            return Err(ImageWriteError::InvalidFilm {
+                path: path.to_path_buf(),
+                width: candidate.width,
+                height: candidate.height,
+                pixels: candidate.pixels.len(),
+            });
+        }
+    }
+    if format != OutputFormat::Exr && !layers.is_empty() {
+        return Err(ImageWriteError::LayersNeedExr {
             path: path.to_path_buf(),
-            width: film.width,
-            height: film.height,
-            pixels: film.pixels.len(),
         });
     }
     let io_error = |source: std::io::Error| ImageWriteError::Io {
@@ -195,7 +225,11 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
         .map_err(io_error)?;
     {
         let mut writer = BufWriter::new(temporary.as_file_mut());
-        encode(format, film, &mut writer).map_err(|source| ImageWriteError::Encode {
+        match format {
+            OutputFormat::Png => encode_png(film, &mut writer),
+            OutputFormat::Exr => encode_exr(film, layers, &mut writer),
+        }
+        .map_err(|source| ImageWriteError::Encode {
             path: path.to_path_buf(),
             source,
         })?;
@@ -210,28 +244,54 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
     Ok(())
 }
 
-fn encode(
-    format: OutputFormat,
+fn encode_png(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), EncodeError> {
+    let buffer = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8_course())
+        .ok_or("film size does not match its pixels")?;
+    buffer.write_to(writer, image::ImageFormat::Png)?;
+    Ok(())
+}
+
+/// One EXR part with f32 channels R, G, B (the beauty) and `NAME.R/G/B` for each layer,
+/// rows from the top, as the `exr` crate stores them.
+fn encode_exr(
     film: &Film,
+    layers: &[(&str, &Film)],
     writer: &mut BufWriter<&mut File>,
-) -> Result<(), image::ImageError> {
-    let dimension_error = || {
-        image::ImageError::Parameter(image::error::ParameterError::from_kind(
-            image::error::ParameterErrorKind::DimensionMismatch,
-        ))
+) -> Result<(), EncodeError> {
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Encoding, FlatSamples, Image as ExrImage, Layer, LayerAttributes,
+        WritableImage,
     };
-    match format {
-        OutputFormat::Png => {
-            let buffer = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8_course())
-                .ok_or_else(dimension_error)?;
-            buffer.write_to(writer, image::ImageFormat::Png)
-        }
-        OutputFormat::Exr => {
-            let buffer = image::Rgb32FImage::from_raw(film.width, film.height, film.to_rgb_f32())
-                .ok_or_else(dimension_error)?;
-            buffer.write_to(writer, image::ImageFormat::OpenExr)
+    let channel = |name: String, film: &Film, component: usize| {
+        AnyChannel::new(
+            name.as_str(),
+            FlatSamples::F32(
+                film.pixels
+                    .iter()
+                    .map(|p| p.to_array()[component])
+                    .collect(),
+            ),
+        )
+    };
+    let mut channels = smallvec::SmallVec::new();
+    for (prefix, source) in std::iter::once(("", film)).chain(layers.iter().copied()) {
+        for (component, suffix) in ["R", "G", "B"].into_iter().enumerate() {
+            let name = if prefix.is_empty() {
+                suffix.to_owned()
+            } else {
+                format!("{prefix}.{suffix}")
+            };
+            channels.push(channel(name, source, component));
         }
     }
+    let layer = Layer::new(
+        (film.width as usize, film.height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(channels),
+    );
+    ExrImage::from_layer(layer).write().to_buffered(writer)?;
+    Ok(())
 }
 
 /// Temporary files are created private (0600); the output should get the permissions of the file

@@ -29,7 +29,10 @@ mod desc;
 mod diagnostic;
 mod image_io;
 mod json;
+mod mesh;
 mod obj;
+mod ply;
+mod rays;
 mod read;
 mod tree;
 mod values;
@@ -38,7 +41,11 @@ mod xml;
 use std::path::Path;
 
 pub use diagnostic::{Diagnostic, SceneError, Severity};
-pub use image_io::{output_format, write_image, ImageWriteError, OutputFormat};
+pub use image_io::{
+    output_format, write_image, write_image_with_layers, EncodeError, ImageWriteError, OutputFormat,
+};
+pub use mesh::{load_mesh, Mesh, MeshError};
+pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
 
 use diagnostic::Diagnostics;
 use read::Format;
