@@ -250,9 +250,12 @@ impl Packets {
             out.lanes.push(lanes);
             out.index.push(index);
         };
-        match width.filter(|&w| w > 0 && rays.len() % w as usize == 0) {
+        // A whole number of rows of `width` (rust-version 1.80: no `is_multiple_of`).
+        let rows = width
+            .map(|w| w as usize)
+            .filter(|&w| w > 0 && rays.len() / w * w == rays.len());
+        match rows {
             Some(w) => {
-                let w = w as usize;
                 let h = rays.len() / w;
                 for by in (0..h).step_by(2) {
                     for bx in (0..w).step_by(4) {
@@ -683,7 +686,7 @@ fn packets_compare(args: &PacketsArgs) -> Result<(), String> {
         args.size, args.size, threads, rounds
     );
     println!(
-        "{:<24} {:<8} {:>8} {:>8} {:>8} {:>6} {:>9}",
+        "{:<30} {:<8} {:>8} {:>8} {:>8} {:>6} {:>9}",
         "workload", "rays", "count", "single", "packets", "ratio", "identical"
     );
     for path in &meshes {
@@ -692,7 +695,7 @@ fn packets_compare(args: &PacketsArgs) -> Result<(), String> {
             .map(|n| n.to_string_lossy().into_owned())
             .unwrap_or_default();
         if !path.exists() {
-            println!("{name:<24} (missing: {})", path.display());
+            println!("{name:<30} (missing: {})", path.display());
             continue;
         }
         let case = load_case(path)?;
@@ -733,7 +736,7 @@ fn packets_compare(args: &PacketsArgs) -> Result<(), String> {
             let rate = |s: &[f64]| rays.len() as f64 / median(s.to_vec()) / 1e6;
             let (a, b) = (rate(&single[k]), rate(&packet[k]));
             println!(
-                "{:<24} {:<8} {:>8} {:>8.2} {:>8.2} {:>6.2} {:>9}",
+                "{:<30} {:<8} {:>8} {:>8.2} {:>8.2} {:>6.2} {:>9}",
                 name,
                 set,
                 rays.len(),

@@ -1,7 +1,7 @@
 //! Criterion benches of the ray engine (issue 3): BVH build, and closest-hit and shadow-ray
 //! throughput on the Stanford bunny for coherent camera rays and incoherent bounce rays, with
-//! the 8-wide BVH's AVX2 kernel, its scalar kernel, and the reference binary BVH; and a small
-//! whole-frame render. `cargo bench -p glint-render --bench accel`.
+//! the 8-wide BVH's AVX2 kernel, its scalar kernel, and the reference binary BVH, and camera
+//! and shadow rays in packets of eight; and a small whole-frame render. `cargo bench -p glint-render --bench accel`.
 //!
 //! The whole-program table over all workloads is `glint bench table`; the comparison with
 //! Embree is `bench/embree_compare.sh`.
@@ -11,7 +11,7 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glint_render::accel::workload;
-use glint_render::accel::{Isa, WideBvh};
+use glint_render::accel::{Isa, WideBvh, PACKET};
 use glint_render::scene::AccelKind;
 use glint_render::{Ray, RenderSettings, Scene, SceneParts, Shape};
 
@@ -89,7 +89,55 @@ fn traverse(c: &mut Criterion) {
     group.bench_with_input(BenchmarkId::new("binary", "shadow"), &shadow, |b, rays| {
         b.iter(|| rays.iter().filter(|r| binary.occluded(r)).count())
     });
+    // Packets of eight (`Scene::intersect_packet`): camera rays of 4x2 pixel blocks, shadow
+    // rays eight consecutive at a time.
+    let blocks = pixel_blocks(&primary, 256);
+    group.throughput(Throughput::Elements(primary.len() as u64));
+    group.bench_with_input(
+        BenchmarkId::new("wide-avx2-packets", "primary"),
+        &blocks,
+        |b, packets| {
+            b.iter(|| {
+                packets
+                    .iter()
+                    .map(|p| wide.intersect_packet(p).iter().flatten().count())
+                    .sum::<usize>()
+            })
+        },
+    );
+    let shadow_packets: Vec<[Ray; PACKET]> = shadow
+        .chunks_exact(PACKET)
+        .map(|c| std::array::from_fn(|l| c[l]))
+        .collect();
+    group.throughput(Throughput::Elements((shadow_packets.len() * PACKET) as u64));
+    group.bench_with_input(
+        BenchmarkId::new("wide-avx2-packets", "shadow"),
+        &shadow_packets,
+        |b, packets| {
+            b.iter(|| {
+                packets
+                    .iter()
+                    .map(|p| wide.occluded_packet(p).iter().filter(|&&o| o).count())
+                    .sum::<usize>()
+            })
+        },
+    );
     group.finish();
+}
+
+/// Rays of a `width`-pixel-wide image (row by row) regrouped into 4x2 pixel blocks.
+fn pixel_blocks(rays: &[Ray], width: usize) -> Vec<[Ray; PACKET]> {
+    let height = rays.len() / width;
+    let mut packets = Vec::new();
+    for by in (0..height).step_by(2) {
+        for bx in (0..width).step_by(4) {
+            packets.push(std::array::from_fn(|l| {
+                let (x, y) = ((bx + l % 4).min(width - 1), (by + l / 4).min(height - 1));
+                rays[y * width + x]
+            }));
+        }
+    }
+    packets
 }
 
 fn frame(c: &mut Criterion) {

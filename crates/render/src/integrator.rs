@@ -5,7 +5,7 @@ use crate::material::Material;
 use crate::math::{Basis, Color, Vec3};
 use crate::ray::Ray;
 use crate::sampling::{mix64, sample_cosine_hemisphere, sample_uniform_sphere, Rng};
-use crate::scene::{Scene, SurfaceInteraction};
+use crate::scene::{Hit, Scene, SurfaceInteraction};
 use crate::texture::ColorSource;
 
 /// Per-sample state handed to an integrator: the sample's random stream and where the sample
@@ -86,6 +86,25 @@ pub fn permute(mut i: u32, n: u32, seed: u32) -> u32 {
 /// Computes the radiance arriving along a camera ray.
 pub trait Integrator: Sync {
     fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color;
+
+    /// Whether `radiance_from_hit` uses the first hit it is given; the render loop then traces
+    /// camera rays in packets of 4x2 pixels (`Scene::intersect_lanes`) and hands each hit over.
+    fn takes_first_hit(&self) -> bool {
+        false
+    }
+
+    /// `radiance` when the camera ray's first intersection, `first` = `scene.intersect(ray)`,
+    /// is already known. Must return exactly what `radiance` returns.
+    fn radiance_from_hit(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        first: Option<Hit>,
+        ctx: &mut SampleContext,
+    ) -> Color {
+        let _ = first;
+        self.radiance(scene, ray, ctx)
+    }
 }
 
 /// Mirror reflection of direction `d` about unit normal `n`: r = d − 2(d·n)n (slide001 p.105).
@@ -250,6 +269,20 @@ impl Integrator for CourseIntegrator {
     fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color {
         ray_color(scene, ray, 0, true, ctx)
     }
+
+    fn takes_first_hit(&self) -> bool {
+        true
+    }
+
+    fn radiance_from_hit(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        first: Option<Hit>,
+        ctx: &mut SampleContext,
+    ) -> Color {
+        shade(scene, ray, first, 0, true, ctx)
+    }
 }
 
 /// `count_emission` is false on Diffuse bounce rays: emitters were already sampled directly
@@ -261,7 +294,19 @@ fn ray_color(
     count_emission: bool,
     ctx: &mut SampleContext,
 ) -> Color {
-    let Some(hit) = scene.intersect(ray) else {
+    shade(scene, ray, scene.intersect(ray), depth, count_emission, ctx)
+}
+
+/// `ray_color` with the ray's closest hit (`scene.intersect(ray)`) given.
+fn shade(
+    scene: &Scene,
+    ray: &Ray,
+    hit: Option<Hit>,
+    depth: u32,
+    count_emission: bool,
+    ctx: &mut SampleContext,
+) -> Color {
+    let Some(hit) = hit else {
         return scene.background_radiance(ray.direction);
     };
     let si = scene.surface(ray, &hit);

@@ -5,10 +5,12 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
+use crate::accel::PACKET;
 use crate::film::Film;
 use crate::integrator::{CourseIntegrator, Integrator, NormalsIntegrator, SampleContext};
 use crate::math::Color;
 use crate::path::PathSettings;
+use crate::ray::Ray;
 use crate::sampling::Rng;
 use crate::scene::Scene;
 
@@ -217,9 +219,8 @@ fn render_with<I: Integrator>(
         let pixel_index = y as u64 * width as u64 + x as u64;
         // The lecture's j counts rows from the bottom; film row 0 is the top.
         let j = height - 1 - y;
-        let mut sum = Color::ZERO;
-        let mut valid = 0u32;
-        for s in 0..samples {
+        // Sample `s`: its camera ray and context.
+        let camera_sample = |s: u32| {
             let mut rng = Rng::for_sample(settings.seed, pixel_index, s as u64);
             let (p, q) = (s % grid, s / grid);
             // Pixel centre with one sample (FORMAT.md 4.4); jittered grid otherwise.
@@ -234,7 +235,7 @@ fn render_with<I: Integrator>(
             let ray = scene
                 .camera
                 .ray(x as f32 + ox, j as f32 + oy, width, height, aspect);
-            let mut ctx = SampleContext {
+            let ctx = SampleContext {
                 rng,
                 sample_index: s,
                 grid_size: grid,
@@ -242,13 +243,41 @@ fn render_with<I: Integrator>(
                 max_depth: settings.max_depth,
                 rays: 1,
             };
-            let c = integrator.radiance(scene, &ray, &mut ctx);
+            (ray, ctx)
+        };
+        let mut sum = Color::ZERO;
+        let mut valid = 0u32;
+        let mut add = |c: Color, ctx: &SampleContext, counters: &mut TileCounters| {
             counters.rays += ctx.rays;
             if c.has_nan() {
                 counters.dropped_sample(pixel_index);
             } else {
                 sum += c;
                 valid += 1;
+            }
+        };
+        if integrator.takes_first_hit() && samples >= PACKET as u32 {
+            // The pixel's camera rays travel in packets of eight (`Scene::intersect_lanes`);
+            // samples are still shaded and summed in order, so the pixel is the same. (Fewer
+            // than eight samples, 1 or 4, go ray by ray: half-empty packets did not pay.)
+            for first in (0..samples).step_by(PACKET) {
+                let count = (samples - first).min(PACKET as u32) as usize;
+                let mut taken: [Option<(Ray, SampleContext)>; PACKET] = Default::default();
+                for (l, t) in taken.iter_mut().enumerate().take(count) {
+                    *t = Some(camera_sample(first + l as u32));
+                }
+                let rays = std::array::from_fn(|l| taken[l.min(count - 1)].as_ref().unwrap().0);
+                let hits = scene.intersect_lanes(&rays, ((1u32 << count) - 1) as u8);
+                for (l, (ray, mut ctx)) in taken.into_iter().flatten().enumerate() {
+                    let c = integrator.radiance_from_hit(scene, &ray, hits[l], &mut ctx);
+                    add(c, &ctx, counters);
+                }
+            }
+        } else {
+            for s in 0..samples {
+                let (ray, mut ctx) = camera_sample(s);
+                let c = integrator.radiance(scene, &ray, &mut ctx);
+                add(c, &ctx, counters);
             }
         }
         if valid > 0 {

@@ -61,6 +61,9 @@ pub struct SceneParts {
 pub(crate) struct Geometry {
     pub blas: Blas,
     pub materials: Materials,
+    /// The unit geometric normal of each triangle by primitive index (`Shape::normal`,
+    /// computed once at build rather than at every hit); zero for other primitives.
+    pub normals: Vec<Vec3>,
 }
 
 /// A bottom-level structure: the wide BVH, or the reference binary BVH over the shapes.
@@ -116,16 +119,21 @@ impl Geometry {
             AccelKind::Wide => {
                 let bvh = crate::accel::build::build(&desc.shapes);
                 let materials = Materials::new(&desc.materials, &bvh.source);
+                let normals = (0..bvh.primitive_slots() as u32)
+                    .map(|p| triangle_normal(&bvh.shape(p)))
+                    .collect();
                 Geometry {
                     blas: Blas::Wide(bvh),
                     materials,
+                    normals,
                 }
             }
             AccelKind::Binary => {
                 let bounds: Vec<Aabb> = desc.shapes.iter().map(Shape::bounds).collect();
                 let (bvh, order) = Bvh::build(&bounds);
-                let shapes = order.iter().map(|&i| desc.shapes[i as usize]).collect();
+                let shapes: Vec<Shape> = order.iter().map(|&i| desc.shapes[i as usize]).collect();
                 let materials = Materials::new(&desc.materials, &order);
+                let normals = shapes.iter().map(triangle_normal).collect();
                 Geometry {
                     blas: Blas::Binary {
                         bvh,
@@ -133,6 +141,7 @@ impl Geometry {
                         source: order,
                     },
                     materials,
+                    normals,
                 }
             }
         }
@@ -177,6 +186,32 @@ impl Geometry {
                 });
                 best
             }
+        }
+    }
+
+    /// `intersect` without the barycentrics: (t, primitive).
+    #[inline]
+    fn intersect_preliminary(&self, ray: &Ray) -> Option<(f32, u32)> {
+        match &self.blas {
+            Blas::Wide(bvh) => bvh.intersect_preliminary(ray),
+            Blas::Binary { .. } => self.intersect(ray).map(|h| (h.t, h.primitive)),
+        }
+    }
+
+    /// The barycentrics `intersect` reports for its hit (t, primitive) of `ray`.
+    fn barycentrics(&self, ray: &Ray, t: f32, primitive: u32) -> (f32, f32) {
+        match &self.blas {
+            Blas::Wide(bvh) => {
+                let h = bvh.finish(ray, t, primitive);
+                (h.b1, h.b2)
+            }
+            Blas::Binary { shapes, .. } => shapes[primitive as usize]
+                .intersect(&Ray {
+                    t_min: t,
+                    t_max: t,
+                    ..*ray
+                })
+                .map_or((0.0, 0.0), |h| (h.b1, h.b2)),
         }
     }
 
@@ -289,6 +324,17 @@ pub struct Hit {
     pub primitive: u32,
     pub b1: f32,
     pub b2: f32,
+}
+
+/// What traversal alone finds: the closest hit without its barycentrics (Mitsuba 3's
+/// `PreliminaryIntersection`), for callers that need them only at some hits, such as the path
+/// tracer at untextured surfaces. `Scene::complete` turns it into the `Hit` that `intersect`
+/// returns.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PreliminaryHit {
+    pub t: f32,
+    pub instance: u32,
+    pub primitive: u32,
 }
 
 /// Shading data at the closest hit.
@@ -439,6 +485,55 @@ impl Scene {
             }
         });
         best
+    }
+
+    /// `intersect` without the barycentrics (the same t, instance and primitive).
+    #[inline]
+    pub fn intersect_preliminary(&self, ray: &Ray) -> Option<PreliminaryHit> {
+        if self.instances.len() == 1 {
+            let inst = &self.instances[0];
+            let local = Scene::object_ray(inst, ray, ray.t_max);
+            return self.geometries[inst.geometry as usize]
+                .intersect_preliminary(&local)
+                .map(|(t, primitive)| PreliminaryHit {
+                    t,
+                    instance: 0,
+                    primitive,
+                });
+        }
+        let mut best: Option<PreliminaryHit> = None;
+        self.tlas.traverse(ray, |inst_index, t_limit| {
+            let inst = &self.instances[inst_index as usize];
+            let local = Scene::object_ray(inst, ray, t_limit);
+            match self.geometries[inst.geometry as usize].intersect_preliminary(&local) {
+                Some((t, primitive)) => {
+                    best = Some(PreliminaryHit {
+                        t,
+                        instance: inst_index,
+                        primitive,
+                    });
+                    t
+                }
+                None => t_limit,
+            }
+        });
+        best
+    }
+
+    /// The `Hit` that `intersect(ray)` returns, from the `PreliminaryHit` that
+    /// `intersect_preliminary(ray)` returned.
+    pub fn complete(&self, ray: &Ray, hit: &PreliminaryHit) -> Hit {
+        let inst = &self.instances[hit.instance as usize];
+        let local = Scene::object_ray(inst, ray, ray.t_max);
+        let (b1, b2) =
+            self.geometries[inst.geometry as usize].barycentrics(&local, hit.t, hit.primitive);
+        Hit {
+            t: hit.t,
+            instance: hit.instance,
+            primitive: hit.primitive,
+            b1,
+            b2,
+        }
     }
 
     /// True when anything blocks the ray within its window (shadow rays). Instances that do not
@@ -615,21 +710,63 @@ impl Scene {
             b2: hit.b2,
         };
         let point = ray.at(hit.t);
-        let (local_point, normal) = match &inst.transform {
-            Some(xf) => {
-                let lp = xf.point_to_object(point);
-                let n = shape.normal(lp, &prim_hit);
-                (lp, xf.normal_to_world(n).normalized())
-            }
-            None => (point, shape.normal(point, &prim_hit)),
+        let local_point = match &inst.transform {
+            Some(xf) => xf.point_to_object(point),
+            None => point,
         };
-        let uv = shape.uv(local_point, &prim_hit);
-        let material = inst.material.unwrap_or(geom.materials.get(hit.primitive));
         SurfaceInteraction {
             point,
-            normal,
-            uv,
-            material,
+            normal: self.normal_at(inst, geom, hit.primitive, local_point),
+            uv: shape.uv(local_point, &prim_hit),
+            material: inst.material.unwrap_or(geom.materials.get(hit.primitive)),
+        }
+    }
+
+    /// `surface` for a preliminary hit, without texture coordinates: `uv` is (0, 0) (ask
+    /// `complete` and `surface` where a texture needs them). Everything else is as `surface`
+    /// computes it.
+    #[inline]
+    pub fn surface_without_uv(&self, ray: &Ray, hit: &PreliminaryHit) -> SurfaceInteraction {
+        let inst = &self.instances[hit.instance as usize];
+        let geom = &self.geometries[inst.geometry as usize];
+        let point = ray.at(hit.t);
+        let local_point = match &inst.transform {
+            Some(xf) => xf.point_to_object(point),
+            None => point,
+        };
+        SurfaceInteraction {
+            point,
+            normal: self.normal_at(inst, geom, hit.primitive, local_point),
+            uv: (0.0, 0.0),
+            material: inst.material.unwrap_or(geom.materials.get(hit.primitive)),
+        }
+    }
+
+    /// The world-space unit geometric normal of a primitive at `local_point` (object space).
+    #[inline]
+    fn normal_at(
+        &self,
+        inst: &Instance,
+        geom: &Geometry,
+        primitive: u32,
+        local_point: Vec3,
+    ) -> Vec3 {
+        let stored = geom.normals[primitive as usize];
+        let n = if stored != Vec3::ZERO {
+            stored
+        } else {
+            // Spheres and boxes (their normal depends on the point; the hit's t and
+            // barycentrics do not enter it).
+            let unused = PrimitiveHit {
+                t: 0.0,
+                b1: 0.0,
+                b2: 0.0,
+            };
+            geom.shape(primitive).normal(local_point, &unused)
+        };
+        match &inst.transform {
+            Some(xf) => xf.normal_to_world(n).normalized(),
+            None => n,
         }
     }
 
@@ -639,6 +776,17 @@ impl Scene {
             Background::Color(c) => *c,
             Background::CubeMap(map) => map.lookup(direction),
         }
+    }
+}
+
+/// A triangle's unit geometric normal as `Shape::normal` computes it; zero for other shapes
+/// (and for a degenerate triangle, whose normal is zero there too).
+fn triangle_normal(shape: &Shape) -> Vec3 {
+    match shape {
+        Shape::Triangle {
+            vertices: [a, b, c],
+        } => (*b - *a).cross(*c - *a).normalized(),
+        _ => Vec3::ZERO,
     }
 }
 

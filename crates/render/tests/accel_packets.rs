@@ -70,8 +70,8 @@ fn jittered_packets(r: &mut Rng, bounds: Aabb, count: usize) -> Vec<Packet> {
             let spread = [1e-4, 1e-2, 0.1][k % 3];
             let packet = std::array::from_fn(|_| {
                 let mut ray = base;
-                ray.origin = ray.origin + random_unit(r) * (spread * size);
-                ray.direction = ray.direction + random_unit(r) * (spread * ray.direction.length());
+                ray.origin += random_unit(r) * (spread * size);
+                ray.direction += random_unit(r) * (spread * ray.direction.length());
                 ray
             });
             (packet, ALL_LANES)

@@ -1,32 +1,40 @@
-//! Packet traversal of the 8-wide BVH: eight coherent rays (camera rays of a 4x2 pixel block)
-//! walk the tree together, as the lecture suggests for coherent rays and as Embree's hybrid
-//! intersectors do (`kernels/bvh/bvh_intersector_hybrid.cpp`).
+//! Packet traversal of the 8-wide BVH: eight coherent rays (camera rays of a pixel block, or the
+//! samples of one pixel) walk the tree together, as the lecture suggests for coherent rays and
+//! as Embree's hybrid intersectors do (`kernels/bvh/bvh_intersector_hybrid.cpp`). Every ray gets
+//! exactly its single-ray answer, bit for bit.
 //!
 //! **Lanes are rays.** At an inner node the packet first asks which of the eight children *any*
-//! of its rays can enter, in one 8-lane pass of interval arithmetic over the packet (the boxes of
-//! its origins and of its reciprocal directions, when all rays share direction signs; Wald et
-//! al., "Ray tracing deformable scenes using dynamic bounding volume hierarchies", 2007, and
-//! Reshetov's MLRTA inverse frusta). Only those children get the exact test: each ray of the
-//! packet against one child box in one 8-lane pass, with *the same arithmetic as the single-ray
-//! kernel* (same slab planes, same min/max order, same `FAR_SCALE`), so a ray enters exactly the
-//! boxes it would enter alone. Entered children are visited nearest first by the smallest entry
-//! distance over the packet; each waits on the stack with the mask of rays that entered it and
-//! their entry distances, and a popped entry re-activates only the rays whose closest hit so far
-//! is not nearer than their entry (per-ray culling, as in single-ray traversal).
+//! of its rays can enter, in one 8-lane pass (lanes are children) of interval arithmetic over
+//! the packet: the boxes of its origins and of its reciprocal directions, which bound every ray's
+//! slab distances because rounding is monotone (the frustum and interval tests of packet BVH
+//! tracers, e.g. Wald, Boulos and Shirley 2007). Only those children get the exact test: the
+//! packet against one child box in one 8-lane pass, with *the single-ray kernel's arithmetic*
+//! (same slab planes, same min/max order, same `FAR_SCALE`), so a ray enters exactly the boxes it
+//! would enter alone. Entered children are visited nearest first by the smallest entry distance
+//! over the packet; each waits on the stack with the mask of rays that entered it and their entry
+//! distances, and a popped entry re-activates only the rays whose closest hit so far is not
+//! nearer than their entry (per-ray culling, as in single-ray traversal).
 //!
-//! **Leaves** test each active ray against each 4-triangle block with the single-ray block test
-//! of the kernel (the watertight test of `triangle.rs`, zero edges resolved the same way), and
-//! merge with the same tie rule, so each ray's closest hit is exactly its single-ray closest
-//! hit: the hit with the smallest (t, source index), whatever the order of the walk.
+//! **Leaves** test each active ray against each 4-triangle block with the single-ray watertight
+//! test (`triangle.rs`): in the AVX2 kernel one triangle per pass with rays in lanes when the
+//! rays share the sheared frame's axes, the same operations lane by lane, with rays that meet a
+//! zero edge function sent to the scalar test as single rays are. Hits merge with the same tie
+//! rule, so each ray's closest hit is the hit with the smallest (t, source index), whatever the
+//! order of the walk. The winners' barycentrics are computed in one pass too (`finish` ray by
+//! ray otherwise).
 //!
-//! **Scalar fallback.** `ScalarPacketKernel` here does the same tests one lane at a time; the
+//! **Incoherent packets** (rays whose direction signs differ, so no interval bounds) go ray by
+//! ray with the single-ray traversal, which costs less than testing each child exactly for the
+//! packet; the packet traversal would answer them identically (tested).
+//!
+//! **Scalar fallback.** `ScalarPacketKernel` here does the same tests one ray at a time; the
 //! AVX2 kernel lives in `simd.rs` (the one module with `unsafe`). The traversal below is generic
 //! over both, like `wide::closest`.
 
 use crate::accel::triangle::WoopRay;
 use crate::accel::wide::{
-    BoxPlanes, ChildRef, Kernel, ScalarKernel, TriangleBlock, WideBvh, WideNode, BLOCK, FAR_SCALE,
-    STACK_SIZE, WIDTH,
+    self, ArrayStack, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, TriangleBlock, WideBvh,
+    WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
 };
 use crate::ray::Ray;
 
@@ -91,7 +99,10 @@ pub(crate) fn ray_is_valid(ray: &Ray) -> bool {
 }
 
 impl<'a> PacketRays<'a> {
+    /// Written lane by lane in plain loops, which the compiler turns into 8-lane code inside
+    /// the AVX2 functions of `simd.rs` (the reciprocals are then a few vector divisions).
     #[inline(always)]
+    #[allow(clippy::needless_range_loop)] // Lane-indexed loops over several arrays at once.
     pub fn new(rays: &'a [Ray; PACKET], lanes: u8) -> PacketRays<'a> {
         let mut valid = 0u32;
         for (l, ray) in rays.iter().enumerate() {
@@ -99,17 +110,6 @@ impl<'a> PacketRays<'a> {
                 valid |= 1 << l;
             }
         }
-        // Lanes outside `valid` take a valid lane's ray (never reported: every mask of the
-        // traversal is within `valid`), so no lane computes with NaN, and bounds over all
-        // eight lanes are bounds over the valid ones.
-        let fill = valid.trailing_zeros() as usize % PACKET;
-        let lane_ray = |l: usize| {
-            if valid & (1 << l) != 0 {
-                &rays[l]
-            } else {
-                &rays[fill]
-            }
-        };
         let mut p = PacketRays {
             origin: [Lanes::INFINITY; 3],
             inv_dir: [Lanes::INFINITY; 3],
@@ -125,24 +125,61 @@ impl<'a> PacketRays<'a> {
         if valid == 0 {
             return p;
         }
+        // Lanes outside `valid` take a valid lane's ray (never reported: every mask of the
+        // traversal is within `valid`), so no lane computes with NaN, and bounds over all
+        // eight lanes are bounds over the valid ones.
+        let fill = valid.trailing_zeros() as usize;
+        let mut dir = [[0.0f32; PACKET]; 3];
         for l in 0..PACKET {
-            let ray = lane_ray(l);
-            let o = ray.origin.to_array();
-            let d = ray.direction.to_array();
+            let ray = if valid & (1 << l) != 0 {
+                &rays[l]
+            } else {
+                &rays[fill]
+            };
             for a in 0..3 {
-                p.origin[a].0[l] = o[a];
-                // As `BoxPlanes::new`: 1/±0 = ±∞, the sign of 1/d is the sign of d.
-                p.inv_dir[a].0[l] = 1.0 / d[a];
+                p.origin[a].0[l] = ray.origin[a];
+                dir[a][l] = ray.direction[a];
             }
             p.t_min.0[l] = ray.t_min;
             p.t_max.0[l] = ray.t_max;
-            let w = WoopRay::new(ray.origin, ray.direction);
-            p.axes[0][l] = w.kx as u8;
-            p.axes[1][l] = w.ky as u8;
-            p.axes[2][l] = w.kz as u8;
-            p.shear[0].0[l] = w.sx;
-            p.shear[1].0[l] = w.sy;
-            p.shear[2].0[l] = w.sz;
+        }
+        for a in 0..3 {
+            for l in 0..PACKET {
+                // As `BoxPlanes::new`: 1/±0 = ±∞, and the sign of 1/d is the sign of d.
+                p.inv_dir[a].0[l] = 1.0 / dir[a][l];
+            }
+        }
+        // `WoopRay::new`, lane by lane.
+        let mut d_kz = [0.0f32; PACKET];
+        let mut d_kx = [0.0f32; PACKET];
+        let mut d_ky = [0.0f32; PACKET];
+        for l in 0..PACKET {
+            let d = [dir[0][l], dir[1][l], dir[2][l]];
+            let a = d.map(f32::abs);
+            let kz = if a[0] >= a[1] && a[0] >= a[2] {
+                0
+            } else if a[1] >= a[2] {
+                1
+            } else {
+                2
+            };
+            let mut kx = if kz == 2 { 0 } else { kz + 1 };
+            let mut ky = if kx == 2 { 0 } else { kx + 1 };
+            if d[kz] < 0.0 {
+                std::mem::swap(&mut kx, &mut ky);
+            }
+            p.axes[0][l] = kx as u8;
+            p.axes[1][l] = ky as u8;
+            p.axes[2][l] = kz as u8;
+            d_kx[l] = d[kx];
+            d_ky[l] = d[ky];
+            d_kz[l] = d[kz];
+        }
+        for l in 0..PACKET {
+            let sz = 1.0 / d_kz[l];
+            p.shear[0].0[l] = d_kx[l] * sz;
+            p.shear[1].0[l] = d_ky[l] * sz;
+            p.shear[2].0[l] = sz;
         }
         let same = |v: &[u8; PACKET]| v.iter().all(|&x| x == v[0]);
         if p.axes.iter().all(same) {
@@ -182,9 +219,17 @@ impl<'a> PacketRays<'a> {
 }
 
 /// The packet's interval bounds, or `None` where signs differ or a reciprocal is infinite.
+#[inline(always)]
 fn interval(origin: &[Lanes; 3], inv_dir: &[Lanes; 3], t_min: &Lanes) -> Option<Interval> {
-    let lo = |v: &Lanes| v.0.iter().copied().fold(f32::INFINITY, f32::min);
-    let hi = |v: &Lanes| v.0.iter().copied().fold(f32::NEG_INFINITY, f32::max);
+    // No NaN here: valid rays have finite origins and t_min, and 1/d is never NaN.
+    let lo = |v: &Lanes| {
+        v.0.iter()
+            .fold(f32::INFINITY, |m, &x| if x < m { x } else { m })
+    };
+    let hi = |v: &Lanes| {
+        v.0.iter()
+            .fold(f32::NEG_INFINITY, |m, &x| if x > m { x } else { m })
+    };
     let mut positive = [false; 3];
     for a in 0..3 {
         let (l, h) = (lo(&inv_dir[a]), hi(&inv_dir[a]));
@@ -254,6 +299,21 @@ pub(crate) trait PacketKernel {
     ) -> u32;
     /// The rays of `lanes` that meet any triangle of the block within their window.
     fn block_any(&self, block: &TriangleBlock, p: &PacketRays, lanes: u32) -> u32;
+    /// The kernel's single-ray closest hit, (t, primitive) (`wide::closest`).
+    fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)>;
+    /// The kernel's single-ray any hit (`wide::any`).
+    fn single_any(&self, bvh: &WideBvh, ray: &Ray) -> bool;
+    /// The barycentrics `WideBvh::finish` reports, for the rays whose closest hit `prim` is a
+    /// triangle, where the kernel computes them for all rays at once: returns the rays done
+    /// (the others go through `finish` one by one).
+    fn barycentrics(
+        &self,
+        bvh: &WideBvh,
+        p: &PacketRays,
+        prim: &[u32; PACKET],
+        b1: &mut Lanes,
+        b2: &mut Lanes,
+    ) -> u32;
 }
 
 /// The packet traversal stack: child, mask of rays that entered it, their entry distances.
@@ -417,6 +477,28 @@ impl PacketKernel for ScalarPacketKernel {
         }
         hits
     }
+
+    #[inline(always)]
+    fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
+        wide::closest(&ScalarKernel, bvh, ray, &mut ArrayStack::new())
+    }
+
+    #[inline(always)]
+    fn single_any(&self, bvh: &WideBvh, ray: &Ray) -> bool {
+        wide::any(&ScalarKernel, bvh, ray, &mut ArrayStack::new())
+    }
+
+    #[inline(always)]
+    fn barycentrics(
+        &self,
+        _: &WideBvh,
+        _: &PacketRays,
+        _: &[u32; PACKET],
+        _: &mut Lanes,
+        _: &mut Lanes,
+    ) -> u32 {
+        0
+    }
 }
 
 /// The largest value over `lanes` (−∞ for none).
@@ -429,6 +511,68 @@ pub(crate) fn max_over(lanes: u32, v: &Lanes) -> f32 {
         }
     }
     hi
+}
+
+/// `WideBvh::intersect_packet`: the packet's constants, its closest hits, and barycentrics for
+/// each ray's winner.
+#[inline(always)]
+pub(crate) fn intersect<K: PacketKernel, S: PacketStack>(
+    kernel: &K,
+    bvh: &WideBvh,
+    rays: &[Ray; PACKET],
+    lanes: u8,
+    stack: &mut S,
+) -> [Option<LocalHit>; PACKET] {
+    let p = PacketRays::new(rays, lanes);
+    if p.interval.is_none() {
+        // Not coherent (direction signs differ): ray by ray, which costs less than testing
+        // each child of each node exactly for the packet (as Embree's hybrid traversal does).
+        let mut out = [None; PACKET];
+        for (l, out) in out.iter_mut().enumerate() {
+            if p.valid & (1 << l) != 0 {
+                *out = kernel
+                    .single_closest(bvh, &rays[l])
+                    .map(|(t, prim)| bvh.finish_with(&rays[l], &p.woop(l), t, prim));
+            }
+        }
+        return out;
+    }
+    let (t, prim) = closest(kernel, bvh, &p, stack);
+    let (mut b1, mut b2) = (Lanes::INFINITY, Lanes::INFINITY);
+    let done = kernel.barycentrics(bvh, &p, &prim, &mut b1, &mut b2);
+    let mut out = [None; PACKET];
+    for (l, out) in out.iter_mut().enumerate() {
+        if done & (1 << l) != 0 {
+            *out = Some(LocalHit {
+                t: t.0[l],
+                primitive: prim[l],
+                b1: b1.0[l],
+                b2: b2.0[l],
+            });
+        } else if prim[l] != u32::MAX {
+            *out = Some(bvh.finish_with(&rays[l], &p.woop(l), t.0[l], prim[l]));
+        }
+    }
+    out
+}
+
+/// `WideBvh::occluded_packet`: the packet's constants and its occluded rays.
+#[inline(always)]
+pub(crate) fn occluded<K: PacketKernel, S: PacketStack>(
+    kernel: &K,
+    bvh: &WideBvh,
+    rays: &[Ray; PACKET],
+    lanes: u8,
+    stack: &mut S,
+) -> u8 {
+    let p = PacketRays::new(rays, lanes);
+    if p.interval.is_none() {
+        // Not coherent: ray by ray, as in `intersect`.
+        return (0..PACKET)
+            .filter(|&l| p.valid & (1 << l) != 0 && kernel.single_any(bvh, &rays[l]))
+            .fold(0, |m, l| m | 1 << l);
+    }
+    any(kernel, bvh, &p, stack) as u8
 }
 
 /// Closest hits of the packet's valid rays: per lane (t, primitive), primitive `u32::MAX` for
@@ -630,5 +774,86 @@ pub(crate) fn any<K: PacketKernel, S: PacketStack>(
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Shape;
+    use crate::math::Vec3;
+    use crate::sampling::Rng;
+
+    /// `intersect` and `occluded` hand packets whose direction signs differ to single rays; the
+    /// packet traversal itself still answers them exactly as single rays do, with both kernels.
+    #[test]
+    fn incoherent_packets_through_the_packet_traversal() {
+        let mut r = Rng::new(3, 7);
+        let mut u = |lo: f32, hi: f32| lo + (hi - lo) * r.next_f32();
+        let shapes: Vec<Shape> = (0..600)
+            .map(|k| {
+                let c = Vec3::new(u(-4.0, 4.0), u(-4.0, 4.0), u(-4.0, 4.0));
+                let e = |u: &mut dyn FnMut(f32, f32) -> f32| {
+                    Vec3::new(u(-0.6, 0.6), u(-0.6, 0.6), u(-0.6, 0.6))
+                };
+                if k % 50 == 0 {
+                    Shape::Sphere {
+                        center: c,
+                        radius: 0.4,
+                    }
+                } else {
+                    Shape::Triangle {
+                        vertices: [c, c + e(&mut u), c + e(&mut u)],
+                    }
+                }
+            })
+            .collect();
+        let bvh = crate::accel::build::build(&shapes);
+        let mut hits = 0;
+        for k in 0..400 {
+            let rays: [Ray; PACKET] = std::array::from_fn(|l| {
+                let o = Vec3::new(u(-6.0, 6.0), u(-6.0, 6.0), u(-6.0, 6.0));
+                let mut d = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+                if (k + l) % 9 == 0 {
+                    d = Vec3::new(0.0, -0.0, 1.0);
+                }
+                let mut ray = Ray::new(o, d);
+                if l % 3 == 0 {
+                    ray.t_min = u(0.0, 1.0);
+                    ray.t_max = u(1.0, 8.0);
+                }
+                ray
+            });
+            let lanes = if k % 4 == 0 { 0b0111_1011 } else { ALL_LANES };
+            let p = PacketRays::new(&rays, lanes);
+            let scalar = (
+                closest(&ScalarPacketKernel, &bvh, &p, &mut ArrayPacketStack::new()),
+                any(&ScalarPacketKernel, &bvh, &p, &mut ArrayPacketStack::new()),
+            );
+            let avx2 = crate::accel::simd::packet_closest_any(&bvh, &p);
+            for ((t, prim), occluded) in std::iter::once(scalar).chain(avx2) {
+                for l in 0..PACKET {
+                    let expect = if lanes & (1 << l) != 0 {
+                        wide::closest(&ScalarKernel, &bvh, &rays[l], &mut ArrayStack::new())
+                    } else {
+                        None
+                    };
+                    let got = (prim[l] != u32::MAX).then(|| (t.0[l], prim[l]));
+                    assert_eq!(
+                        got.map(|(t, i)| (t.to_bits(), i)),
+                        expect.map(|(t, i)| (t.to_bits(), i)),
+                        "packet {k} lane {l}: {:?}",
+                        rays[l]
+                    );
+                    assert_eq!(
+                        occluded & (1 << l) != 0,
+                        expect.is_some(),
+                        "packet {k} lane {l}"
+                    );
+                    hits += expect.is_some() as usize;
+                }
+            }
+        }
+        assert!(hits > 500, "only {hits} hits");
     }
 }

@@ -16,8 +16,8 @@
 //! `bench/README.md` for the figures.
 #![allow(unsafe_code)]
 
-use crate::accel::packet::{self, ArrayPacketStack, Lanes, PacketRays, ScalarPacketKernel, PACKET};
-use crate::accel::wide::{self, WideBvh};
+use crate::accel::packet::{self, ArrayPacketStack, ScalarPacketKernel, PACKET};
+use crate::accel::wide::{self, LocalHit, WideBvh};
 use crate::ray::Ray;
 
 /// Whether this CPU runs the AVX2+FMA kernels.
@@ -55,26 +55,80 @@ pub(crate) fn any(bvh: &WideBvh, ray: &Ray) -> bool {
     wide::any(&wide::ScalarKernel, bvh, ray, &mut wide::ArrayStack::new())
 }
 
-/// Closest hits of a packet with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
+/// `WideBvh::intersect_packet` with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
 #[inline]
-pub(crate) fn packet_closest(bvh: &WideBvh, p: &PacketRays) -> (Lanes, [u32; PACKET]) {
+pub(crate) fn intersect_packet(
+    bvh: &WideBvh,
+    rays: &[Ray; PACKET],
+    lanes: u8,
+) -> [Option<LocalHit>; PACKET] {
     #[cfg(target_arch = "x86_64")]
     if avx2_available() {
         // SAFETY: the CPU has AVX2 and FMA (checked just above).
-        return unsafe { x86::packet_closest(bvh, p) };
+        return unsafe { x86::intersect_packet(bvh, rays, lanes) };
     }
-    packet::closest(&ScalarPacketKernel, bvh, p, &mut ArrayPacketStack::new())
+    packet::intersect(
+        &ScalarPacketKernel,
+        bvh,
+        rays,
+        lanes,
+        &mut ArrayPacketStack::new(),
+    )
 }
 
-/// Occluded rays of a packet with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
+/// `WideBvh::occluded_packet` with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
 #[inline]
-pub(crate) fn packet_any(bvh: &WideBvh, p: &PacketRays) -> u32 {
+pub(crate) fn occluded_packet(bvh: &WideBvh, rays: &[Ray; PACKET], lanes: u8) -> u8 {
     #[cfg(target_arch = "x86_64")]
     if avx2_available() {
         // SAFETY: the CPU has AVX2 and FMA (checked just above).
-        return unsafe { x86::packet_any(bvh, p) };
+        return unsafe { x86::occluded_packet(bvh, rays, lanes) };
     }
-    packet::any(&ScalarPacketKernel, bvh, p, &mut ArrayPacketStack::new())
+    packet::occluded(
+        &ScalarPacketKernel,
+        bvh,
+        rays,
+        lanes,
+        &mut ArrayPacketStack::new(),
+    )
+}
+
+/// The packet traversal alone with the AVX2 kernel (`None` without AVX2), for tests of packets
+/// that `WideBvh::intersect_packet` would hand to single rays.
+#[cfg(test)]
+pub(crate) fn packet_closest_any(
+    bvh: &WideBvh,
+    p: &packet::PacketRays,
+) -> Option<((packet::Lanes, [u32; PACKET]), u32)> {
+    #[cfg(target_arch = "x86_64")]
+    if avx2_available() {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above).
+        return Some(unsafe { x86::packet_closest_any(bvh, p) });
+    }
+    let _ = (bvh, p);
+    None
+}
+
+/// The slab test of the binary BVH (`bvh::RayInverse::hits`) for eight rays against one node,
+/// the same operations lane by lane: the mask of rays that hit it within [t_min, t_max], or
+/// `None` where the CPU lacks AVX2 (the caller then tests ray by ray). For the top level's
+/// packet traversal (`Bvh::traverse_packet`).
+#[inline]
+pub(crate) fn binary_node_lanes(
+    min: [f32; 3],
+    max: [f32; 3],
+    origin: &[[f32; 8]; 3],
+    inv_dir: &[[f32; 8]; 3],
+    t_min: &[f32; 8],
+    t_max: &[f32; 8],
+) -> Option<u8> {
+    #[cfg(target_arch = "x86_64")]
+    if avx2_available() {
+        // SAFETY: the CPU has AVX2 and FMA (checked just above).
+        return Some(unsafe { x86::binary_node_lanes(min, max, origin, inv_dir, t_min, t_max) });
+    }
+    let _ = (min, max, origin, inv_dir, t_min, t_max);
+    None
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -85,8 +139,8 @@ mod x86 {
     use crate::accel::packet::{self, Lanes, PacketKernel, PacketRays, PacketStack, PACKET};
     use crate::accel::triangle::WoopRay;
     use crate::accel::wide::{
-        self, BoxPlanes, Kernel, ScalarKernel, Stack, TriangleBlock, WideBvh, WideNode, BLOCK,
-        FAR_SCALE, STACK_SIZE, WIDTH,
+        self, BoxPlanes, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock, WideBvh, WideNode,
+        BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
     };
     use crate::ray::Ray;
 
@@ -344,15 +398,31 @@ mod x86 {
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn packet_closest(bvh: &WideBvh, p: &PacketRays) -> (Lanes, [u32; PACKET]) {
-        packet::closest(&Avx2PacketKernel, bvh, p, &mut UninitPacketStack::new())
+    pub(super) unsafe fn intersect_packet(
+        bvh: &WideBvh,
+        rays: &[Ray; PACKET],
+        lanes: u8,
+    ) -> [Option<LocalHit>; PACKET] {
+        packet::intersect(
+            &Avx2PacketKernel,
+            bvh,
+            rays,
+            lanes,
+            &mut UninitPacketStack::new(),
+        )
     }
 
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn packet_any(bvh: &WideBvh, p: &PacketRays) -> u32 {
-        packet::any(&Avx2PacketKernel, bvh, p, &mut UninitPacketStack::new())
+    pub(super) unsafe fn occluded_packet(bvh: &WideBvh, rays: &[Ray; PACKET], lanes: u8) -> u8 {
+        packet::occluded(
+            &Avx2PacketKernel,
+            bvh,
+            rays,
+            lanes,
+            &mut UninitPacketStack::new(),
+        )
     }
 
     /// The packet traversal stack, not cleared for every packet (it is 14 KB).
@@ -481,6 +551,32 @@ mod x86 {
             }
             hits
         }
+
+        #[inline(always)]
+        fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
+            wide::closest(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
+        }
+
+        #[inline(always)]
+        fn single_any(&self, bvh: &WideBvh, ray: &Ray) -> bool {
+            wide::any(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
+        }
+
+        #[inline(always)]
+        fn barycentrics(
+            &self,
+            bvh: &WideBvh,
+            p: &PacketRays,
+            prim: &[u32; PACKET],
+            b1: &mut Lanes,
+            b2: &mut Lanes,
+        ) -> u32 {
+            let Some(axes) = p.shared_axes else {
+                return 0;
+            };
+            // SAFETY: as above.
+            unsafe { packet_barycentrics(bvh, p, axes, prim, b1, b2) }
+        }
     }
 
     /// Active rays from which a block is tested with rays in lanes (one pass per triangle)
@@ -602,6 +698,69 @@ mod x86 {
             }
         }
         hits
+    }
+
+    /// `WideBvh::finish` for the rays (sharing the sheared frame's axes) whose closest hit is a
+    /// triangle, in lanes: the winners' corners gathered, then the edge functions of
+    /// `triangle::intersect` in the same order, b1 = V / det and b2 = W / det. (`finish` gets
+    /// these from `triangle::intersect` over [t, t], which cannot miss the triangle the same
+    /// arithmetic just found at t.)
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_barycentrics(
+        bvh: &WideBvh,
+        p: &PacketRays,
+        [kx, ky, kz]: [usize; 3],
+        prim: &[u32; PACKET],
+        b1: &mut Lanes,
+        b2: &mut Lanes,
+    ) -> u32 {
+        let triangle_lanes = (bvh.blocks.len() * BLOCK) as u32;
+        let mut done = 0u32;
+        let mut corner = [[Lanes::INFINITY; 3]; 3];
+        for (l, &prim) in prim.iter().enumerate() {
+            if prim < triangle_lanes {
+                done |= 1 << l;
+                let block = &bvh.blocks[prim as usize / BLOCK];
+                let j = prim as usize % BLOCK;
+                for (c, corner) in corner.iter_mut().enumerate() {
+                    for (a, axis) in corner.iter_mut().enumerate() {
+                        axis.0[l] = block.v[c][a][j];
+                    }
+                }
+            }
+        }
+        if done == 0 {
+            return 0;
+        }
+        let (ox, oy, oz) = (
+            load(&p.origin[kx]),
+            load(&p.origin[ky]),
+            load(&p.origin[kz]),
+        );
+        let (sx, sy) = (load(&p.shear[0]), load(&p.shear[1]));
+        let shear = |c: usize| {
+            let ax = _mm256_sub_ps(load(&corner[c][kx]), ox);
+            let ay = _mm256_sub_ps(load(&corner[c][ky]), oy);
+            let az = _mm256_sub_ps(load(&corner[c][kz]), oz);
+            (
+                _mm256_sub_ps(ax, _mm256_mul_ps(sx, az)),
+                _mm256_sub_ps(ay, _mm256_mul_ps(sy, az)),
+            )
+        };
+        let (ax, ay) = shear(0);
+        let (bx, by) = shear(1);
+        let (cx, cy) = shear(2);
+        let u = _mm256_sub_ps(_mm256_mul_ps(cx, by), _mm256_mul_ps(cy, bx));
+        let v = _mm256_sub_ps(_mm256_mul_ps(ax, cy), _mm256_mul_ps(ay, cx));
+        let w = _mm256_sub_ps(_mm256_mul_ps(bx, ay), _mm256_mul_ps(by, ax));
+        let det = _mm256_add_ps(_mm256_add_ps(u, v), w);
+        // SAFETY: `Lanes` is 8 f32, 32-byte aligned.
+        unsafe {
+            _mm256_store_ps(b1.0.as_mut_ptr(), _mm256_div_ps(v, det));
+            _mm256_store_ps(b2.0.as_mut_ptr(), _mm256_div_ps(w, det));
+        }
+        done
     }
 
     /// `Avx2Kernel::block_any` for the rays of `lanes` within their windows, with rays in lanes.
@@ -742,5 +901,51 @@ mod x86 {
         let v = _mm256_min_ps(v, _mm256_permute_ps::<0b01_00_11_10>(v));
         let v = _mm256_min_ps(v, _mm256_permute_ps::<0b10_11_00_01>(v));
         _mm256_cvtss_f32(v)
+    }
+
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn binary_node_lanes(
+        min: [f32; 3],
+        max: [f32; 3],
+        origin: &[[f32; 8]; 3],
+        inv_dir: &[[f32; 8]; 3],
+        t_min: &[f32; 8],
+        t_max: &[f32; 8],
+    ) -> u8 {
+        // SAFETY: each array is 8 f32 (unaligned loads).
+        let load = |v: &[f32; 8]| unsafe { _mm256_loadu_ps(v.as_ptr()) };
+        let scale = _mm256_set1_ps(1.0 + 2.0 * f32::EPSILON * 2.0);
+        let mut t0 = load(t_min);
+        let mut t1 = load(t_max);
+        for a in 0..3 {
+            let o = load(&origin[a]);
+            let inv = load(&inv_dir[a]);
+            let lo = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(min[a]), o), inv);
+            let hi = _mm256_mul_ps(_mm256_sub_ps(_mm256_set1_ps(max[a]), o), inv);
+            // A negative direction (sign bit of 1/d) swaps near and far.
+            let near = _mm256_blendv_ps(lo, hi, inv);
+            let far = _mm256_blendv_ps(hi, lo, inv);
+            // `t0.max(near)`, `t1.min(far · scale)`: with the running value second, a NaN slab
+            // leaves it alone, as Rust's max/min do (the running values are never NaN).
+            t0 = _mm256_max_ps(near, t0);
+            t1 = _mm256_min_ps(_mm256_mul_ps(far, scale), t1);
+        }
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u8
+    }
+
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[cfg(test)]
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn packet_closest_any(
+        bvh: &WideBvh,
+        p: &PacketRays,
+    ) -> ((Lanes, [u32; PACKET]), u32) {
+        (
+            packet::closest(&Avx2PacketKernel, bvh, p, &mut UninitPacketStack::new()),
+            packet::any(&Avx2PacketKernel, bvh, p, &mut UninitPacketStack::new()),
+        )
     }
 }

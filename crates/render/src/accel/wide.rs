@@ -21,7 +21,7 @@
 //! hit. The box and block tests are the `Kernel`: AVX2 in `simd.rs` when the CPU has it, the
 //! scalar `ScalarKernel` here otherwise. Both compute the same thing.
 
-use crate::accel::packet::{self, ArrayPacketStack, PacketRays, ScalarPacketKernel, PACKET};
+use crate::accel::packet::{self, ArrayPacketStack, ScalarPacketKernel, PACKET};
 use crate::accel::triangle::{self, WoopRay};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
@@ -260,14 +260,20 @@ impl WideBvh {
     /// first, so the answer depends neither on the traversal order nor on the structure.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<LocalHit> {
+        let (t, primitive) = self.intersect_preliminary(ray)?;
+        Some(self.finish(ray, t, primitive))
+    }
+
+    /// `intersect` without the barycentrics: (t, primitive). `finish` adds them.
+    #[inline]
+    pub fn intersect_preliminary(&self, ray: &Ray) -> Option<(f32, u32)> {
         if !ray_is_valid(ray) {
             return None;
         }
-        let (t, primitive) = match self.isa {
+        match self.isa {
             Isa::Avx2 => crate::accel::simd::closest(self, ray),
             Isa::Scalar => closest(&ScalarKernel, self, ray, &mut ArrayStack::new()),
-        }?;
-        Some(self.finish(ray, t, primitive))
+        }
     }
 
     /// True when any primitive meets the ray with t in `[ray.t_min, ray.t_max]`.
@@ -287,27 +293,32 @@ impl WideBvh {
     /// `None` in the other lanes. For coherent rays (camera rays of a pixel block).
     #[inline]
     pub fn intersect_packet(&self, rays: &[Ray; PACKET], lanes: u8) -> [Option<LocalHit>; PACKET] {
-        let p = PacketRays::new(rays, lanes);
-        let (t, prim) = match self.isa {
-            Isa::Avx2 => crate::accel::simd::packet_closest(self, &p),
-            Isa::Scalar => {
-                packet::closest(&ScalarPacketKernel, self, &p, &mut ArrayPacketStack::new())
-            }
-        };
-        std::array::from_fn(|l| {
-            (prim[l] != u32::MAX).then(|| self.finish_with(&rays[l], &p.woop(l), t.0[l], prim[l]))
-        })
+        match self.isa {
+            Isa::Avx2 => crate::accel::simd::intersect_packet(self, rays, lanes),
+            Isa::Scalar => packet::intersect(
+                &ScalarPacketKernel,
+                self,
+                rays,
+                lanes,
+                &mut ArrayPacketStack::new(),
+            ),
+        }
     }
 
     /// The rays of `lanes` that `occluded` would report occluded, traced as a packet: bit l
     /// set for `rays[l]`.
     #[inline]
     pub fn occluded_packet(&self, rays: &[Ray; PACKET], lanes: u8) -> u8 {
-        let p = PacketRays::new(rays, lanes);
-        (match self.isa {
-            Isa::Avx2 => crate::accel::simd::packet_any(self, &p),
-            Isa::Scalar => packet::any(&ScalarPacketKernel, self, &p, &mut ArrayPacketStack::new()),
-        }) as u8
+        match self.isa {
+            Isa::Avx2 => crate::accel::simd::occluded_packet(self, rays, lanes),
+            Isa::Scalar => packet::occluded(
+                &ScalarPacketKernel,
+                self,
+                rays,
+                lanes,
+                &mut ArrayPacketStack::new(),
+            ),
+        }
     }
 
     /// Whether primitive `a` comes before `b` in the geometry as given (ties in t go to the
@@ -318,13 +329,19 @@ impl WideBvh {
     }
 
     /// Barycentrics for the winner only (traversal keeps t and the index).
-    fn finish(&self, ray: &Ray, t: f32, primitive: u32) -> LocalHit {
+    pub(crate) fn finish(&self, ray: &Ray, t: f32, primitive: u32) -> LocalHit {
         self.finish_with(ray, &WoopRay::new(ray.origin, ray.direction), t, primitive)
     }
 
     /// `finish` with the ray's watertight constants at hand.
     #[inline]
-    fn finish_with(&self, ray: &Ray, woop: &WoopRay, t: f32, primitive: u32) -> LocalHit {
+    pub(crate) fn finish_with(
+        &self,
+        ray: &Ray,
+        woop: &WoopRay,
+        t: f32,
+        primitive: u32,
+    ) -> LocalHit {
         let p = primitive as usize;
         let (mut b1, mut b2) = (0.0, 0.0);
         if p < self.blocks.len() * BLOCK {
