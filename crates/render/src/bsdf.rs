@@ -208,6 +208,38 @@ impl Bsdf {
         }
     }
 
+    /// Whether `from_material(materials, _, id, uv)` depends on `uv`: whether a texture enters
+    /// it. Where none does, one BSDF serves every hit on the material.
+    pub fn depends_on_uv(materials: &[Material], id: MaterialId) -> bool {
+        let textured = |source: &ColorSource| source.texture.is_some();
+        let plain = |material: &Material| match material {
+            Material::Lambertian { diffuse }
+            | Material::Diffuse { diffuse }
+            | Material::CoolToWarm { diffuse }
+            | Material::Glaze { diffuse, .. } => textured(diffuse),
+            Material::BlinnPhong {
+                diffuse, specular, ..
+            }
+            | Material::Phong {
+                diffuse, specular, ..
+            }
+            | Material::BlinnPhongMirrored {
+                diffuse, specular, ..
+            } => textured(diffuse) || textured(specular),
+            Material::Mirror { .. } | Material::Dielectric { .. } | Material::Emissive { .. } => {
+                false
+            }
+        };
+        match materials.get(id as usize) {
+            None => plain(&Material::fallback()),
+            Some(Material::Emissive {
+                surface: Some(surface),
+                ..
+            }) => materials.get(*surface as usize).is_some_and(plain),
+            Some(other) => plain(other),
+        }
+    }
+
     fn from_plain_material(material: &Material, textures: &[Image], uv: (f32, f32)) -> Bsdf {
         let color = |source: &ColorSource| resolve_color(textures, source, uv).clamp01();
         match material {
@@ -339,6 +371,17 @@ impl Bsdf {
     pub fn eval_and_pdf(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
         let mut f = Color::ZERO;
         let mut pdf = 0.0;
+        if self.count == 1 && self.lobes[0].lobe == Lobe::Diffuse {
+            // The commonest case, short-cut (the same arithmetic as the loop below).
+            if wo.z * wi.z <= 0.0 {
+                return (f, pdf);
+            }
+            let lobe = &self.lobes[0];
+            return (
+                lobe.weight * FRAC_1_PI,
+                lobe.probability * cosine_hemisphere_pdf(wi.z.abs()),
+            );
+        }
         let Some((wo, wi)) = upper_hemisphere(wo, wi) else {
             return (f, pdf);
         };
@@ -352,6 +395,7 @@ impl Bsdf {
 
     /// Draws ωi for ωo: `u_lobe` picks the lobe (and, remapped, a dielectric's event), `u`
     /// the direction. `None` when the sample carries no light (below the horizon, say).
+    #[inline]
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: (f32, f32)) -> Option<BsdfSample> {
         if wo.z == 0.0 {
             return None;
@@ -371,6 +415,11 @@ impl Bsdf {
                 eta: 1.0,
             });
         }
+        self.sample_lobes(wo, u_lobe, u)
+    }
+
+    /// `sample` past the single-diffuse short-cut.
+    fn sample_lobes(&self, wo: Vec3, u_lobe: f32, u: (f32, f32)) -> Option<BsdfSample> {
         let mut start = 0.0;
         let mut chosen = self.count.checked_sub(1)?;
         for (index, lobe) in self.lobes[..self.count].iter().enumerate() {

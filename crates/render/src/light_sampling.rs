@@ -68,6 +68,8 @@ enum PreparedLight {
         first: u32,
         count: u32,
         area: f32,
+        /// 1 / area: the density per unit area of a point sampled on the light.
+        inverse_area: f32,
         radiance: Color,
     },
     Environment,
@@ -199,6 +201,7 @@ impl LightSampler {
                             first,
                             count: list.len() as u32,
                             area: total as f32,
+                            inverse_area: 1.0 / total as f32,
                             radiance: *intensity,
                         },
                         PI * total as f32 * mean(*intensity),
@@ -291,8 +294,60 @@ impl LightSampler {
     #[inline]
     pub fn sample(&self, scene: &Scene, reference: Vec3, u: (f32, f32)) -> Option<LightSample> {
         let (index, probability, remapped) = sample_cdf(&self.selection_cdf, u.0)?;
-        let mut sample = self.sample_light(scene, index, reference, (remapped, u.1))?;
+        let u = (remapped, u.1);
+        // Shape emitters, the commonest lights, inline; the others out of line.
+        let mut sample = match self.lights.get(index)? {
+            PreparedLight::Triangles { .. } => self.sample_triangles(index, reference, u)?,
+            _ => self.sample_light(scene, index, reference, u)?,
+        };
         sample.pdf *= probability;
+        Some(sample)
+    }
+
+    /// `sample_light` for light `index`, a `PreparedLight::Triangles`: a triangle chosen by
+    /// area with `u.0`, which is then remapped to pick the point on it.
+    #[inline]
+    fn sample_triangles(
+        &self,
+        index: usize,
+        reference: Vec3,
+        u: (f32, f32),
+    ) -> Option<LightSample> {
+        let PreparedLight::Triangles {
+            first,
+            count,
+            inverse_area,
+            radiance,
+            ..
+        } = self.lights[index]
+        else {
+            return None;
+        };
+        let list = &self.triangles[first as usize..(first + count) as usize];
+        let (triangle, u0) = match list {
+            [] => return None,
+            // One triangle (a shape light): all of u.0 is its own.
+            [triangle] => (triangle, u.0),
+            _ => {
+                let chosen = list
+                    .partition_point(|t| t.cumulative <= u.0)
+                    .min(list.len() - 1);
+                let start = if chosen == 0 {
+                    0.0
+                } else {
+                    list[chosen - 1].cumulative
+                };
+                let width = list[chosen].cumulative - start;
+                if width <= 0.0 {
+                    return None;
+                }
+                (&list[chosen], ((u.0 - start) / width).clamp(0.0, 1.0))
+            }
+        };
+        let (b1, b2) = sample_uniform_triangle(u0, u.1);
+        let position = triangle.v0 + triangle.edge1 * b1 + triangle.edge2 * b2;
+        let mut sample = area_sample(reference, position, triangle.normal, inverse_area, radiance)?;
+        sample.reachable_by_bsdf = self.reachable_by_bsdf(index);
         Some(sample)
     }
 
@@ -343,39 +398,7 @@ impl LightSampler {
                     }
                 })
             }
-            PreparedLight::Triangles {
-                first,
-                count,
-                area,
-                radiance,
-            } => {
-                let list = &self.triangles[*first as usize..(*first + *count) as usize];
-                if list.is_empty() {
-                    return None;
-                }
-                let chosen = list
-                    .partition_point(|t| t.cumulative <= u.0)
-                    .min(list.len() - 1);
-                let start = if chosen == 0 {
-                    0.0
-                } else {
-                    list[chosen - 1].cumulative
-                };
-                let width = list[chosen].cumulative - start;
-                if width <= 0.0 {
-                    return None;
-                }
-                let u0 = ((u.0 - start) / width).clamp(0.0, 1.0);
-                let triangle = &list[chosen];
-                let (b1, b2) = sample_uniform_triangle(u0, u.1);
-                let position = triangle.v0 + triangle.edge1 * b1 + triangle.edge2 * b2;
-                area_sample(reference, position, triangle.normal, 1.0 / area, *radiance).map(|s| {
-                    LightSample {
-                        reachable_by_bsdf,
-                        ..s
-                    }
-                })
-            }
+            PreparedLight::Triangles { .. } => self.sample_triangles(index, reference, u),
             PreparedLight::Sphere {
                 center,
                 radius,

@@ -19,9 +19,9 @@ use crate::bsdf::{Bsdf, Frame};
 use crate::film::Film;
 use crate::integrator::{Integrator, SampleContext};
 use crate::light_sampling::LightSampler;
-use crate::material::Material;
+use crate::material::{Material, MaterialId};
 use crate::math::{Color, Vec3};
-use crate::path_sampler::{PathSampler, SobolSampler};
+use crate::path_sampler::{PathSampler, SobolPixel};
 use crate::ray::Ray;
 use crate::render::{render_tiles, Cancelled, RenderSettings, RenderStats};
 use crate::scene::Scene;
@@ -67,11 +67,63 @@ pub struct PathOutput {
 }
 
 /// The path tracer with its per-render preprocessing (light selection by power, triangle and
-/// environment distributions).
+/// environment distributions, what each material does at a hit).
 #[derive(Clone, Debug)]
 pub struct PathIntegrator {
     lights: LightSampler,
     settings: PathSettings,
+    /// By material id, then one more entry for ids out of range (the fallback material).
+    materials: Vec<PreparedMaterial>,
+}
+
+/// What the path tracer needs of one material at every hit, worked out once per render so
+/// that a hit neither matches on the material nor rebuilds its BSDF.
+#[derive(Clone, Copy, Debug)]
+struct PreparedMaterial {
+    /// The BSDF where no texture enters it (then it is the same at every point); `None` where
+    /// one does, and the hit builds it from its texture coordinates.
+    bsdf: Option<Bsdf>,
+    emitter: Emitter,
+    /// A dielectric's attenuation per unit distance (Beer's law for segments inside it).
+    attenuation: Option<Color>,
+}
+
+#[derive(Clone, Copy, Debug)]
+enum Emitter {
+    None,
+    /// Emits as light `index` of `Scene::lights`, which light sampling also finds.
+    Light(usize),
+    /// Emits `radiance` on the side of its geometric normal; no light samples it.
+    Unsampled(Color),
+}
+
+impl PreparedMaterial {
+    fn new(scene: &Scene, id: MaterialId) -> PreparedMaterial {
+        let material = scene.materials.get(id as usize);
+        let bsdf = (!Bsdf::depends_on_uv(&scene.materials, id))
+            .then(|| Bsdf::from_material(&scene.materials, &scene.textures, id, (0.0, 0.0)));
+        let emitter = match material {
+            Some(Material::Emissive {
+                radiance, light, ..
+            }) => match light
+                .map(|index| index as usize)
+                .filter(|&index| index < scene.lights.len())
+            {
+                Some(index) => Emitter::Light(index),
+                None => Emitter::Unsampled(*radiance),
+            },
+            _ => Emitter::None,
+        };
+        let attenuation = match material {
+            Some(Material::Dielectric { attenuation, .. }) => Some(*attenuation),
+            _ => None,
+        };
+        PreparedMaterial {
+            bsdf,
+            emitter,
+            attenuation,
+        }
+    }
 }
 
 /// Veach's power heuristic with β = 2 for one sample from each strategy.
@@ -91,10 +143,21 @@ fn power_heuristic(pdf: f32, other_pdf: f32) -> f32 {
 
 impl PathIntegrator {
     pub fn new(scene: &Scene, settings: PathSettings) -> PathIntegrator {
+        let count = scene.materials.len() as MaterialId;
         PathIntegrator {
             lights: LightSampler::new(scene),
             settings,
+            materials: (0..=count)
+                .map(|id| PreparedMaterial::new(scene, id))
+                .collect(),
         }
+    }
+
+    /// The prepared material `id`; the fallback's for an id out of range.
+    #[inline]
+    fn material(&self, id: MaterialId) -> &PreparedMaterial {
+        let last = self.materials.len() - 1;
+        &self.materials[(id as usize).min(last)]
     }
 
     pub fn lights(&self) -> &LightSampler {
@@ -136,7 +199,7 @@ impl PathIntegrator {
             // samples are stratified against each other vertex by vertex.
             let dimension = FIRST_PATH_DIMENSION + DIMENSIONS_PER_VERTEX * depth;
             *rays += 1;
-            let Some(hit) = scene.intersect(&ray) else {
+            let Some(hit) = scene.intersect_preliminary(&ray) else {
                 let background = scene.background_radiance(ray.direction);
                 if depth == 0 {
                     first_hit.albedo = background.clamp01();
@@ -151,8 +214,8 @@ impl PathIntegrator {
                 }
                 break;
             };
-            let si = scene.surface(&ray, &hit);
-            let material = scene.materials.get(si.material as usize);
+            let si = scene.surface_without_uv(&ray, &hit);
+            let material = self.material(si.material);
 
             // Light emitted by the surface towards the ray's origin. Emitters are one-sided, and
             // their back reflects nothing either: the surface material of an emitter only
@@ -160,26 +223,22 @@ impl PathIntegrator {
             // one-sided unless wrapped in `twosided`), and it matters where the back of a light
             // can be seen, such as the gap between the Cornell box's light and its ceiling.
             let mut behind_emitter = false;
-            if let Some(Material::Emissive {
-                radiance: emitted,
-                light,
-                ..
-            }) = material
-            {
-                let light_index = light
-                    .map(|index| index as usize)
-                    .filter(|&index| index < scene.lights.len());
-                let emitted = match light_index {
-                    Some(index) => self
-                        .lights
-                        .emission_towards(index, ray.direction, si.normal),
+            if let Emitter::Light(_) | Emitter::Unsampled(_) = material.emitter {
+                let emitted = match material.emitter {
+                    Emitter::Light(index) => {
+                        self.lights
+                            .emission_towards(index, ray.direction, si.normal)
+                    }
                     // An emitter no light samples: one-sided along its geometric normal.
-                    None => (ray.direction.dot(si.normal) < 0.0).then_some(*emitted),
+                    Emitter::Unsampled(emitted) => {
+                        (ray.direction.dot(si.normal) < 0.0).then_some(emitted)
+                    }
+                    Emitter::None => None,
                 };
                 match emitted {
                     Some(emitted) if emitted != Color::ZERO => {
-                        let weight = match light_index {
-                            Some(index) if !specular_bounce => {
+                        let weight = match material.emitter {
+                            Emitter::Light(index) if !specular_bounce => {
                                 let light_pdf = self
                                     .lights
                                     .pdf_emitter_hit(index, ray.origin, si.point, si.normal);
@@ -199,7 +258,7 @@ impl PathIntegrator {
 
             // Beer's law for the segment that just travelled inside a dielectric: the ray meets
             // the surface from behind its outward normal.
-            if let Some(Material::Dielectric { attenuation, .. }) = material {
+            if let Some(attenuation) = material.attenuation {
                 if ray.direction.dot(si.normal) > 0.0 {
                     let distance = hit.t;
                     throughput =
@@ -209,10 +268,16 @@ impl PathIntegrator {
 
             let frame = Frame::from_normal(si.normal);
             let wo = frame.to_local(-ray.direction);
-            let bsdf = if behind_emitter {
-                Bsdf::BLACK
-            } else {
-                Bsdf::from_material(&scene.materials, &scene.textures, si.material, si.uv)
+            let textured;
+            let bsdf = match &material.bsdf {
+                _ if behind_emitter => &Bsdf::BLACK,
+                Some(bsdf) => bsdf,
+                None => {
+                    let uv = scene.surface(&ray, &scene.complete(&ray, &hit)).uv;
+                    textured =
+                        Bsdf::from_material(&scene.materials, &scene.textures, si.material, uv);
+                    &textured
+                }
             };
             if depth == 0 {
                 first_hit.normal = if wo.z < 0.0 { -si.normal } else { si.normal };
@@ -224,9 +289,27 @@ impl PathIntegrator {
                 break;
             }
 
+            // The vertex's random numbers, drawn in a fixed order (the stream beyond the
+            // stratified dimensions is consumed in call order), and the continuation, which
+            // does not depend on the light sample: all of it ahead of the shadow ray, so that
+            // its arithmetic overlaps the light sample's instead of waiting for the shadow
+            // ray's traversal.
+            let nee = bsdf.has_non_specular();
+            let u_light = if nee {
+                sampler.sample_2d(dimension)
+            } else {
+                (0.5, 0.5)
+            };
+            let u_lobe = if bsdf.uses_lobe_sample() {
+                sampler.sample_1d(dimension + 2)
+            } else {
+                0.5
+            };
+            let u_direction = sampler.sample_2d(dimension + 3);
+            let continuation = bsdf.sample(wo, u_lobe, u_direction);
+
             // Next-event estimation: one light, chosen by power, one point on it.
-            if bsdf.has_non_specular() {
-                let u_light = sampler.sample_2d(dimension);
+            if nee {
                 if let Some(sample) = self.lights.sample(scene, si.point, u_light) {
                     let wi = frame.to_local(sample.direction);
                     let (f, scattering_pdf) = bsdf.eval_and_pdf(wo, wi);
@@ -250,14 +333,8 @@ impl PathIntegrator {
                 }
             }
 
-            // Continue the path by sampling the BSDF.
-            let u_lobe = if bsdf.uses_lobe_sample() {
-                sampler.sample_1d(dimension + 2)
-            } else {
-                0.5
-            };
-            let u_direction = sampler.sample_2d(dimension + 3);
-            let Some(sample) = bsdf.sample(wo, u_lobe, u_direction) else {
+            // Continue the path along the BSDF sample.
+            let Some(sample) = continuation else {
                 break;
             };
             throughput = throughput.mul_elem(sample.weight);
@@ -322,8 +399,9 @@ pub fn render_with_aovs(
         let mut albedo = Color::ZERO;
         let mut normal = Vec3::ZERO;
         let mut valid = 0u32;
+        let sobol = SobolPixel::new(settings.seed, pixel_index, samples);
         for s in 0..samples {
-            let mut sampler = SobolSampler::new(settings.seed, pixel_index, s, samples);
+            let mut sampler = sobol.sampler(s);
             let (ox, oy) = sampler.sample_2d(0);
             let ray = scene
                 .camera

@@ -15,7 +15,6 @@
 //! `Rng` is a `PathSampler` too (independent samples, dimensions ignored): what the generic
 //! `Integrator` interface and the tests use.
 
-use crate::integrator::permute;
 use crate::sampling::{mix64, Rng};
 
 /// Where a path tracer draws its random numbers from.
@@ -40,60 +39,148 @@ impl PathSampler for Rng {
 /// Dimensions served by the scrambled Sobol' points; later ones come from the PCG stream.
 pub const QMC_DIMENSIONS: u32 = 32;
 
-/// Owen-scrambled, index-padded Sobol' samples for one pixel sample (module docs).
+/// What all the samples of one pixel share: each dimension's hash, which seeds the shuffle of
+/// the sample index and the scrambling. Computed once per pixel (`SobolPixel::new`), then
+/// `sampler` hands out each sample's `SobolSampler`.
 #[derive(Clone, Debug)]
-pub struct SobolSampler {
-    rng: Rng,
-    pixel_key: u64,
-    sample_index: u32,
+pub struct SobolPixel {
+    seed: u64,
+    pixel: u64,
     sample_count: u32,
+    /// The smallest all-ones mask covering `sample_count - 1` (`permute`'s `w`).
+    mask: u32,
+    hashes: [u64; QMC_DIMENSIONS as usize],
+    /// Per dimension, the permutation seed (`hash as u32`) modulo the sample count.
+    seeds_mod_count: [u32; QMC_DIMENSIONS as usize],
 }
 
-impl SobolSampler {
-    /// Sample `sample_index` of `sample_count` in pixel `pixel` (row-major index).
-    pub fn new(seed: u64, pixel: u64, sample_index: u32, sample_count: u32) -> SobolSampler {
-        SobolSampler {
-            rng: Rng::for_sample(seed, pixel, sample_index as u64),
-            pixel_key: mix64(
-                mix64(seed ^ 0x5851_f42d_4c95_7f2d) ^ pixel.wrapping_mul(0x2545_f491_4f6c_dd1d),
-            ),
-            sample_index,
-            sample_count: sample_count.max(1),
+impl SobolPixel {
+    /// Pixel `pixel` (row-major index) rendered with `sample_count` samples.
+    pub fn new(seed: u64, pixel: u64, sample_count: u32) -> SobolPixel {
+        let pixel_key =
+            mix64(mix64(seed ^ 0x5851_f42d_4c95_7f2d) ^ pixel.wrapping_mul(0x2545_f491_4f6c_dd1d));
+        let sample_count = sample_count.max(1);
+        let hashes: [u64; QMC_DIMENSIONS as usize] = std::array::from_fn(|dimension| {
+            mix64(pixel_key ^ (dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+        });
+        SobolPixel {
+            seed,
+            pixel,
+            sample_count,
+            mask: permute_mask(sample_count),
+            hashes,
+            seeds_mod_count: hashes.map(|hash| hash as u32 % sample_count),
         }
     }
 
-    /// The shuffled index into the Sobol' sequence and the scrambling seed of a dimension.
+    /// The sampler of sample `sample_index` (below the pixel's sample count).
+    #[inline]
+    pub fn sampler(&self, sample_index: u32) -> SobolSampler<'_> {
+        SobolSampler {
+            rng: Rng::for_sample(self.seed, self.pixel, sample_index as u64),
+            pixel: self,
+            sample_index,
+        }
+    }
+}
+
+/// Owen-scrambled, index-padded Sobol' samples for one pixel sample (module docs).
+#[derive(Clone, Debug)]
+pub struct SobolSampler<'a> {
+    rng: Rng,
+    pixel: &'a SobolPixel,
+    sample_index: u32,
+}
+
+impl SobolSampler<'_> {
+    /// The shuffled index into the Sobol' sequence and the scrambling seed of a dimension
+    /// (below `QMC_DIMENSIONS`).
     #[inline]
     fn index_and_hash(&self, dimension: u32) -> (u32, u64) {
-        let hash =
-            mix64(self.pixel_key ^ (dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-        let index = permute(self.sample_index, self.sample_count, hash as u32);
+        let pixel = self.pixel;
+        let hash = pixel.hashes[dimension as usize];
+        let index = permute_with(
+            self.sample_index,
+            pixel.sample_count,
+            pixel.mask,
+            hash as u32,
+            pixel.seeds_mod_count[dimension as usize],
+        );
         (index, hash)
     }
 }
 
-impl PathSampler for SobolSampler {
-    #[inline]
+/// `integrator::permute`'s `w` for n: the smallest all-ones mask covering n − 1.
+fn permute_mask(n: u32) -> u32 {
+    u32::MAX
+        .checked_shr(n.saturating_sub(1).leading_zeros())
+        .unwrap_or(0)
+}
+
+/// `integrator::permute(i, n, seed)` for i < n, given the mask `w` of n and `seed % n` (what
+/// depends only on the pixel and the dimension), so that no sample pays for them: the same
+/// rounds, and the final `(i + seed) mod 2³² mod n` without a division.
+#[inline]
+fn permute_with(mut i: u32, n: u32, w: u32, seed: u32, seed_mod_n: u32) -> u32 {
+    if n <= 1 {
+        return 0;
+    }
+    loop {
+        i ^= seed;
+        i = i.wrapping_mul(0xe170_893d);
+        i ^= seed >> 16;
+        i ^= (i & w) >> 4;
+        i ^= seed >> 8;
+        i = i.wrapping_mul(0x0929_eb3f);
+        i ^= seed >> 23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(1 | seed >> 27);
+        i = i.wrapping_mul(0x6935_fa69);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dc_b303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e50_1cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860_a3df);
+        i &= w;
+        i ^= i >> 5;
+        if i < n {
+            break;
+        }
+    }
+    match i.overflowing_add(seed) {
+        // Past 2³², the wrapped sum is below i, so below n already.
+        (wrapped, true) => wrapped,
+        (_, false) => {
+            let sum = i as u64 + seed_mod_n as u64;
+            (if sum >= n as u64 { sum - n as u64 } else { sum }) as u32
+        }
+    }
+}
+
+impl PathSampler for SobolSampler<'_> {
+    #[inline(always)]
     fn sample_1d(&mut self, dimension: u32) -> f32 {
         if dimension >= QMC_DIMENSIONS {
             return self.rng.next_f32();
         }
         let (index, hash) = self.index_and_hash(dimension);
-        unit_float(owen_scramble_reversed(index, (hash >> 32) as u32))
+        unit_float(owen_hash(index, (hash >> 32) as u32).reverse_bits())
     }
 
-    #[inline]
+    #[inline(always)]
     fn sample_2d(&mut self, dimension: u32) -> (f32, f32) {
         if dimension >= QMC_DIMENSIONS {
             return (self.rng.next_f32(), self.rng.next_f32());
         }
         let (index, hash) = self.index_and_hash(dimension);
+        let first = owen_hash(index, (hash >> 32) as u32);
+        let second = owen_hash(sobol_second_dimension_reversed(index), hash as u32);
+        // Both reversed at once: reversing the 64 bits (first, second) gives (second', first').
+        let reversed = ((first as u64) << 32 | second as u64).reverse_bits();
         (
-            unit_float(owen_scramble_reversed(index, (hash >> 32) as u32)),
-            unit_float(owen_scramble_reversed(
-                sobol_second_dimension_reversed(index),
-                hash as u32,
-            )),
+            unit_float(reversed as u32),
+            unit_float((reversed >> 32) as u32),
         )
     }
 }
@@ -106,19 +193,48 @@ pub fn sobol_second_dimension(index: u32) -> u32 {
 }
 
 /// `sobol_second_dimension` with its bits reversed, which is what the scrambler takes: the
-/// direction numbers run the other way, v_k = v_{k−1} ⊕ (v_{k−1} << 1).
+/// direction numbers run the other way, v_k = v_{k−1} ⊕ (v_{k−1} << 1). The result is the XOR
+/// of v_k over the set bits k of the index, so it is looked up a byte of the index at a time.
 #[inline]
-fn sobol_second_dimension_reversed(mut index: u32) -> u32 {
-    let mut result = 0;
-    let mut direction = 1u32;
-    while index != 0 {
-        if index & 1 != 0 {
-            result ^= direction;
-        }
-        index >>= 1;
-        direction ^= direction << 1;
+fn sobol_second_dimension_reversed(index: u32) -> u32 {
+    let [b0, b1, b2, b3] = index.to_le_bytes();
+    SOBOL_SECOND_DIMENSION[0][b0 as usize]
+        ^ SOBOL_SECOND_DIMENSION[1][b1 as usize]
+        ^ SOBOL_SECOND_DIMENSION[2][b2 as usize]
+        ^ SOBOL_SECOND_DIMENSION[3][b3 as usize]
+}
+
+/// `SOBOL_SECOND_DIMENSION[k][b]`: the XOR of the reversed direction numbers v_{8k+j} over
+/// the set bits j of byte b.
+static SOBOL_SECOND_DIMENSION: [[u32; 256]; 4] = sobol_second_dimension_tables();
+
+const fn sobol_second_dimension_tables() -> [[u32; 256]; 4] {
+    let mut directions = [0u32; 32];
+    directions[0] = 1;
+    let mut k = 1;
+    while k < 32 {
+        directions[k] = directions[k - 1] ^ (directions[k - 1] << 1);
+        k += 1;
     }
-    result
+    let mut tables = [[0u32; 256]; 4];
+    let mut byte = 0;
+    while byte < 4 {
+        let mut b = 0;
+        while b < 256 {
+            let mut value = 0;
+            let mut j = 0;
+            while j < 8 {
+                if b & (1 << j) != 0 {
+                    value ^= directions[8 * byte + j];
+                }
+                j += 1;
+            }
+            tables[byte][b] = value;
+            b += 1;
+        }
+        byte += 1;
+    }
+    tables
 }
 
 /// A fast hash-based approximation of Owen's nested uniform scrambling of the bits of `value`
@@ -133,13 +249,19 @@ pub fn owen_scramble(value: u32, seed: u32) -> u32 {
 /// that has them (the first Sobol' dimension is the reversed index itself) skips two reversals.
 #[inline]
 fn owen_scramble_reversed(reversed: u32, seed: u32) -> u32 {
+    owen_hash(reversed, seed).reverse_bits()
+}
+
+/// `owen_scramble_reversed` before its final reversal.
+#[inline(always)]
+fn owen_hash(reversed: u32, seed: u32) -> u32 {
     let mut v = reversed;
     v ^= v.wrapping_mul(0x3d20_adea);
     v = v.wrapping_add(seed);
     v = v.wrapping_mul((seed >> 16) | 1);
     v ^= v.wrapping_mul(0x0552_6c56);
     v ^= v.wrapping_mul(0x53a2_2864);
-    v.reverse_bits()
+    v
 }
 
 /// The top 24 bits as a float in [0, 1): every value exact, never 1.
@@ -151,6 +273,7 @@ fn unit_float(bits: u32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::permute;
 
     #[test]
     fn first_points_are_stratified() {
@@ -161,8 +284,9 @@ mod tests {
             let mut cells = [0u32; 16];
             let mut columns = [0u32; 16];
             let mut rows = [0u32; 16];
+            let pixel = SobolPixel::new(seed, 7, 16);
             for i in 0..16 {
-                let mut sampler = SobolSampler::new(seed, 7, i, 16);
+                let mut sampler = pixel.sampler(i);
                 let (u, v) = sampler.sample_2d(4);
                 cells[(u * 4.0) as usize * 4 + (v * 4.0) as usize] += 1;
                 columns[(u * 16.0) as usize] += 1;
@@ -176,12 +300,55 @@ mod tests {
 
     #[test]
     fn values_depend_on_seed_pixel_and_dimension() {
-        let value =
-            |seed, pixel, dimension| SobolSampler::new(seed, pixel, 3, 16).sample_2d(dimension);
+        let value = |seed, pixel, dimension| {
+            SobolPixel::new(seed, pixel, 16)
+                .sampler(3)
+                .sample_2d(dimension)
+        };
         assert_ne!(value(0, 0, 2), value(1, 0, 2));
         assert_ne!(value(0, 0, 2), value(0, 1, 2));
         assert_ne!(value(0, 0, 2), value(0, 0, 4));
         assert_eq!(value(5, 9, 6), value(5, 9, 6));
+    }
+
+    #[test]
+    fn permute_with_matches_permute() {
+        let mut rng = Rng::new(11, 3);
+        for n in (1..=70).chain([127, 128, 129, 1000, 4096, 65_537]) {
+            let w = permute_mask(n);
+            for _ in 0..200 {
+                let seed = rng.next_u32();
+                let i = rng.below(n);
+                assert_eq!(
+                    permute_with(i, n, w, seed, seed % n),
+                    permute(i, n, seed),
+                    "i {i} n {n} seed {seed}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn sobol_second_dimension_tables_match_the_recurrence() {
+        let by_recurrence = |mut index: u32| {
+            let (mut result, mut direction) = (0u32, 1u32);
+            while index != 0 {
+                if index & 1 != 0 {
+                    result ^= direction;
+                }
+                index >>= 1;
+                direction ^= direction << 1;
+            }
+            result
+        };
+        let mut rng = Rng::new(5, 0);
+        for index in (0..4096).chain((0..4096).map(|_| rng.next_u32())) {
+            assert_eq!(
+                sobol_second_dimension_reversed(index),
+                by_recurrence(index),
+                "{index}"
+            );
+        }
     }
 
     #[test]
