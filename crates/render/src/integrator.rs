@@ -47,40 +47,11 @@ const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Kensler's hash-based permutation of 0..n (Correlated Multi-Jittered Sampling, 2013): a
 /// bijection chosen by `seed`, evaluated without storing the permutation.
-pub fn permute(mut i: u32, n: u32, seed: u32) -> u32 {
+pub fn permute(i: u32, n: u32, seed: u32) -> u32 {
     if n <= 1 {
         return 0;
     }
-    let mut w = n - 1;
-    w |= w >> 1;
-    w |= w >> 2;
-    w |= w >> 4;
-    w |= w >> 8;
-    w |= w >> 16;
-    loop {
-        i ^= seed;
-        i = i.wrapping_mul(0xe170_893d);
-        i ^= seed >> 16;
-        i ^= (i & w) >> 4;
-        i ^= seed >> 8;
-        i = i.wrapping_mul(0x0929_eb3f);
-        i ^= seed >> 23;
-        i ^= (i & w) >> 1;
-        i = i.wrapping_mul(1 | seed >> 27);
-        i = i.wrapping_mul(0x6935_fa69);
-        i ^= (i & w) >> 11;
-        i = i.wrapping_mul(0x74dc_b303);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0x9e50_1cc3);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0xc860_a3df);
-        i &= w;
-        i ^= i >> 5;
-        if i < n {
-            break;
-        }
-    }
-    (i.wrapping_add(seed)) % n
+    crate::path_sampler::permute_with(i, n, crate::path_sampler::permute_mask(n), seed, seed % n)
 }
 
 /// Computes the radiance arriving along a camera ray.

@@ -691,32 +691,10 @@ pub fn uniform_sphere_pdf() -> f32 {
     1.0 / (4.0 * PI)
 }
 
-/// Face index, and (s, t) in [0, 1]² on it, that `CubeMap::lookup` reads for direction `d`:
-/// the OpenGL selection table (the same as `texture.rs`; a test keeps the two in step).
+/// Face index, and (s, t) in [0, 1]² on it, that `CubeMap::lookup` reads for direction `d`.
 #[inline]
 pub fn cube_face_coordinates(d: Vec3) -> Option<(usize, f32, f32)> {
-    let a = d.abs();
-    let (face, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
-        if d.x > 0.0 {
-            (0, -d.z, -d.y, a.x)
-        } else {
-            (1, d.z, -d.y, a.x)
-        }
-    } else if a.y >= a.z {
-        if d.y > 0.0 {
-            (2, d.x, d.z, a.y)
-        } else {
-            (3, d.x, -d.z, a.y)
-        }
-    } else if d.z > 0.0 {
-        (4, d.x, -d.y, a.z)
-    } else {
-        (5, -d.x, -d.y, a.z)
-    };
-    if ma <= 0.0 || !ma.is_finite() {
-        return None;
-    }
-    Some((face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)))
+    CubeMap::face_coordinates(d)
 }
 
 /// The (unnormalised) direction through point (s, t) of cube face `face`: the inverse of

@@ -111,7 +111,7 @@ impl SobolSampler<'_> {
 }
 
 /// `integrator::permute`'s `w` for n: the smallest all-ones mask covering n − 1.
-fn permute_mask(n: u32) -> u32 {
+pub(crate) fn permute_mask(n: u32) -> u32 {
     u32::MAX
         .checked_shr(n.saturating_sub(1).leading_zeros())
         .unwrap_or(0)
@@ -121,7 +121,7 @@ fn permute_mask(n: u32) -> u32 {
 /// depends only on the pixel and the dimension), so that no sample pays for them: the same
 /// rounds, and the final `(i + seed) mod 2³² mod n` without a division.
 #[inline]
-fn permute_with(mut i: u32, n: u32, w: u32, seed: u32, seed_mod_n: u32) -> u32 {
+pub(crate) fn permute_with(mut i: u32, n: u32, w: u32, seed: u32, seed_mod_n: u32) -> u32 {
     if n <= 1 {
         return 0;
     }
@@ -311,19 +311,57 @@ mod tests {
         assert_eq!(value(5, 9, 6), value(5, 9, 6));
     }
 
+    /// Kensler's permutation as the paper writes it (with its final modulo), the reference
+    /// for the division-free `permute_with`.
+    fn kensler_permute(mut i: u32, n: u32, seed: u32) -> u32 {
+        let w = permute_mask(n);
+        loop {
+            i ^= seed;
+            i = i.wrapping_mul(0xe170_893d);
+            i ^= seed >> 16;
+            i ^= (i & w) >> 4;
+            i ^= seed >> 8;
+            i = i.wrapping_mul(0x0929_eb3f);
+            i ^= seed >> 23;
+            i ^= (i & w) >> 1;
+            i = i.wrapping_mul(1 | seed >> 27);
+            i = i.wrapping_mul(0x6935_fa69);
+            i ^= (i & w) >> 11;
+            i = i.wrapping_mul(0x74dc_b303);
+            i ^= (i & w) >> 2;
+            i = i.wrapping_mul(0x9e50_1cc3);
+            i ^= (i & w) >> 2;
+            i = i.wrapping_mul(0xc860_a3df);
+            i &= w;
+            i ^= i >> 5;
+            if i < n {
+                break;
+            }
+        }
+        i.wrapping_add(seed) % n
+    }
+
     #[test]
-    fn permute_with_matches_permute() {
+    fn permute_matches_kensler_and_is_a_bijection() {
         let mut rng = Rng::new(11, 3);
-        for n in (1..=70).chain([127, 128, 129, 1000, 4096, 65_537]) {
-            let w = permute_mask(n);
+        for n in (2..=70).chain([127, 128, 129, 1000, 4096, 65_537]) {
             for _ in 0..200 {
                 let seed = rng.next_u32();
                 let i = rng.below(n);
                 assert_eq!(
-                    permute_with(i, n, w, seed, seed % n),
                     permute(i, n, seed),
+                    kensler_permute(i, n, seed),
                     "i {i} n {n} seed {seed}"
                 );
+            }
+            if n <= 4096 {
+                let seed = rng.next_u32();
+                let mut seen = vec![false; n as usize];
+                for i in 0..n {
+                    let j = permute(i, n, seed) as usize;
+                    assert!(!seen[j], "n {n}: {j} twice");
+                    seen[j] = true;
+                }
             }
         }
     }

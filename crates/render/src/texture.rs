@@ -69,11 +69,12 @@ pub struct CubeMap {
 }
 
 impl CubeMap {
-    /// Radiance seen along world direction `d` (need not be unit), by the OpenGL cube-map
-    /// face selection and (s, t) convention.
-    pub fn lookup(&self, d: Vec3) -> Color {
+    /// Face index and (s, t) in [0, 1]² on it for direction `d` (need not be unit), by the
+    /// OpenGL cube-map selection table (its specification's table 3.21); `None` for a zero or
+    /// non-finite direction. The environment's importance sampling reads the same mapping.
+    #[inline]
+    pub fn face_coordinates(d: Vec3) -> Option<(usize, f32, f32)> {
         let a = d.abs();
-        // (face, sc, tc, ma) per the OpenGL specification's table 3.21.
         let (face, sc, tc, ma) = if a.x >= a.y && a.x >= a.z {
             if d.x > 0.0 {
                 (0, -d.z, -d.y, a.x)
@@ -92,10 +93,16 @@ impl CubeMap {
             (5, -d.x, -d.y, a.z)
         };
         if ma <= 0.0 || !ma.is_finite() {
-            return Vec3::ZERO;
+            return None;
         }
-        let s = 0.5 * (sc / ma + 1.0);
-        let t = 0.5 * (tc / ma + 1.0);
+        Some((face, 0.5 * (sc / ma + 1.0), 0.5 * (tc / ma + 1.0)))
+    }
+
+    /// Radiance seen along world direction `d` (need not be unit).
+    pub fn lookup(&self, d: Vec3) -> Color {
+        let Some((face, s, t)) = CubeMap::face_coordinates(d) else {
+            return Vec3::ZERO;
+        };
         let img = &self.faces[face];
         // OpenGL's t runs down the face image as stored (row 0 at the top).
         let x = (s * img.width as f32) as u32;
