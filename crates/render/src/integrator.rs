@@ -59,7 +59,8 @@ pub trait Integrator: Sync {
     fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color;
 
     /// Whether `radiance_from_hit` uses the first hit it is given; the render loop then traces
-    /// camera rays in packets of 4x2 pixels (`Scene::intersect_lanes`) and hands each hit over.
+    /// a pixel's camera rays (its jittered samples) in packets of up to 8
+    /// (`Scene::intersect_lanes`) and hands each hit over.
     fn takes_first_hit(&self) -> bool {
         false
     }
