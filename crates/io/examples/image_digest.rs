@@ -1,0 +1,107 @@
+//! Prints a digest of the pixels Glint renders for every scene of the course corpus, with
+//! every integrator, at a fixed small size, sample count and seed: one line per scene and
+//! integrator. `scripts/same-images.sh` compares these lines with `scripts/image-digests.txt`
+//! to show that a change to the renderer left every image bit-identical.
+//!
+//! The digest is FNV-1a over the bits of each f32 channel (beauty, then feature layers), so
+//! it does not depend on any file format's metadata.
+//!
+//! ```sh
+//! cargo run --release -p glint-io --example image_digest -- ../shared/scenes/course
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use glint_render::{render, render_with_aovs, IntegratorKind, RenderSettings, Scene};
+
+const WIDTH: u32 = 40;
+const HEIGHT: u32 = 30;
+/// Nine rays per pixel: the course loop's 3x3 jittered grid, traced as ray packets.
+const COURSE_RPP: u32 = 9;
+const PATH_SPP: u32 = 4;
+const SEED: u64 = 7;
+
+fn fnv1a(hash: &mut u64, values: impl IntoIterator<Item = f32>) {
+    for value in values {
+        for byte in value.to_bits().to_le_bytes() {
+            *hash ^= byte as u64;
+            *hash = hash.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+}
+
+fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<_> = std::fs::read_dir(dir)
+        .expect("corpus directory readable")
+        .map(|e| e.expect("directory entry").path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            scene_files(&path, out);
+        } else if matches!(
+            path.extension().and_then(|e| e.to_str()),
+            Some("xml" | "json")
+        ) {
+            out.push(path);
+        }
+    }
+}
+
+fn main() {
+    let dir = PathBuf::from(
+        std::env::args()
+            .nth(1)
+            .unwrap_or_else(|| "../shared/scenes/course".into()),
+    );
+    let mut files = Vec::new();
+    scene_files(&dir, &mut files);
+    for path in &files {
+        let name = path
+            .strip_prefix(&dir)
+            .unwrap()
+            .to_string_lossy()
+            .replace('\\', "/");
+        let loaded = match glint_io::load_scene(path) {
+            Ok(loaded) => loaded,
+            Err(error) => {
+                println!(
+                    "{name} load-error {}",
+                    error.to_string().lines().next().unwrap_or("")
+                );
+                continue;
+            }
+        };
+        let scene = Scene::new(loaded.parts);
+        for (label, integrator) in [
+            ("course", IntegratorKind::Course),
+            ("normals", IntegratorKind::Normals),
+            ("path", IntegratorKind::Path),
+        ] {
+            let settings = RenderSettings {
+                width: WIDTH,
+                height: HEIGHT,
+                rays_per_pixel: if integrator == IntegratorKind::Path {
+                    PATH_SPP
+                } else {
+                    COURSE_RPP
+                },
+                seed: SEED,
+                integrator,
+                ..RenderSettings::default()
+            };
+            let mut hash = 0xcbf2_9ce4_8422_2325u64;
+            let never_cancel = |_: usize, _: usize| true;
+            if integrator == IntegratorKind::Path {
+                let (output, _) = render_with_aovs(&scene, &settings, &never_cancel).unwrap();
+                for film in [&output.beauty, &output.albedo, &output.normal] {
+                    fnv1a(&mut hash, film.to_rgb_f32());
+                }
+            } else {
+                let (film, _) = render(&scene, &settings, &never_cancel).unwrap();
+                fnv1a(&mut hash, film.to_rgb_f32());
+            }
+            println!("{name} {label} {hash:016x}");
+        }
+    }
+}
