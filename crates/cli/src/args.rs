@@ -103,10 +103,11 @@ pub struct Options {
           default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     pub rpp: u32,
 
-    /// Maximum reflection/refraction recursion depth.
-    #[arg(short = 'k', long = "recursionDepth", value_name = "DEPTH", default_value_t = 4,
+    /// Maximum recursion depth: reflection/refraction for the course integrator, scattering
+    /// events for the path tracer [default: 4 for the course, unbounded (1024) for path].
+    #[arg(short = 'k', long = "recursionDepth", value_name = "DEPTH",
           value_parser = clap::value_parser!(u32).range(0..=MAX_DEPTH as i64))]
-    pub recursion_depth: u32,
+    pub recursion_depth: Option<u32>,
 
     /// Render threads [default: all cores].
     #[arg(short = 'n', long = "numcpus", value_name = "THREADS",
@@ -126,8 +127,8 @@ pub struct Options {
     pub seed: u64,
 
     /// `course`: the course's ray tracer. `path`: the physically based path tracer (exactly
-    /// RPP samples per pixel; an .exr output also gets `albedo` and `normal` layers).
-    /// `normals`: a debug view of the normal at the first hit, (n + 1) / 2.
+    /// RPP samples per pixel). Debug views of the first hit: `normals` ((n + 1) / 2),
+    /// `albedo`, `depth`. An .exr output also gets `albedo`, `normal` and `depth` layers.
     #[arg(long, visible_alias = "shader", value_name = "NAME", value_enum,
           default_value_t = IntegratorArg::Course)]
     pub integrator: IntegratorArg,
@@ -166,6 +167,8 @@ pub enum IntegratorArg {
     Course,
     Path,
     Normals,
+    Albedo,
+    Depth,
 }
 
 impl From<IntegratorArg> for IntegratorKind {
@@ -174,6 +177,8 @@ impl From<IntegratorArg> for IntegratorKind {
             IntegratorArg::Course => IntegratorKind::Course,
             IntegratorArg::Normals => IntegratorKind::Normals,
             IntegratorArg::Path => IntegratorKind::Path,
+            IntegratorArg::Albedo => IntegratorKind::Albedo,
+            IntegratorArg::Depth => IntegratorKind::Depth,
         }
     }
 }
@@ -307,20 +312,22 @@ impl Options {
         let settings = RenderSettings {
             width: self.width,
             height: self.height,
-            rays_per_pixel: self.rpp,
+            samples_per_pixel: self.rpp,
             max_depth: self.recursion_depth,
             aspect: self.aspect,
             seed: self.seed,
             integrator: self.integrator.into(),
+            // Feature layers cost a first-hit ray per sample; only an EXR keeps them.
+            features: output_is_exr(&output),
             ..RenderSettings::default()
         };
-        let grid = settings.grid_size();
         // The path tracer takes exactly RPP samples; the course's grid takes N².
-        if settings.integrator != IntegratorKind::Path && grid * grid != self.rpp {
+        let taken = settings.samples_per_pixel();
+        if taken != self.rpp {
+            let grid = (taken as f64).sqrt() as u32;
             notes.push(format!(
-                "-r {} is not a perfect square: using a {grid}x{grid} grid, {} rays per pixel",
+                "-r {} is not a perfect square: using a {grid}x{grid} grid, {taken} rays per pixel",
                 self.rpp,
-                grid * grid
             ));
         }
         Ok(Job {
@@ -350,6 +357,13 @@ fn default_output(scene: &Path) -> Result<PathBuf, UsageError> {
 
 /// Asks glint-io, which decides the format by the extension, before rendering: a typo becomes
 /// an immediate usage error instead of one after the render.
+fn output_is_exr(output: &Path) -> bool {
+    matches!(
+        glint_io::output_format(output),
+        Ok(glint_io::OutputFormat::Exr)
+    )
+}
+
 fn check_output_extension(output: &Path) -> Result<(), UsageError> {
     glint_io::output_format(output).map(|_| ()).map_err(|_| {
         UsageError(format!(
@@ -385,8 +399,8 @@ mod tests {
         assert_eq!(job.scene, PathBuf::from("s.xml"));
         assert_eq!(job.output, PathBuf::from("o.png"));
         assert_eq!((job.settings.width, job.settings.height), (250, 120));
-        assert_eq!(job.settings.rays_per_pixel, 16);
-        assert_eq!(job.settings.max_depth, 6);
+        assert_eq!(job.settings.samples_per_pixel, 16);
+        assert_eq!(job.settings.max_depth, Some(6));
         assert_eq!(job.settings.aspect, Some(1.5));
         assert_eq!(job.threads, 2);
         assert!(job.notes.is_empty());
@@ -405,8 +419,8 @@ mod tests {
         .unwrap();
         assert_eq!(job.output, PathBuf::from("s.png"));
         assert_eq!((job.settings.width, job.settings.height), (100, 100));
-        assert_eq!(job.settings.rays_per_pixel, 4);
-        assert_eq!(job.settings.max_depth, 2);
+        assert_eq!(job.settings.samples_per_pixel, 4);
+        assert_eq!(job.settings.max_depth, Some(2));
         assert_eq!(job.settings.seed, 0);
         assert_eq!(job.settings.integrator, IntegratorKind::Course);
         assert_eq!(job.threads, 8);

@@ -8,7 +8,7 @@ use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::time::{Duration, Instant};
 
 use glint_io::{Diagnostic, ImageWriteError, SceneError};
-use glint_render::{Background, IntegratorKind, RenderStats, Scene};
+use glint_render::{Background, Progress, RenderError, RenderStats, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::{Job, UsageError};
@@ -199,13 +199,7 @@ pub fn run(
 
     let settings = &job.settings;
     if job.verbose {
-        let depth = match settings.integrator {
-            IntegratorKind::Path => format!(
-                "path depth {} (roulette from {})",
-                settings.path.max_depth, settings.path.russian_roulette_depth
-            ),
-            _ => format!("depth {}", settings.max_depth),
-        };
+        let depth = format!("depth {}", settings.max_depth());
         let _ = writeln!(
             err,
             "loaded {} in {:.2} s\nrendering {}x{}, {} samples per pixel, {depth}, seed {}, {} \
@@ -216,51 +210,46 @@ pub fn run(
             settings.height,
             settings.samples_per_pixel(),
             settings.seed,
-            integrator_name(settings.integrator),
+            settings.integrator.name(),
             threads_text(job.threads),
             job.output.display()
         );
     }
 
     let bar = progress_bar.then(|| new_progress_bar(settings.width, settings.height));
-    let progress = |_done: usize, total: usize| {
+    let progress = |report: &Progress| {
         if let Some(bar) = &bar {
-            bar.set_length(total as u64);
+            bar.set_length(report.tiles_total as u64);
             bar.inc(1);
         }
         !interrupt.requested()
     };
     interrupt.set_phase(Phase::Rendering);
     let render_start = Instant::now();
-    // The path tracer also returns albedo and normal layers, which an EXR output keeps.
-    let result = pool.install(|| match settings.integrator {
-        IntegratorKind::Path => glint_render::render_with_aovs(&scene, settings, &progress)
-            .map(|(output, stats)| (output.beauty, Some((output.albedo, output.normal)), stats)),
-        _ => glint_render::render(&scene, settings, &progress)
-            .map(|(film, stats)| (film, None, stats)),
-    });
+    let result = pool.install(|| glint_render::render(&scene, settings, &progress));
     let render_time = render_start.elapsed();
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
     // From here on Ctrl-C no longer stops anything; one that came in before is honoured.
     interrupt.set_phase(Phase::Writing);
-    let (film, feature_layers, stats) = match result {
+    let (film, stats) = match result {
         Ok(rendered) if !interrupt.requested() => rendered,
+        Err(RenderError::Invalid(why)) => return Err(Failure::Usage(UsageError(why))),
         _ => return Err(Failure::Interrupted),
     };
 
-    if stats.nan_samples > 0 {
+    if stats.nonfinite_samples > 0 {
         let first = stats
-            .first_nan_pixel
+            .first_nonfinite_pixel
             .map(|(x, y)| format!("; the first in pixel ({x}, {y}) from the top-left"))
             .unwrap_or_default();
         let _ = writeln!(
             err,
-            "warning: {} sample{} returned NaN and {} left out of the image{first}",
-            stats.nan_samples,
-            plural(stats.nan_samples),
-            if stats.nan_samples == 1 {
+            "warning: {} sample{} returned NaN or infinity and {} left out of the image{first}",
+            stats.nonfinite_samples,
+            plural(stats.nonfinite_samples),
+            if stats.nonfinite_samples == 1 {
                 "was"
             } else {
                 "were"
@@ -268,16 +257,7 @@ pub fn run(
         );
     }
 
-    let write = match (&feature_layers, glint_io::output_format(&job.output)) {
-        (Some((albedo, normal)), Ok(glint_io::OutputFormat::Exr)) => {
-            glint_io::write_image_with_layers(
-                &job.output,
-                &film,
-                &[("albedo", albedo), ("normal", normal)],
-            )
-        }
-        _ => glint_io::write_image(&job.output, &film),
-    };
+    let write = glint_io::write_image(&job.output, &film);
     write.map_err(Failure::Write)?;
 
     let _ = writeln!(err, "{}", closing_line(job, &stats, render_time));
@@ -289,7 +269,7 @@ pub fn run(
 }
 
 fn new_progress_bar(width: u32, height: u32) -> ProgressBar {
-    let tile = glint_render::render::TILE_SIZE;
+    let tile = glint_render::TILE_SIZE;
     let tiles = u64::from(width.div_ceil(tile)) * u64::from(height.div_ceil(tile));
     let bar = ProgressBar::with_draw_target(Some(tiles), ProgressDrawTarget::stderr());
     let style = ProgressStyle::with_template(
@@ -345,14 +325,6 @@ fn plural(count: u64) -> &'static str {
     }
 }
 
-fn integrator_name(kind: IntegratorKind) -> &'static str {
-    match kind {
-        IntegratorKind::Course => "course",
-        IntegratorKind::Normals => "normals",
-        IntegratorKind::Path => "path",
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -394,7 +366,7 @@ mod tests {
             settings: RenderSettings {
                 width: 250,
                 height: 250,
-                rays_per_pixel: 16,
+                samples_per_pixel: 16,
                 ..RenderSettings::default()
             },
             threads: 2,

@@ -12,7 +12,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glint_render::{render, render_with_aovs, IntegratorKind, RenderSettings, Scene};
+use glint_render::{render, IntegratorKind, RenderSettings, Scene};
 
 const WIDTH: u32 = 40;
 const HEIGHT: u32 = 30;
@@ -78,28 +78,23 @@ fn main() {
             ("normals", IntegratorKind::Normals),
             ("path", IntegratorKind::Path),
         ] {
+            let path = integrator == IntegratorKind::Path;
             let settings = RenderSettings {
                 width: WIDTH,
                 height: HEIGHT,
-                rays_per_pixel: if integrator == IntegratorKind::Path {
-                    PATH_SPP
-                } else {
-                    COURSE_RPP
-                },
+                samples_per_pixel: if path { PATH_SPP } else { COURSE_RPP },
                 seed: SEED,
                 integrator,
+                // The path tracer's feature layers are part of what must not change.
+                features: path,
                 ..RenderSettings::default()
             };
             let mut hash = 0xcbf2_9ce4_8422_2325u64;
-            let never_cancel = |_: usize, _: usize| true;
-            if integrator == IntegratorKind::Path {
-                let (output, _) = render_with_aovs(&scene, &settings, &never_cancel).unwrap();
-                for film in [&output.beauty, &output.albedo, &output.normal] {
-                    fnv1a(&mut hash, film.to_rgb_f32());
-                }
-            } else {
-                let (film, _) = render(&scene, &settings, &never_cancel).unwrap();
-                fnv1a(&mut hash, film.to_rgb_f32());
+            let (film, _) = render(&scene, &settings, &|_| true).unwrap();
+            fnv1a(&mut hash, film.to_rgb_f32());
+            if let Some(features) = &film.features {
+                fnv1a(&mut hash, features.albedo.iter().flat_map(|c| c.to_array()));
+                fnv1a(&mut hash, features.normal.iter().flat_map(|n| n.to_array()));
             }
             println!("{name} {label} {hash:016x}");
         }

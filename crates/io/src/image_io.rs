@@ -5,8 +5,7 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use glint_render::film::Film;
-use glint_render::{Color, CubeMap, Image};
+use glint_render::{Color, CubeMap, Film, Image, Vec3};
 
 /// Reads a texture or environment-map image. The course applies no gamma anywhere
 /// (FORMAT.md 1.3), so a texel is its 8-bit value / 255; alpha is dropped.
@@ -135,11 +134,6 @@ pub enum ImageWriteError {
         #[source]
         source: EncodeError,
     },
-    #[error(
-        "cannot write {}: feature layers (albedo, normal) need an .exr output",
-        path.display()
-    )]
-    LayersNeedExr { path: PathBuf },
 }
 
 /// An encoder's own error.
@@ -176,38 +170,23 @@ pub fn output_format(path: &Path) -> Result<OutputFormat, ImageWriteError> {
 }
 
 /// Writes the film to `path`: `.png` as 8-bit RGB with the course's conversion (clamp,
-/// floor(c·255), no gamma: `Film::to_rgb8_course`), `.exr` as linear RGB f32.
+/// floor(c·255), no gamma: `Film::to_rgb8_course`), `.exr` as linear RGB f32 with the film's
+/// feature layers, when it has them, as channels `albedo.R/G/B`, `normal.R/G/B` (what
+/// denoisers take) and `depth.Y`. A PNG holds the beauty alone.
 pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
-    write_image_with_layers(path, film, &[])
-}
-
-/// Writes `film` as `write_image` does, plus named feature layers (a path tracer's `albedo`
-/// and `normal`, what denoisers take) as channels `NAME.R`, `NAME.G`, `NAME.B` of the same
-/// EXR. Layers need an `.exr` name: asking for them with another format is an error rather
-/// than a silent loss.
-pub fn write_image_with_layers(
-    path: &Path,
-    film: &Film,
-    layers: &[(&str, &Film)],
-) -> Result<(), ImageWriteError> {
     let format = output_format(path)?;
-    for candidate in std::iter::once(film).chain(layers.iter().map(|(_, layer)| *layer)) {
-        let expected_pixels = film.width as usize * film.height as usize;
-        if candidate.pixels.len() != expected_pixels
-            || expected_pixels == 0
-            || (candidate.width, candidate.height) != (film.width, film.height)
-        {
-            return Err(ImageWriteError::InvalidFilm {
-                path: path.to_path_buf(),
-                width: candidate.width,
-                height: candidate.height,
-                pixels: candidate.pixels.len(),
-            });
-        }
-    }
-    if format != OutputFormat::Exr && !layers.is_empty() {
-        return Err(ImageWriteError::LayersNeedExr {
+    let expected_pixels = film.width as usize * film.height as usize;
+    let features_fit = film.features.as_ref().is_none_or(|features| {
+        features.albedo.len() == expected_pixels
+            && features.normal.len() == expected_pixels
+            && features.depth.len() == expected_pixels
+    });
+    if film.pixels.len() != expected_pixels || expected_pixels == 0 || !features_fit {
+        return Err(ImageWriteError::InvalidFilm {
             path: path.to_path_buf(),
+            width: film.width,
+            height: film.height,
+            pixels: film.pixels.len(),
         });
     }
     let io_error = |source: std::io::Error| ImageWriteError::Io {
@@ -227,7 +206,7 @@ pub fn write_image_with_layers(
         let mut writer = BufWriter::new(temporary.as_file_mut());
         match format {
             OutputFormat::Png => encode_png(film, &mut writer),
-            OutputFormat::Exr => encode_exr(film, layers, &mut writer),
+            OutputFormat::Exr => encode_exr(film, &mut writer),
         }
         .map_err(|source| ImageWriteError::Encode {
             path: path.to_path_buf(),
@@ -251,38 +230,33 @@ fn encode_png(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), Enco
     Ok(())
 }
 
-/// One EXR part with f32 channels R, G, B (the beauty) and `NAME.R/G/B` for each layer,
-/// rows from the top, as the `exr` crate stores them.
-fn encode_exr(
-    film: &Film,
-    layers: &[(&str, &Film)],
-    writer: &mut BufWriter<&mut File>,
-) -> Result<(), EncodeError> {
+/// One EXR part with f32 channels R, G, B (the beauty) and the feature layers' channels, rows
+/// from the top, as the `exr` crate stores them.
+fn encode_exr(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), EncodeError> {
     use exr::prelude::{
         AnyChannel, AnyChannels, Encoding, FlatSamples, Image as ExrImage, Layer, LayerAttributes,
         WritableImage,
     };
-    let channel = |name: String, film: &Film, component: usize| {
-        AnyChannel::new(
-            name.as_str(),
-            FlatSamples::F32(
-                film.pixels
-                    .iter()
-                    .map(|p| p.to_array()[component])
-                    .collect(),
-            ),
-        )
+    let rgb = |prefix: &str,
+               values: &[Vec3],
+               channels: &mut smallvec::SmallVec<[AnyChannel<FlatSamples>; 4]>| {
+        for (component, suffix) in ["R", "G", "B"].into_iter().enumerate() {
+            let samples = values.iter().map(|p| p.to_array()[component]).collect();
+            channels.push(AnyChannel::new(
+                format!("{prefix}{suffix}").as_str(),
+                FlatSamples::F32(samples),
+            ));
+        }
     };
     let mut channels = smallvec::SmallVec::new();
-    for (prefix, source) in std::iter::once(("", film)).chain(layers.iter().copied()) {
-        for (component, suffix) in ["R", "G", "B"].into_iter().enumerate() {
-            let name = if prefix.is_empty() {
-                suffix.to_owned()
-            } else {
-                format!("{prefix}.{suffix}")
-            };
-            channels.push(channel(name, source, component));
-        }
+    rgb("", &film.pixels, &mut channels);
+    if let Some(features) = &film.features {
+        rgb("albedo.", &features.albedo, &mut channels);
+        rgb("normal.", &features.normal, &mut channels);
+        channels.push(AnyChannel::new(
+            "depth.Y",
+            FlatSamples::F32(features.depth.clone()),
+        ));
     }
     let layer = Layer::new(
         (film.width as usize, film.height as usize),

@@ -85,14 +85,14 @@ fn every_corpus_scene_loads_and_renders_without_nan() {
         let settings = RenderSettings {
             width: 24,
             height: 24,
-            rays_per_pixel: 4,
+            samples_per_pixel: 4,
             ..RenderSettings::default()
         };
-        let (film, stats) = render(&scene, &settings, &|_, _| true).expect("not cancelled");
-        if stats.nan_samples > 0 || film.pixels.iter().any(|p| p.has_nan()) {
+        let (film, stats) = render(&scene, &settings, &|_| true).expect("not cancelled");
+        if stats.nonfinite_samples > 0 || film.pixels.iter().any(|p| p.has_nan()) {
             failures.push(format!(
                 "{relative}: {} NaN samples, first at {:?}",
-                stats.nan_samples, stats.first_nan_pixel
+                stats.nonfinite_samples, stats.first_nonfinite_pixel
             ));
         }
         println!("{relative}: ok ({} rays)", stats.rays);
@@ -127,7 +127,7 @@ fn example_scenes_load_cleanly() {
             height: 12,
             ..RenderSettings::default()
         };
-        let (film, _) = render(&scene, &settings, &|_, _| true).expect("not cancelled");
+        let (film, _) = render(&scene, &settings, &|_| true).expect("not cancelled");
         assert!(film.pixels.iter().any(|p| p.max_component() > 0.0));
     }
 }
@@ -143,7 +143,7 @@ fn images_do_not_depend_on_the_thread_count() {
     let settings = RenderSettings {
         width: 40,
         height: 30,
-        rays_per_pixel: 9,
+        samples_per_pixel: 9,
         seed: 11,
         ..RenderSettings::default()
     };
@@ -152,7 +152,7 @@ fn images_do_not_depend_on_the_thread_count() {
             .num_threads(threads)
             .build()
             .expect("thread pool");
-        pool.install(|| render(&scene, &settings, &|_, _| true).expect("not cancelled"))
+        pool.install(|| render(&scene, &settings, &|_| true).expect("not cancelled"))
             .0
     };
     let one = render_on(1);
@@ -169,6 +169,6 @@ fn images_do_not_depend_on_the_thread_count() {
         seed: 12,
         ..settings
     };
-    let (different, _) = render(&scene, &other_seed, &|_, _| true).expect("not cancelled");
+    let (different, _) = render(&scene, &other_seed, &|_| true).expect("not cancelled");
     assert_ne!(bits(&one), bits(&different), "the seed must matter");
 }

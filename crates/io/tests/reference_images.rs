@@ -59,10 +59,10 @@ fn render_course(scene_path: &Path, width: u32, height: u32, rays_per_pixel: u32
     let settings = RenderSettings {
         width,
         height,
-        rays_per_pixel,
+        samples_per_pixel: rays_per_pixel,
         ..RenderSettings::default()
     };
-    let (film, _) = render(&scene, &settings, &|_, _| true).expect("not cancelled");
+    let (film, _) = render(&scene, &settings, &|_| true).expect("not cancelled");
     film.to_rgb8_course()
 }
 

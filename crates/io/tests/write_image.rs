@@ -4,13 +4,10 @@
 use std::path::Path;
 
 use glint_io::{write_image, ImageWriteError};
-use glint_render::film::Film;
-use glint_render::Vec3;
+use glint_render::{Film, Vec3};
 
 fn film() -> Film {
     Film {
-        width: 3,
-        height: 2,
         pixels: vec![
             Vec3::new(0.5, 1.2, -0.1),
             Vec3::new(f32::NAN, 0.999, 1.0 / 255.0),
@@ -19,6 +16,7 @@ fn film() -> Film {
             Vec3::splat(0.2),
             Vec3::new(3.5, 0.1, 0.9),
         ],
+        ..Film::new(3, 2)
     }
 }
 
@@ -86,9 +84,8 @@ fn a_failed_write_leaves_the_old_file_untouched() {
     let path = directory.path().join("out.png");
     std::fs::write(&path, b"previous image").unwrap();
     let broken = Film {
-        width: 4,
-        height: 4,
         pixels: vec![Vec3::ZERO; 3],
+        ..Film::new(4, 4)
     };
     let error = write_image(&path, &broken).unwrap_err();
     assert!(

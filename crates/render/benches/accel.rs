@@ -156,7 +156,7 @@ fn frame(c: &mut Criterion) {
     group.sample_size(10);
     group.bench_function("instanced-dragon-128", |b| {
         b.iter(|| {
-            glint_render::render(&scene, &settings, &|_, _| true).map(|(film, _)| film.pixels.len())
+            glint_render::render(&scene, &settings, &|_| true).map(|(film, _)| film.pixels.len())
         })
     });
     group.finish();

@@ -1,24 +1,54 @@
-//! The image being rendered: linear RGB f32, row 0 at the top.
+//! The rendered image: linear RGB f32, row 0 at the top, with optional feature layers.
 
-use crate::math::Color;
+use crate::math::{Color, Vec3};
 
+/// What `render` returns: the pixels of the rendered rectangle (the whole image, or the crop
+/// window / farm tile of `RenderSettings::pixel_bounds`), linear RGB, each the mean of its
+/// finite samples.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Film {
+    /// Size of `pixels`: the rendered rectangle (the data window).
     pub width: u32,
     pub height: u32,
-    /// `width * height` pixels, row-major from the top-left.
+    /// `width * height` pixels, row-major from the rectangle's top-left.
     pub pixels: Vec<Color>,
+    /// Where the rectangle's top-left pixel sits in the whole image.
+    pub origin: (u32, u32),
+    /// Size of the whole image (the display window).
+    pub full_size: (u32, u32),
+    /// First-hit feature layers, when `RenderSettings::features` asked for them.
+    pub features: Option<Features>,
+}
+
+/// First-hit feature layers, each averaged over the pixel's samples and laid out as
+/// `Film::pixels`: what a denoiser takes (Intel Open Image Denoise's `albedo` and `normal`),
+/// plus depth.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Features {
+    /// Reflectance of the first surface hit; an emitter's radiance clamped to [0, 1] where the
+    /// surface only emits, the background clamped to [0, 1] where the ray escapes.
+    pub albedo: Vec<Color>,
+    /// World-space geometric normal of the first hit, facing the camera; zero where the ray
+    /// escapes.
+    pub normal: Vec<Vec3>,
+    /// Distance from the camera to the first hit in scene units; zero where the ray escapes.
+    pub depth: Vec<f32>,
 }
 
 impl Film {
+    /// A black `width` x `height` image (the whole of itself), without features.
     pub fn new(width: u32, height: u32) -> Film {
         Film {
             width,
             height,
             pixels: vec![Color::ZERO; width as usize * height as usize],
+            origin: (0, 0),
+            full_size: (width, height),
+            features: None,
         }
     }
 
+    /// The pixel at (`x`, `y`) from the rectangle's top-left.
     #[inline]
     pub fn pixel(&self, x: u32, y: u32) -> Color {
         self.pixels[(y * self.width + x) as usize]
@@ -40,7 +70,7 @@ impl Film {
             .collect()
     }
 
-    /// Interleaved RGB f32 (for EXR).
+    /// Interleaved RGB f32 (for EXR and arrays).
     pub fn to_rgb_f32(&self) -> Vec<f32> {
         self.pixels.iter().flat_map(|c| c.to_array()).collect()
     }

@@ -25,11 +25,12 @@ pub use texture::{ColorSource, CubeMap, Image, TextureId};
 pub mod film;
 pub mod integrator;
 pub mod light_sampling;
-pub mod path;
 pub mod path_sampler;
-pub mod render;
+mod pipeline;
 pub mod sampling;
 
-pub use film::Film;
-pub use path::{render_with_aovs, PathIntegrator, PathOutput, PathSettings};
-pub use render::{render, Cancelled, IntegratorKind, RenderSettings, RenderStats};
+pub use film::{Features, Film};
+pub use pipeline::{
+    render, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings, RenderStats,
+    TILE_SIZE,
+};

@@ -273,7 +273,7 @@ fn unit_float(bits: u32) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::integrator::permute;
+    use crate::integrator::course::permute;
 
     #[test]
     fn first_points_are_stratified() {

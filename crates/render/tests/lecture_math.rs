@@ -8,7 +8,7 @@
 use glint_render::geometry::{
     intersect_box, intersect_sphere, intersect_triangle, slab_interval, PrimitiveHit,
 };
-use glint_render::integrator::{reflect, refract, schlick};
+use glint_render::integrator::course::{reflect, refract, schlick};
 use glint_render::ray::SPAWN_EPSILON;
 use glint_render::sampling::{sample_uniform_sphere, Rng};
 use glint_render::{

@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glint_render::integrator::{CourseIntegrator, Integrator, SampleContext};
+use glint_render::integrator::course::{shade_camera_ray, SampleContext};
 use glint_render::sampling::Rng;
 use glint_render::{render, Color, RenderSettings, Scene};
 
@@ -22,8 +22,8 @@ fn course_scene(relative: &str) -> Scene {
 fn single_ray_frame(scene: &Scene, settings: &RenderSettings) -> (Vec<Color>, u64) {
     let (width, height) = (settings.width, settings.height);
     let aspect = settings.aspect.unwrap_or(width as f32 / height as f32);
-    let grid = settings.grid_size();
-    let samples = grid * grid;
+    let samples = settings.samples_per_pixel();
+    let grid = (samples as f64).sqrt() as u32;
     let mut pixels = Vec::new();
     let mut rays = 0;
     for y in 0..height {
@@ -49,12 +49,12 @@ fn single_ray_frame(scene: &Scene, settings: &RenderSettings) -> (Vec<Color>, u6
                     sample_index: s,
                     grid_size: grid,
                     pixel_key: pixel_index ^ settings.seed.rotate_left(32),
-                    max_depth: settings.max_depth,
+                    max_depth: settings.max_depth(),
                     rays: 1,
                 };
-                let c = CourseIntegrator.radiance(scene, &ray, &mut ctx);
+                let c = shade_camera_ray(scene, &ray, &mut ctx);
                 rays += ctx.rays;
-                if !c.has_nan() {
+                if c.is_finite() {
                     sum += c;
                     valid += 1;
                 }
@@ -74,11 +74,11 @@ fn check(relative: &str, size: u32, rays_per_pixel: u32) {
     let settings = RenderSettings {
         width: size,
         height: size * 3 / 4,
-        rays_per_pixel,
+        samples_per_pixel: rays_per_pixel,
         seed: 7,
         ..RenderSettings::default()
     };
-    let (film, stats) = render(&scene, &settings, &|_, _| true).expect("not cancelled");
+    let (film, stats) = render(&scene, &settings, &|_| true).expect("not cancelled");
     let (expected, rays) = single_ray_frame(&scene, &settings);
     assert_eq!(stats.rays, rays, "{relative}: rays traced");
     for (k, (a, b)) in film.pixels.iter().zip(&expected).enumerate() {

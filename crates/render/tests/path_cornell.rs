@@ -64,13 +64,17 @@ fn render(scene: &Scene, samples: u32, seed: u64) -> Vec<[f64; 3]> {
     let settings = RenderSettings {
         width: SIZE,
         height: SIZE,
-        rays_per_pixel: samples,
+        samples_per_pixel: samples,
         seed,
         integrator: IntegratorKind::Path,
         ..RenderSettings::default()
     };
-    let (film, stats) = glint_render::render(scene, &settings, &|_, _| true).unwrap();
-    assert_eq!(stats.nan_samples, 0, "first at {:?}", stats.first_nan_pixel);
+    let (film, stats) = glint_render::render(scene, &settings, &|_| true).unwrap();
+    assert_eq!(
+        stats.nonfinite_samples, 0,
+        "first at {:?}",
+        stats.first_nonfinite_pixel
+    );
     film.pixels
         .iter()
         .map(|c: &Color| [c.x as f64, c.y as f64, c.z as f64])

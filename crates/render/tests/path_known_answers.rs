@@ -4,12 +4,12 @@
 //! light, a triangle emitter and a sphere emitter, plus the render-loop properties the path
 //! tracer promises (thread-count independence, no allocation per sample, denoiser features).
 
-use glint_render::path::FirstHit;
+use glint_render::integrator::path::{PathIntegrator, PathSettings};
+use glint_render::integrator::FirstHit;
 use glint_render::sampling::Rng;
 use glint_render::{
-    render_with_aovs, Background, Camera, Color, GeometryDesc, Instance, IntegratorKind, Light,
-    Material, PathIntegrator, PathSettings, Projection, Ray, RenderSettings, Scene, SceneParts,
-    Shape, Vec3,
+    render, Background, Camera, Color, GeometryDesc, Instance, IntegratorKind, Light, Material,
+    Projection, Ray, RenderSettings, Scene, SceneParts, Shape, Vec3,
 };
 
 fn instance(geometry: u32, casts_shadow: bool) -> Instance {
@@ -54,9 +54,10 @@ fn path_settings(size: u32, samples: u32) -> RenderSettings {
     RenderSettings {
         width: size,
         height: size,
-        rays_per_pixel: samples,
+        samples_per_pixel: samples,
         seed: 11,
         integrator: IntegratorKind::Path,
+        features: true,
         ..RenderSettings::default()
     }
 }
@@ -65,13 +66,14 @@ fn path_settings(size: u32, samples: u32) -> RenderSettings {
 /// channels) and the mean of the sphere's pixels minus 1.
 fn furnace_errors(material: Material, size: u32, samples: u32) -> (f32, f32) {
     let scene = furnace(material);
-    let (output, stats) = render_with_aovs(&scene, &path_settings(size, samples), &|_, _| true)
-        .expect("not cancelled");
-    assert_eq!(stats.nan_samples, 0);
+    let (film, stats) =
+        render(&scene, &path_settings(size, samples), &|_| true).expect("not cancelled");
+    let normals = &film.features.as_ref().expect("features").normal;
+    assert_eq!(stats.nonfinite_samples, 0);
     let mut worst = 0.0f32;
     let mut sum = 0.0f64;
     let mut sphere_pixels = 0;
-    for (pixel, normal) in output.beauty.pixels.iter().zip(&output.normal.pixels) {
+    for (pixel, normal) in film.pixels.iter().zip(normals) {
         for channel in pixel.to_array() {
             worst = worst.max((channel - 1.0).abs());
         }
@@ -422,15 +424,19 @@ fn same_image_on_any_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| render_with_aovs(&scene, &settings, &|_, _| true).unwrap())
+            .install(|| render(&scene, &settings, &|_| true).unwrap())
     };
     let (one, one_stats) = render_on(1);
     let (three, three_stats) = render_on(3);
     assert_eq!(one, three);
     assert_eq!(one_stats, three_stats);
-    // `render` with the Path kind gives the same beauty image.
-    let (film, _) = glint_render::render(&scene, &settings, &|_, _| true).unwrap();
-    assert_eq!(film, one.beauty);
+    // Without feature layers, the same beauty image.
+    let plain = RenderSettings {
+        features: false,
+        ..settings.clone()
+    };
+    let (film, _) = render(&scene, &plain, &|_| true).unwrap();
+    assert_eq!(film.pixels, one.pixels);
 }
 
 #[test]
@@ -455,8 +461,9 @@ fn denoiser_features() {
         geometries: vec![geometry],
         instances: vec![instance(0, true)],
     });
-    let (output, _) = render_with_aovs(&scene, &path_settings(8, 4), &|_, _| true).unwrap();
-    for (albedo, normal) in output.albedo.pixels.iter().zip(&output.normal.pixels) {
+    let (film, _) = render(&scene, &path_settings(8, 4), &|_| true).unwrap();
+    let features = film.features.expect("features");
+    for (albedo, normal) in features.albedo.iter().zip(&features.normal) {
         assert!((*albedo - Color::new(0.2, 0.4, 0.6)).abs().max_component() < 1e-6);
         assert!((*normal - Vec3::Z).abs().max_component() < 1e-6);
     }

@@ -9,11 +9,12 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use glint_render::path::FirstHit;
+use glint_render::integrator::path::{PathIntegrator, PathSettings};
+use glint_render::integrator::FirstHit;
 use glint_render::sampling::Rng;
 use glint_render::{
-    Background, Camera, Color, CubeMap, GeometryDesc, Image, Instance, Light, Material,
-    PathIntegrator, PathSettings, Projection, Scene, SceneParts, Shape, Vec3,
+    Background, Camera, Color, CubeMap, GeometryDesc, Image, Instance, Light, Material, Projection,
+    Scene, SceneParts, Shape, Vec3,
 };
 
 struct CountingAllocator;

@@ -136,12 +136,12 @@ fn render_path(scene: &Scene) -> Vec<Color> {
     let settings = RenderSettings {
         width: 24,
         height: 24,
-        rays_per_pixel: 4,
+        samples_per_pixel: 4,
         seed: 3,
         integrator: IntegratorKind::Path,
         ..Default::default()
     };
-    render(scene, &settings, &|_, _| true).unwrap().0.pixels
+    render(scene, &settings, &|_| true).unwrap().0.pixels
 }
 
 #[test]

@@ -15,15 +15,15 @@
 //! count, and nothing on the per-sample path allocates: the BSDF lives on the stack and the
 //! light distributions are built once by `PathIntegrator::new`.
 
+use std::ops::Range;
+
 use crate::bsdf::{Bsdf, Frame};
-use crate::film::Film;
-use crate::integrator::{Integrator, SampleContext};
+use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 use crate::light_sampling::LightSampler;
 use crate::material::{Material, MaterialId};
-use crate::math::{Color, Vec3};
+use crate::math::Color;
 use crate::path_sampler::{PathSampler, SobolPixel};
 use crate::ray::Ray;
-use crate::render::{render_tiles, Cancelled, RenderSettings, RenderStats};
 use crate::scene::Scene;
 
 /// Path-length controls of the path tracer.
@@ -38,32 +38,26 @@ pub struct PathSettings {
     pub russian_roulette_depth: u32,
 }
 
+/// The path tracer's depth cap when `-k` is not given.
+pub(crate) const DEFAULT_MAX_DEPTH: u32 = 1024;
+
 impl Default for PathSettings {
     fn default() -> Self {
         PathSettings {
-            max_depth: 1024,
+            max_depth: DEFAULT_MAX_DEPTH,
             russian_roulette_depth: 5,
         }
     }
 }
 
-/// What the camera ray's first hit contributes to the denoiser features.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct FirstHit {
-    /// The surface's reflectance (`Bsdf::albedo`), an emitter's radiance clamped to [0, 1] if
-    /// it does not reflect, the background clamped to [0, 1] where the ray escapes.
-    pub albedo: Color,
-    /// World-space geometric normal facing the camera; zero where the ray escapes.
-    pub normal: Vec3,
-}
-
-/// The beauty image and the first-hit feature images a denoiser takes (OIDN's `color`,
-/// `albedo` and `normal`), all linear and averaged over the pixel's samples.
-#[derive(Clone, Debug, PartialEq)]
-pub struct PathOutput {
-    pub beauty: Film,
-    pub albedo: Film,
-    pub normal: Film,
+impl PathSettings {
+    /// The default settings with the depth cap `max_depth`.
+    pub fn with_max_depth(max_depth: u32) -> PathSettings {
+        PathSettings {
+            max_depth,
+            ..PathSettings::default()
+        }
+    }
 }
 
 /// The path tracer with its per-render preprocessing (light selection by power, triangle and
@@ -281,6 +275,7 @@ impl PathIntegrator {
             };
             if depth == 0 {
                 first_hit.normal = if wo.z < 0.0 { -si.normal } else { si.normal };
+                first_hit.depth = hit.t;
                 if !bsdf.is_black() {
                     first_hit.albedo = bsdf.albedo();
                 }
@@ -361,13 +356,26 @@ impl PathIntegrator {
 }
 
 impl Integrator for PathIntegrator {
-    fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color {
-        let mut rays = 0;
-        let mut first_hit = FirstHit::default();
-        let color = self.trace(scene, ray, &mut ctx.rng, &mut rays, &mut first_hit);
-        // The render loop counted the camera ray already.
-        ctx.rays += rays.saturating_sub(1);
-        color
+    fn pixel_samples(
+        &self,
+        scene: &Scene,
+        pixel: &PixelContext,
+        samples: Range<u32>,
+        rays: &mut u64,
+        sink: &mut impl FnMut(Sample),
+    ) {
+        let sobol = SobolPixel::new(pixel.seed, pixel.index(), pixel.samples_per_pixel);
+        for s in samples {
+            let mut sampler = sobol.sampler(s);
+            let (ox, oy) = sampler.sample_2d(0);
+            let ray = pixel.camera_ray(scene, ox, oy);
+            let mut first_hit = FirstHit::default();
+            let radiance = self.trace(scene, &ray, &mut sampler, rays, &mut first_hit);
+            sink(Sample {
+                radiance,
+                features: pixel.features.then_some(first_hit),
+            });
+        }
     }
 }
 
@@ -376,69 +384,3 @@ impl Integrator for PathIntegrator {
 pub const FIRST_PATH_DIMENSION: u32 = 2;
 /// Per path vertex: light and point on it (2), lobe, direction (2), roulette.
 const DIMENSIONS_PER_VERTEX: u32 = 6;
-
-/// Renders `scene` with the path tracer: `settings.rays_per_pixel` samples per pixel (exactly
-/// that many: `--spp`), `settings.path` for path lengths. Returns the beauty image with albedo
-/// and normal feature images. `progress(tiles_done, tiles_total)` may cancel, as in `render`.
-/// Samples that come out NaN or infinite are dropped from the average and counted in
-/// `RenderStats::nan_samples`.
-pub fn render_with_aovs(
-    scene: &Scene,
-    settings: &RenderSettings,
-    progress: &(dyn Fn(usize, usize) -> bool + Sync),
-) -> Result<(PathOutput, RenderStats), Cancelled> {
-    let integrator = PathIntegrator::new(scene, settings.path);
-    let (width, height) = (settings.width, settings.height);
-    let aspect = settings.aspect.unwrap_or(width as f32 / height as f32);
-    let samples = settings.samples_per_pixel();
-    let (pixels, stats) = render_tiles(settings, progress, |x, y, counters| {
-        let pixel_index = y as u64 * width as u64 + x as u64;
-        // The camera's j counts rows from the bottom; film row 0 is the top.
-        let j = height - 1 - y;
-        let mut sum = Color::ZERO;
-        let mut albedo = Color::ZERO;
-        let mut normal = Vec3::ZERO;
-        let mut valid = 0u32;
-        let sobol = SobolPixel::new(settings.seed, pixel_index, samples);
-        for s in 0..samples {
-            let mut sampler = sobol.sampler(s);
-            let (ox, oy) = sampler.sample_2d(0);
-            let ray = scene
-                .camera
-                .ray(x as f32 + ox, j as f32 + oy, width, height, aspect);
-            let mut first_hit = FirstHit::default();
-            let c = integrator.trace(
-                scene,
-                &ray,
-                &mut sampler,
-                &mut counters.rays,
-                &mut first_hit,
-            );
-            albedo += first_hit.albedo;
-            normal += first_hit.normal;
-            if c.is_finite() {
-                sum += c;
-                valid += 1;
-            } else {
-                counters.dropped_sample(pixel_index);
-            }
-        }
-        let beauty = if valid > 0 {
-            sum / valid as f32
-        } else {
-            Color::ZERO
-        };
-        [beauty, albedo / samples as f32, normal / samples as f32]
-    })?;
-    let film = |layer: usize| Film {
-        width,
-        height,
-        pixels: pixels.iter().map(|p| p[layer]).collect(),
-    };
-    let output = PathOutput {
-        beauty: film(0),
-        albedo: film(1),
-        normal: film(2),
-    };
-    Ok((output, stats))
-}

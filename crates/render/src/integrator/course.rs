@@ -1,4 +1,12 @@
-//! Integrators: the course's recursive ray tracer and debug views.
+//! The course's recursive ray tracer (slide001; FORMAT.md 4), and the course family's sample
+//! placement that the debug views share: sample s of a pixel sits in cell (s mod N, s div N)
+//! of the lecture's N x N jittered grid (the pixel centre with one sample), with its own
+//! random stream keyed by (seed, pixel, s).
+
+use std::ops::Range;
+
+use crate::accel::PACKET;
+use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 
 use crate::light::Light;
 use crate::material::Material;
@@ -52,31 +60,6 @@ pub fn permute(i: u32, n: u32, seed: u32) -> u32 {
         return 0;
     }
     crate::path_sampler::permute_with(i, n, crate::path_sampler::permute_mask(n), seed, seed % n)
-}
-
-/// Computes the radiance arriving along a camera ray.
-pub trait Integrator: Sync {
-    fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color;
-
-    /// Whether `radiance_from_hit` uses the first hit it is given; the render loop then traces
-    /// a pixel's camera rays (its jittered samples) in packets of up to 8
-    /// (`Scene::intersect_lanes`) and hands each hit over.
-    fn takes_first_hit(&self) -> bool {
-        false
-    }
-
-    /// `radiance` when the camera ray's first intersection, `first` = `scene.intersect(ray)`,
-    /// is already known. Must return exactly what `radiance` returns.
-    fn radiance_from_hit(
-        &self,
-        scene: &Scene,
-        ray: &Ray,
-        first: Option<Hit>,
-        ctx: &mut SampleContext,
-    ) -> Color {
-        let _ = first;
-        self.radiance(scene, ray, ctx)
-    }
 }
 
 /// Mirror reflection of direction `d` about unit normal `n`: r = d − 2(d·n)n (slide001 p.105).
@@ -235,26 +218,115 @@ fn triangle_area(t: &[Vec3; 3]) -> f32 {
 /// with no light falloff, shadow rays with epsilon 1e-3, mirror/glaze/dielectric recursion up
 /// to `max_depth`, and `Diffuse` as a Monte Carlo surface lit by background and emitters.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct CourseIntegrator;
+pub(crate) struct CourseIntegrator;
+
+impl CourseIntegrator {
+    pub fn new(_scene: &Scene) -> CourseIntegrator {
+        CourseIntegrator
+    }
+}
 
 impl Integrator for CourseIntegrator {
-    fn radiance(&self, scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color {
-        ray_color(scene, ray, 0, true, ctx)
-    }
-
-    fn takes_first_hit(&self) -> bool {
-        true
-    }
-
-    fn radiance_from_hit(
+    fn pixel_samples(
         &self,
         scene: &Scene,
-        ray: &Ray,
-        first: Option<Hit>,
-        ctx: &mut SampleContext,
-    ) -> Color {
-        shade(scene, ray, first, 0, true, ctx)
+        pixel: &PixelContext,
+        samples: Range<u32>,
+        rays: &mut u64,
+        sink: &mut impl FnMut(Sample),
+    ) {
+        grid_samples(
+            scene,
+            pixel,
+            samples,
+            rays,
+            sink,
+            Some(&|ray, first, ctx| shade(scene, ray, first, 0, true, ctx)),
+            &|ray, ctx| shade_camera_ray(scene, ray, ctx),
+        );
     }
+}
+
+/// The shading of a camera ray whose first hit is already known (traced in a packet).
+pub(crate) type ShadeFirstHit<'a> = &'a dyn Fn(&Ray, Option<Hit>, &mut SampleContext) -> Color;
+
+/// The course family's pixel samples `samples` of `pixel`: the camera ray of each on the
+/// jittered grid, its radiance from `radiance`, handed to `sink` in order. With
+/// `from_first_hit`, nine or more samples travel as packets of eight camera rays
+/// (`Scene::intersect_lanes`) and each hit is handed over; the samples are the same. (Fewer
+/// than eight samples, 1 or 4, go ray by ray: half-empty packets did not pay.)
+pub(crate) fn grid_samples(
+    scene: &Scene,
+    pixel: &PixelContext,
+    samples: Range<u32>,
+    rays: &mut u64,
+    sink: &mut impl FnMut(Sample),
+    from_first_hit: Option<ShadeFirstHit>,
+    radiance: &dyn Fn(&Ray, &mut SampleContext) -> Color,
+) {
+    let pixel_index = pixel.index();
+    let all = pixel.samples_per_pixel;
+    let grid = crate::pipeline::grid_size(all);
+    // Sample `s`: its camera ray and context.
+    let camera_sample = |s: u32| {
+        let mut rng = Rng::for_sample(pixel.seed, pixel_index, s as u64);
+        let (p, q) = (s % grid, s / grid);
+        // Pixel centre with one sample (FORMAT.md 4.4); jittered grid otherwise.
+        let (ox, oy) = if all == 1 {
+            (0.5, 0.5)
+        } else {
+            (
+                (p as f32 + rng.next_f32()) / grid as f32,
+                (q as f32 + rng.next_f32()) / grid as f32,
+            )
+        };
+        let ray = pixel.camera_ray(scene, ox, oy);
+        let ctx = SampleContext {
+            rng,
+            sample_index: s,
+            grid_size: grid,
+            pixel_key: pixel_index ^ pixel.seed.rotate_left(32),
+            max_depth: pixel.max_depth,
+            rays: 1,
+        };
+        (ray, ctx)
+    };
+    let mut emit = |radiance: Color, ray: &Ray, ctx: &SampleContext, rays: &mut u64| {
+        *rays += ctx.rays;
+        let features = pixel.features.then(|| FirstHit::trace(scene, ray, rays));
+        sink(Sample { radiance, features });
+    };
+    match from_first_hit {
+        Some(shade_hit) if all >= PACKET as u32 => {
+            let mut first = samples.start;
+            while first < samples.end {
+                let count = (samples.end - first).min(PACKET as u32) as usize;
+                let mut taken: [Option<(Ray, SampleContext)>; PACKET] = Default::default();
+                for (l, t) in taken.iter_mut().enumerate().take(count) {
+                    *t = Some(camera_sample(first + l as u32));
+                }
+                let packet = std::array::from_fn(|l| taken[l.min(count - 1)].as_ref().unwrap().0);
+                let hits = scene.intersect_lanes(&packet, ((1u32 << count) - 1) as u8);
+                for (l, (ray, mut ctx)) in taken.into_iter().flatten().enumerate() {
+                    let c = shade_hit(&ray, hits[l], &mut ctx);
+                    emit(c, &ray, &ctx, rays);
+                }
+                first += count as u32;
+            }
+        }
+        _ => {
+            for s in samples {
+                let (ray, mut ctx) = camera_sample(s);
+                let c = radiance(&ray, &mut ctx);
+                emit(c, &ray, &ctx, rays);
+            }
+        }
+    }
+}
+
+/// The course integrator's radiance along a camera ray, traced on its own.
+pub fn shade_camera_ray(scene: &Scene, ray: &Ray, ctx: &mut SampleContext) -> Color {
+    ray_color(scene, ray, 0, true, ctx)
 }
 
 /// `count_emission` is false on Diffuse bounce rays: emitters were already sampled directly
@@ -632,18 +704,4 @@ fn diffuse_surface(
         sum += kd.mul_elem(incoming);
     }
     sum
-}
-
-/// Debug view: the world-space geometric normal at the first hit as colour, (n + 1) / 2;
-/// black where the ray leaves the scene. Selected with `--shader normals`.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct NormalsIntegrator;
-
-impl Integrator for NormalsIntegrator {
-    fn radiance(&self, scene: &Scene, ray: &Ray, _ctx: &mut SampleContext) -> Color {
-        match scene.intersect(ray) {
-            Some(hit) => (scene.surface(ray, &hit).normal + Vec3::ONE) * 0.5,
-            None => Color::ZERO,
-        }
-    }
 }

@@ -1,0 +1,156 @@
+//! Integrators: what one pixel sample sees. The pipeline (`crate::pipeline`) asks an
+//! integrator for a pixel's samples and does everything else with them (averaging, dropping
+//! non-finite values, feature layers, tiles, progress).
+//!
+//! - `course`: the course's recursive ray tracer and the course family's sample placement
+//!   (the N x N jittered grid, camera rays in packets of eight).
+//! - `path`: the physically based path tracer (Sobol' samples).
+//! - `debug`: normals, albedo and depth views on the course family's samples.
+
+pub mod course;
+pub mod debug;
+pub mod path;
+
+use std::ops::Range;
+
+use crate::bsdf::Bsdf;
+use crate::material::Material;
+use crate::math::{Color, Vec3};
+use crate::ray::Ray;
+use crate::scene::Scene;
+
+pub(crate) use course::CourseIntegrator;
+
+/// One pixel as an integrator sees it.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PixelContext {
+    /// The pixel, from the top-left of the whole image.
+    pub x: u32,
+    pub y: u32,
+    /// The whole image.
+    pub width: u32,
+    pub height: u32,
+    pub aspect: f32,
+    pub seed: u64,
+    /// Samples the pixel takes in the whole render (stratification spans all of them, so a
+    /// sample range sees each sample exactly as the whole render does).
+    pub samples_per_pixel: u32,
+    pub max_depth: u32,
+    /// Whether samples should carry first-hit features.
+    pub features: bool,
+}
+
+impl PixelContext {
+    /// The row-major index of the pixel in the whole image: with the seed and the sample
+    /// index, the key of every random number.
+    #[inline]
+    pub fn index(&self) -> u64 {
+        self.y as u64 * self.width as u64 + self.x as u64
+    }
+
+    /// The camera ray through (`ox`, `oy`) in [0, 1)² within the pixel.
+    #[inline]
+    pub fn camera_ray(&self, scene: &Scene, ox: f32, oy: f32) -> Ray {
+        // The lecture's j counts rows from the bottom; film row 0 is the top.
+        let j = self.height - 1 - self.y;
+        scene.camera.ray(
+            self.x as f32 + ox,
+            j as f32 + oy,
+            self.width,
+            self.height,
+            self.aspect,
+        )
+    }
+}
+
+/// What the camera ray's first hit contributes to the feature layers a denoiser takes (Intel
+/// Open Image Denoise's `albedo` and `normal`) and to the depth layer.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct FirstHit {
+    /// The surface's reflectance (`Bsdf::albedo`), an emitter's radiance clamped to [0, 1] if
+    /// it does not reflect, the background clamped to [0, 1] where the ray escapes.
+    pub albedo: Color,
+    /// World-space geometric normal facing the camera; zero where the ray escapes.
+    pub normal: Vec3,
+    /// Distance from the camera to the hit in scene units; zero where the ray escapes.
+    pub depth: f32,
+}
+
+impl FirstHit {
+    /// The features of the first hit along `camera_ray`, traced on its own: how the course
+    /// family and the debug views get them (the path tracer records them as it goes, by the
+    /// same definition). Adds the ray it traces to `rays`.
+    pub fn trace(scene: &Scene, camera_ray: &Ray, rays: &mut u64) -> FirstHit {
+        let ray = Ray {
+            direction: camera_ray.direction.normalized(),
+            ..*camera_ray
+        };
+        *rays += 1;
+        let Some(hit) = scene.intersect(&ray) else {
+            return FirstHit {
+                albedo: scene.background_radiance(ray.direction).clamp01(),
+                ..FirstHit::default()
+            };
+        };
+        let si = scene.surface(&ray, &hit);
+        let bsdf = Bsdf::from_material(&scene.materials, &scene.textures, si.material, si.uv);
+        let albedo = match Material::get(&scene.materials, si.material) {
+            Material::Emissive { radiance, .. } if bsdf.is_black() => radiance.clamp01(),
+            _ => bsdf.albedo(),
+        };
+        FirstHit {
+            albedo,
+            normal: if ray.direction.dot(si.normal) > 0.0 {
+                -si.normal
+            } else {
+                si.normal
+            },
+            depth: hit.t,
+        }
+    }
+}
+
+/// One sample of a pixel.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Sample {
+    pub radiance: Color,
+    /// Present when `PixelContext::features` asked for them.
+    pub features: Option<FirstHit>,
+}
+
+/// Computes a pixel's samples.
+pub(crate) trait Integrator: Sync {
+    /// Computes samples `samples` of `pixel` and hands each to `sink`, in sample order. Adds
+    /// every ray it traces to `rays`.
+    fn pixel_samples(
+        &self,
+        scene: &Scene,
+        pixel: &PixelContext,
+        samples: Range<u32>,
+        rays: &mut u64,
+        sink: &mut impl FnMut(Sample),
+    );
+}
+
+/// Counters a tile keeps while its pixels render; summed into `RenderStats` at the end.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct TileCounters {
+    pub rays: u64,
+    pub nonfinite_samples: u64,
+    /// Smallest pixel index with a non-finite sample.
+    pub first_nonfinite: Option<u64>,
+}
+
+impl TileCounters {
+    /// Records `count` samples of pixel `pixel_index` dropped for being NaN or infinite.
+    #[inline]
+    pub fn dropped_samples(&mut self, pixel_index: u64, count: u32) {
+        if count > 0 {
+            self.nonfinite_samples += count as u64;
+            self.first_nonfinite = Some(
+                self.first_nonfinite
+                    .map_or(pixel_index, |p| p.min(pixel_index)),
+            );
+        }
+    }
+}

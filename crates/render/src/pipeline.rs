@@ -1,0 +1,540 @@
+//! The one render pipeline: the tile scheduler and the per-pixel sample loop, generic over
+//! the integrator. It is the only place that turns samples into pixels, so everything that is
+//! about pixels rather than light lives here once: which integrator runs, the crop window
+//! (`pixel_bounds`), the sample range, dropping and counting non-finite samples, averaging
+//! the feature layers, progress and cancellation. The model is pbrt-v4's
+//! `RayIntegrator::EvaluatePixelSample` (`src/pbrt/cpu/integrators.cpp`).
+//!
+//! Determinism: every random number is a function of (seed, pixel, sample index), each pixel
+//! is computed by exactly one task, and the tiles are stitched in a fixed order, so the image
+//! does not depend on the thread count, the scheduling, the crop window or the sample range a
+//! pixel is rendered in.
+
+use std::ops::Range;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+
+use rayon::prelude::*;
+
+use crate::film::{Features, Film};
+use crate::integrator::debug::{DebugIntegrator, DebugView};
+use crate::integrator::path::{PathIntegrator, PathSettings, DEFAULT_MAX_DEPTH};
+use crate::integrator::{CourseIntegrator, Integrator, PixelContext, Sample, TileCounters};
+use crate::math::{Color, Vec3};
+use crate::scene::Scene;
+
+/// Which integrator computes a sample.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Hash)]
+pub enum IntegratorKind {
+    /// The course's recursive ray tracer: its shading formulas, no light falloff, the N x N
+    /// jittered grid of `samples_per_pixel` (N = floor(sqrt)). The default for course scenes.
+    #[default]
+    Course,
+    /// The physically based path tracer: exactly `samples_per_pixel` samples, next-event
+    /// estimation with MIS, Russian roulette.
+    Path,
+    /// Debug view: the world-space normal of the first hit as colour, (n + 1) / 2.
+    Normals,
+    /// Debug view: the first hit's albedo (the feature layer a denoiser takes).
+    Albedo,
+    /// Debug view: the distance from the camera to the first hit, in scene units, in every
+    /// channel (0 where the ray escapes).
+    Depth,
+}
+
+impl IntegratorKind {
+    /// Every integrator, in the order the CLI lists them.
+    pub const ALL: [IntegratorKind; 5] = [
+        IntegratorKind::Course,
+        IntegratorKind::Path,
+        IntegratorKind::Normals,
+        IntegratorKind::Albedo,
+        IntegratorKind::Depth,
+    ];
+
+    /// The name the CLI, Python and the web page use: `course`, `path`, `normals`, `albedo`,
+    /// `depth`.
+    pub fn name(self) -> &'static str {
+        match self {
+            IntegratorKind::Course => "course",
+            IntegratorKind::Path => "path",
+            IntegratorKind::Normals => "normals",
+            IntegratorKind::Albedo => "albedo",
+            IntegratorKind::Depth => "depth",
+        }
+    }
+
+    /// The integrator called `name` (see `name`).
+    pub fn from_name(name: &str) -> Option<IntegratorKind> {
+        IntegratorKind::ALL
+            .into_iter()
+            .find(|kind| kind.name() == name)
+    }
+
+    /// The path length when `RenderSettings::max_depth` is not given: the course's `-k`
+    /// default of 4 for the course family, and for the path tracer a bound large enough to be
+    /// unbounded in practice (Russian roulette ends paths long before).
+    pub fn default_max_depth(self) -> u32 {
+        match self {
+            IntegratorKind::Path => DEFAULT_MAX_DEPTH,
+            _ => 4,
+        }
+    }
+
+    /// The samples a pixel takes when `requested` are asked for: exactly that many (at least
+    /// one) for the path tracer; N² on the course's jittered grid, N = floor(sqrt(requested))
+    /// (FORMAT.md A18).
+    pub fn samples_per_pixel(self, requested: u32) -> u32 {
+        match self {
+            IntegratorKind::Path => requested.max(1),
+            _ => grid_size(requested).pow(2),
+        }
+    }
+}
+
+/// Samples per axis of the course's jittered grid for `requested` rays per pixel.
+pub(crate) fn grid_size(requested: u32) -> u32 {
+    ((requested.max(1) as f64).sqrt().floor() as u32).max(1)
+}
+
+/// A rectangle of pixels, `x0..x1` by `y0..y1`, counted from the top-left corner of the image
+/// (pbrt's `--pixelbounds`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct PixelBounds {
+    pub x0: u32,
+    pub x1: u32,
+    pub y0: u32,
+    pub y1: u32,
+}
+
+impl PixelBounds {
+    /// The whole `width` x `height` image.
+    pub fn full(width: u32, height: u32) -> PixelBounds {
+        PixelBounds {
+            x0: 0,
+            x1: width,
+            y0: 0,
+            y1: height,
+        }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.x1.saturating_sub(self.x0)
+    }
+
+    pub fn height(&self) -> u32 {
+        self.y1.saturating_sub(self.y0)
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.width() == 0 || self.height() == 0
+    }
+
+    /// Whether these bounds lie inside a `width` x `height` image.
+    pub fn fits(&self, width: u32, height: u32) -> bool {
+        self.x0 <= self.x1 && self.y0 <= self.y1 && self.x1 <= width && self.y1 <= height
+    }
+}
+
+/// How to render. `render` takes it with the scene; every front end (CLI, Python, browser,
+/// farm scripts) fills in this one struct.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RenderSettings {
+    /// Size of the whole image in pixels.
+    pub width: u32,
+    pub height: u32,
+    /// Samples per pixel asked for (`-r`, `--spp`); see `IntegratorKind::samples_per_pixel`
+    /// for how many each integrator takes.
+    pub samples_per_pixel: u32,
+    /// Path length cap (`-k`): reflection/refraction depth for the course family, scattering
+    /// events for the path tracer. `None`: the integrator's default
+    /// (`IntegratorKind::default_max_depth`).
+    pub max_depth: Option<u32>,
+    /// Image-plane aspect ratio (`-a`); `None` means width / height (square pixels).
+    pub aspect: Option<f32>,
+    /// Keys every random number, with the pixel and the sample index.
+    pub seed: u64,
+    pub integrator: IntegratorKind,
+    /// Also compute the first-hit feature layers (albedo, normal, depth) into `Film::features`.
+    pub features: bool,
+    /// Render only these pixels (a crop window or farm tile); `None` is the whole image. The
+    /// pixels are exactly those of the whole render.
+    pub pixel_bounds: Option<PixelBounds>,
+    /// Take only samples `start..end` of each pixel's `samples_per_pixel` (a farm's sample
+    /// range); `None` is all of them. Each sample is the same as in the whole render.
+    pub sample_range: Option<Range<u32>>,
+    /// Worker threads; `None` runs on the rayon pool `render` is called in (all cores by
+    /// default).
+    pub threads: Option<usize>,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            width: 100,
+            height: 100,
+            samples_per_pixel: 1,
+            max_depth: None,
+            aspect: None,
+            seed: 0,
+            integrator: IntegratorKind::Course,
+            features: false,
+            pixel_bounds: None,
+            sample_range: None,
+            threads: None,
+        }
+    }
+}
+
+impl RenderSettings {
+    /// Samples each pixel of the whole render takes (see `IntegratorKind::samples_per_pixel`).
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.integrator.samples_per_pixel(self.samples_per_pixel)
+    }
+
+    /// The path length cap in effect.
+    pub fn max_depth(&self) -> u32 {
+        self.max_depth
+            .unwrap_or_else(|| self.integrator.default_max_depth())
+    }
+
+    /// The pixels to render.
+    pub fn bounds(&self) -> PixelBounds {
+        self.pixel_bounds
+            .unwrap_or_else(|| PixelBounds::full(self.width, self.height))
+    }
+
+    /// The samples of each pixel to take.
+    pub fn samples(&self) -> Range<u32> {
+        let all = self.samples_per_pixel();
+        match &self.sample_range {
+            Some(range) => range.start.min(all)..range.end.min(all),
+            None => 0..all,
+        }
+    }
+
+    /// Why these settings cannot be rendered, if they cannot: a front end checks this before
+    /// `render` (which refuses the same settings with `RenderError::Invalid`).
+    pub fn validate(&self) -> Result<(), String> {
+        if self.width == 0 || self.height == 0 {
+            return Err(format!(
+                "the image must have at least one pixel, not {}x{}",
+                self.width, self.height
+            ));
+        }
+        if let Some(bounds) = self.pixel_bounds {
+            if !bounds.fits(self.width, self.height) || bounds.is_empty() {
+                return Err(format!(
+                    "pixel bounds x {}..{}, y {}..{} are empty or outside the {}x{} image",
+                    bounds.x0, bounds.x1, bounds.y0, bounds.y1, self.width, self.height
+                ));
+            }
+        }
+        if let Some(range) = &self.sample_range {
+            let all = self.samples_per_pixel();
+            if range.start >= range.end || range.end > all {
+                return Err(format!(
+                    "sample range {}..{} is empty or beyond the {all} samples of each pixel",
+                    range.start, range.end
+                ));
+            }
+        }
+        if let Some(aspect) = self.aspect {
+            if !(aspect.is_finite() && aspect > 0.0) {
+                return Err(format!("the aspect ratio must be positive, not {aspect}"));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Counters gathered while rendering.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct RenderStats {
+    /// Every ray traced: camera, secondary and shadow rays.
+    pub rays: u64,
+    /// Samples whose radiance was NaN or infinite: dropped from the pixel's average.
+    pub nonfinite_samples: u64,
+    /// The first pixel (x, y from the top-left of the whole image) with a non-finite sample,
+    /// to reproduce it.
+    pub first_nonfinite_pixel: Option<(u32, u32)>,
+}
+
+/// What the progress callback hears after each tile.
+#[derive(Debug)]
+pub struct Progress<'a> {
+    pub tiles_done: usize,
+    pub tiles_total: usize,
+    /// The tile just finished, in whole-image pixel coordinates, and its beauty pixels
+    /// (row-major): what a preview shows.
+    pub tile: PixelBounds,
+    pub pixels: &'a [Color],
+}
+
+impl Progress<'_> {
+    /// The share of the work done, 0 to 1.
+    pub fn fraction(&self) -> f64 {
+        self.tiles_done as f64 / self.tiles_total.max(1) as f64
+    }
+}
+
+/// Why `render` returned no image.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RenderError {
+    /// The progress callback asked to stop.
+    Cancelled,
+    /// The settings cannot be rendered (`RenderSettings::validate` says why).
+    Invalid(String),
+}
+
+impl std::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RenderError::Cancelled => f.write_str("the render was cancelled"),
+            RenderError::Invalid(why) => f.write_str(why),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+/// Side length of the square tiles handed to worker threads.
+pub const TILE_SIZE: u32 = 16;
+
+/// Renders `scene` as `settings` say. `progress` is called from the worker threads after each
+/// tile; returning `false` cancels the render. The film covers `settings.bounds()`.
+pub fn render(
+    scene: &Scene,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(&Progress) -> bool + Sync),
+) -> Result<(Film, RenderStats), RenderError> {
+    settings.validate().map_err(RenderError::Invalid)?;
+    match settings.threads {
+        Some(threads) => {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .thread_name(|index| format!("glint-render-{index}"))
+                .build()
+                .map_err(|error| {
+                    RenderError::Invalid(format!("cannot start {threads} threads: {error}"))
+                })?;
+            pool.install(|| render_on_current_pool(scene, settings, progress))
+        }
+        None => render_on_current_pool(scene, settings, progress),
+    }
+}
+
+/// The integrator is chosen here and only here.
+fn render_on_current_pool(
+    scene: &Scene,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(&Progress) -> bool + Sync),
+) -> Result<(Film, RenderStats), RenderError> {
+    match settings.integrator {
+        IntegratorKind::Course => {
+            render_with(scene, settings, &CourseIntegrator::new(scene), progress)
+        }
+        IntegratorKind::Path => render_with(
+            scene,
+            settings,
+            &PathIntegrator::new(scene, PathSettings::with_max_depth(settings.max_depth())),
+            progress,
+        ),
+        IntegratorKind::Normals => render_with(
+            scene,
+            settings,
+            &DebugIntegrator::new(scene, DebugView::Normals),
+            progress,
+        ),
+        IntegratorKind::Albedo => render_with(
+            scene,
+            settings,
+            &DebugIntegrator::new(scene, DebugView::Albedo),
+            progress,
+        ),
+        IntegratorKind::Depth => render_with(
+            scene,
+            settings,
+            &DebugIntegrator::new(scene, DebugView::Depth),
+            progress,
+        ),
+    }
+}
+
+/// One finished pixel: the beauty and, when asked for, the features.
+#[derive(Clone, Copy, Debug, Default)]
+struct PixelValue {
+    beauty: Color,
+    albedo: Color,
+    normal: Vec3,
+    depth: f32,
+}
+
+/// The per-pixel sample loop over the tile scheduler.
+fn render_with<I: Integrator>(
+    scene: &Scene,
+    settings: &RenderSettings,
+    integrator: &I,
+    progress: &(dyn Fn(&Progress) -> bool + Sync),
+) -> Result<(Film, RenderStats), RenderError> {
+    let (width, height) = (settings.width, settings.height);
+    let samples = settings.samples();
+    let context = |x: u32, y: u32| PixelContext {
+        x,
+        y,
+        width,
+        height,
+        aspect: settings.aspect.unwrap_or(width as f32 / height as f32),
+        seed: settings.seed,
+        samples_per_pixel: settings.samples_per_pixel(),
+        max_depth: settings.max_depth(),
+        features: settings.features,
+    };
+    let (values, stats) = render_tiles(
+        settings.bounds(),
+        width,
+        progress,
+        |value: &PixelValue| value.beauty,
+        |x, y, counters| {
+            let pixel = context(x, y);
+            let pixel_index = pixel.index();
+            let mut value = PixelValue::default();
+            let mut sum = Color::ZERO;
+            let mut valid = 0u32;
+            let mut dropped = 0u32;
+            let mut sink = |sample: Sample| {
+                // The one place a sample becomes part of a pixel.
+                if sample.radiance.is_finite() {
+                    sum += sample.radiance;
+                    valid += 1;
+                } else {
+                    dropped += 1;
+                }
+                if let Some(features) = sample.features {
+                    value.albedo += features.albedo;
+                    value.normal += features.normal;
+                    value.depth += features.depth;
+                }
+            };
+            integrator.pixel_samples(
+                scene,
+                &pixel,
+                samples.clone(),
+                &mut counters.rays,
+                &mut sink,
+            );
+            counters.dropped_samples(pixel_index, dropped);
+            if valid > 0 {
+                value.beauty = sum / valid as f32;
+            }
+            if settings.features {
+                let count = samples.len().max(1) as f32;
+                value.albedo = value.albedo / count;
+                value.normal = value.normal / count;
+                value.depth /= count;
+            }
+            value
+        },
+    )?;
+    let bounds = settings.bounds();
+    let features = settings.features.then(|| Features {
+        albedo: values.iter().map(|v| v.albedo).collect(),
+        normal: values.iter().map(|v| v.normal).collect(),
+        depth: values.iter().map(|v| v.depth).collect(),
+    });
+    let film = Film {
+        width: bounds.width(),
+        height: bounds.height(),
+        pixels: values.iter().map(|v| v.beauty).collect(),
+        origin: (bounds.x0, bounds.y0),
+        full_size: (width, height),
+        features,
+    };
+    Ok((film, stats))
+}
+
+/// The tile scheduler: `pixel(x, y, counters)` computes one pixel (x, y from the top-left of
+/// the whole image `width` wide), tiles of `bounds` run on the current rayon pool, each pixel
+/// is computed by exactly one task, and the results are stitched in tile order, so neither
+/// thread count nor scheduling can change the image. Returns the pixels of `bounds`,
+/// row-major from its top-left.
+fn render_tiles<P: Copy + Default + Send>(
+    bounds: PixelBounds,
+    width: u32,
+    progress: &(dyn Fn(&Progress) -> bool + Sync),
+    beauty: impl Fn(&P) -> Color + Sync,
+    pixel: impl Fn(u32, u32, &mut TileCounters) -> P + Sync,
+) -> Result<(Vec<P>, RenderStats), RenderError> {
+    let tiles_x = bounds.width().div_ceil(TILE_SIZE);
+    let tiles_y = bounds.height().div_ceil(TILE_SIZE);
+    let tile_count = (tiles_x * tiles_y) as usize;
+    let done = AtomicUsize::new(0);
+    let cancelled = AtomicBool::new(false);
+    let tile_bounds = |tile: usize| {
+        let x0 = bounds.x0 + (tile as u32 % tiles_x) * TILE_SIZE;
+        let y0 = bounds.y0 + (tile as u32 / tiles_x) * TILE_SIZE;
+        PixelBounds {
+            x0,
+            x1: (x0 + TILE_SIZE).min(bounds.x1),
+            y0,
+            y1: (y0 + TILE_SIZE).min(bounds.y1),
+        }
+    };
+
+    // Each tile renders into its own buffer; no lock and no shared write on the hot path.
+    let tiles: Vec<(Vec<P>, TileCounters)> = (0..tile_count)
+        .into_par_iter()
+        .map(|tile| {
+            let mut counters = TileCounters::default();
+            if cancelled.load(Ordering::Relaxed) {
+                return (Vec::new(), counters);
+            }
+            let area = tile_bounds(tile);
+            let mut out = Vec::with_capacity((area.width() * area.height()) as usize);
+            for y in area.y0..area.y1 {
+                for x in area.x0..area.x1 {
+                    out.push(pixel(x, y, &mut counters));
+                }
+            }
+            let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
+            let pixels: Vec<Color> = out.iter().map(&beauty).collect();
+            let report = Progress {
+                tiles_done: finished,
+                tiles_total: tile_count,
+                tile: area,
+                pixels: &pixels,
+            };
+            if !progress(&report) {
+                cancelled.store(true, Ordering::Relaxed);
+            }
+            (out, counters)
+        })
+        .collect();
+
+    if cancelled.load(Ordering::Relaxed) {
+        return Err(RenderError::Cancelled);
+    }
+    let (bw, bh) = (bounds.width(), bounds.height());
+    let mut pixels = vec![P::default(); bw as usize * bh as usize];
+    let mut stats = RenderStats::default();
+    let mut first_nonfinite: Option<u64> = None;
+    for (tile, (values, counters)) in tiles.into_iter().enumerate() {
+        let area = tile_bounds(tile);
+        let mut it = values.into_iter();
+        for y in area.y0..area.y1 {
+            for x in area.x0..area.x1 {
+                pixels[((y - bounds.y0) * bw + (x - bounds.x0)) as usize] =
+                    it.next().unwrap_or_default();
+            }
+        }
+        stats.rays += counters.rays;
+        stats.nonfinite_samples += counters.nonfinite_samples;
+        first_nonfinite = match (first_nonfinite, counters.first_nonfinite) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        };
+    }
+    let _ = bh;
+    stats.first_nonfinite_pixel =
+        first_nonfinite.map(|p| ((p % width as u64) as u32, (p / width as u64) as u32));
+    Ok((pixels, stats))
+}
