@@ -313,13 +313,30 @@ impl LightSampler {
         reference: Vec3,
         u: (f32, f32),
     ) -> Option<LightSample> {
+        let (position, normal, inverse_area, radiance) = self.triangle_point(index, u, false)?;
+        let mut sample = area_sample(reference, position, normal, inverse_area, radiance)?;
+        sample.reachable_by_bsdf = self.reachable_by_bsdf(index);
+        Some(sample)
+    }
+
+    /// A point on light `index` when it is a set of emitting triangles: the triangle chosen by
+    /// area with `u.0` (binary search in the prepared table, O(log n)), the point uniform on it
+    /// with the rest of `u.0` and `u.1`, or its centroid when `centroid` (the course's one ray
+    /// per pixel). Returns the point, the triangle's unit normal, the density per unit area of
+    /// the whole light, and its radiance.
+    pub(crate) fn triangle_point(
+        &self,
+        index: usize,
+        u: (f32, f32),
+        centroid: bool,
+    ) -> Option<(Vec3, Vec3, f32, Color)> {
         let PreparedLight::Triangles {
             first,
             count,
             inverse_area,
             radiance,
             ..
-        } = self.lights[index]
+        } = *self.lights.get(index)?
         else {
             return None;
         };
@@ -344,11 +361,13 @@ impl LightSampler {
                 (&list[chosen], ((u.0 - start) / width).clamp(0.0, 1.0))
             }
         };
-        let (b1, b2) = sample_uniform_triangle(u0, u.1);
+        let (b1, b2) = if centroid {
+            (1.0 / 3.0, 1.0 / 3.0)
+        } else {
+            sample_uniform_triangle(u0, u.1)
+        };
         let position = triangle.v0 + triangle.edge1 * b1 + triangle.edge2 * b2;
-        let mut sample = area_sample(reference, position, triangle.normal, inverse_area, radiance)?;
-        sample.reachable_by_bsdf = self.reachable_by_bsdf(index);
-        Some(sample)
+        Some((position, triangle.normal, inverse_area, radiance))
     }
 
     /// A point on light `index` as seen from `reference`; the pdf is per unit solid angle of

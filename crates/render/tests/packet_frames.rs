@@ -7,6 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use glint_render::integrator::course::{shade_camera_ray, SampleContext};
+use glint_render::light_sampling::LightSampler;
 use glint_render::sampling::Rng;
 use glint_render::{render, Color, RenderSettings, Scene};
 
@@ -24,6 +25,7 @@ fn single_ray_frame(scene: &Scene, settings: &RenderSettings) -> (Vec<Color>, u6
     let aspect = settings.aspect.unwrap_or(width as f32 / height as f32);
     let samples = settings.samples_per_pixel();
     let grid = (samples as f64).sqrt() as u32;
+    let lights = LightSampler::new(scene);
     let mut pixels = Vec::new();
     let mut rays = 0;
     for y in 0..height {
@@ -46,6 +48,7 @@ fn single_ray_frame(scene: &Scene, settings: &RenderSettings) -> (Vec<Color>, u6
                     .ray(x as f32 + ox, j as f32 + oy, width, height, aspect);
                 let mut ctx = SampleContext {
                     rng,
+                    lights: Some(&lights),
                     sample_index: s,
                     grid_size: grid,
                     pixel_key: pixel_index ^ settings.seed.rotate_left(32),

@@ -9,6 +9,7 @@ use crate::accel::PACKET;
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 
 use crate::light::Light;
+use crate::light_sampling::LightSampler;
 use crate::material::Material;
 use crate::math::{Basis, Color, Vec3};
 use crate::ray::Ray;
@@ -19,8 +20,11 @@ use crate::texture::ColorSource;
 /// Per-sample state handed to an integrator: the sample's random stream and where the sample
 /// sits in the pixel's jittered grid (area lights and glossy reflection stratify against it).
 #[derive(Clone, Debug)]
-pub struct SampleContext {
+pub struct SampleContext<'a> {
     pub rng: Rng,
+    /// The scene's lights prepared for sampling (the course integrator's emitting triangles
+    /// are chosen from its table); `None` for views that sample no light.
+    pub lights: Option<&'a LightSampler>,
     /// Index of this sample within its pixel, 0 .. grid_size².
     pub sample_index: u32,
     /// Samples per axis of the pixel's jittered grid.
@@ -32,7 +36,7 @@ pub struct SampleContext {
     pub rays: u64,
 }
 
-impl SampleContext {
+impl SampleContext<'_> {
     /// A stratified 2-D sample for light or glossy sampling: the pixel's N² cells are shuffled
     /// by a per-pixel permutation (slide_DistributionRays pp.20-25) so light cells do not line
     /// up with pixel cells, then jittered within the cell. `salt` separates uses.
@@ -170,59 +174,45 @@ fn sample_light(
                 pdf_area: 1.0 / area.max(f32::MIN_POSITIVE),
             }
         }
-        Light::Triangles { triangles, .. } => {
-            let total: f32 = triangles.iter().map(triangle_area).sum();
-            let (u1, u2) = if exact {
+        Light::Triangles { .. } => {
+            // The prepared table of the one light sampler: the triangle by area in O(log n).
+            let u = if exact {
                 (0.5, 1.0 / 3.0)
             } else {
                 ctx.stratified_2d(SALT_LIGHT ^ light_index as u64)
             };
-            // Choose a triangle by area with u1, then reuse its remainder for the point.
-            let mut target = u1 * total;
-            let mut chosen = triangles.len().saturating_sub(1);
-            for (k, tri) in triangles.iter().enumerate() {
-                let a = triangle_area(tri);
-                if target < a {
-                    chosen = k;
-                    target /= a.max(f32::MIN_POSITIVE);
-                    break;
-                }
-                target -= a;
-            }
-            let Some([a, b, c]) = triangles.get(chosen).copied() else {
-                return LightSample {
+            let point = ctx
+                .lights
+                .and_then(|lights| lights.triangle_point(light_index, u, exact));
+            match point {
+                Some((position, normal, pdf_area, _)) => LightSample {
+                    position,
+                    normal: Some(normal),
+                    pdf_area,
+                },
+                None => LightSample {
                     position: p,
                     normal: None,
                     pdf_area: 0.0,
-                };
-            };
-            let (b1, b2) = if exact {
-                (1.0 / 3.0, 1.0 / 3.0)
-            } else {
-                crate::sampling::sample_uniform_triangle(target.clamp(0.0, 1.0), u2)
-            };
-            LightSample {
-                position: a + (b - a) * b1 + (c - a) * b2,
-                normal: Some((b - a).cross(c - a).normalized()),
-                pdf_area: 1.0 / total.max(f32::MIN_POSITIVE),
+                },
             }
         }
     }
 }
 
-fn triangle_area(t: &[Vec3; 3]) -> f32 {
-    0.5 * (t[1] - t[0]).cross(t[2] - t[0]).length()
-}
-
 /// The course's recursive ray tracer (slide001; FORMAT.md 4): the lecture's shading formulas
 /// with no light falloff, shadow rays with epsilon 1e-3, mirror/glaze/dielectric recursion up
 /// to `max_depth`, and `Diffuse` as a Monte Carlo surface lit by background and emitters.
-#[derive(Clone, Copy, Debug, Default)]
-pub(crate) struct CourseIntegrator;
+#[derive(Clone, Debug)]
+pub(crate) struct CourseIntegrator {
+    lights: LightSampler,
+}
 
 impl CourseIntegrator {
-    pub fn new(_scene: &Scene) -> CourseIntegrator {
-        CourseIntegrator
+    pub fn new(scene: &Scene) -> CourseIntegrator {
+        CourseIntegrator {
+            lights: LightSampler::new(scene),
+        }
     }
 }
 
@@ -239,6 +229,7 @@ impl Integrator for CourseIntegrator {
             scene,
             pixel,
             samples,
+            Some(&self.lights),
             rays,
             sink,
             Some(&|ray, first, ctx| shade(scene, ray, first, 0, true, ctx)),
@@ -259,6 +250,7 @@ pub(crate) fn grid_samples(
     scene: &Scene,
     pixel: &PixelContext,
     samples: Range<u32>,
+    lights: Option<&LightSampler>,
     rays: &mut u64,
     sink: &mut impl FnMut(Sample),
     from_first_hit: Option<ShadeFirstHit>,
@@ -283,6 +275,7 @@ pub(crate) fn grid_samples(
         let ray = pixel.camera_ray(scene, ox, oy);
         let ctx = SampleContext {
             rng,
+            lights,
             sample_index: s,
             grid_size: grid,
             pixel_key: pixel_index ^ pixel.seed.rotate_left(32),

@@ -53,7 +53,7 @@ impl Integrator for DebugIntegrator {
         rays: &mut u64,
         sink: &mut impl FnMut(Sample),
     ) {
-        grid_samples(scene, pixel, samples, rays, sink, None, &|ray, _| {
+        grid_samples(scene, pixel, samples, None, rays, sink, None, &|ray, _| {
             self.radiance(scene, ray)
         });
     }
