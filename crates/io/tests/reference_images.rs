@@ -51,6 +51,95 @@ fn compare(rendered: &[u8], reference: &[u8]) -> ImageError {
     }
 }
 
+/// The mean absolute difference (levels) between `rendered` displaced by (dx, dy), that is
+/// rendered(x + dx, y + dy), and reference(x, y), over the pixels one pixel away from the border
+/// (the same pixels for every |dx|, |dy| <= 1).
+fn mean_error_shifted(rendered: &[u8], reference: &[u8], width: u32, dx: i32, dy: i32) -> f64 {
+    let width = width as i32;
+    let height = (reference.len() / 3) as i32 / width;
+    let mut sum = 0u64;
+    let mut count = 0u64;
+    for y in 1..height - 1 {
+        for x in 1..width - 1 {
+            let a = (((y + dy) * width + x + dx) * 3) as usize;
+            let b = ((y * width + x) * 3) as usize;
+            for c in 0..3 {
+                sum += (rendered[a + c] as i32 - reference[b + c] as i32).unsigned_abs() as u64;
+                count += 1;
+            }
+        }
+    }
+    sum as f64 / count as f64
+}
+
+/// `Err` unless `rendered` matches `reference` strictly better as it is than displaced by any
+/// one pixel (eight neighbours). The error bounds alone let a one-pixel shift through on scenes
+/// with few edges (oneSphere, oneTriangle, oneBox: a shifted silhouette is under 2 % of the
+/// pixels); the image must also be in the right place.
+fn check_alignment(rendered: &[u8], reference: &[u8], width: u32) -> Result<(), String> {
+    let aligned = mean_error_shifted(rendered, reference, width, 0, 0);
+    for (dx, dy) in [
+        (-1, -1),
+        (0, -1),
+        (1, -1),
+        (-1, 0),
+        (1, 0),
+        (-1, 1),
+        (0, 1),
+        (1, 1),
+    ] {
+        let shifted = mean_error_shifted(rendered, reference, width, dx, dy);
+        if shifted <= aligned {
+            return Err(format!(
+                "the image matches better displaced by ({dx}, {dy}): {shifted:.3} levels against \
+                 {aligned:.3} as it is"
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// `image` moved by (dx, dy) pixels, the border repeated: what a one-pixel shift bug renders.
+fn shifted(image: &[u8], width: u32, dx: i32, dy: i32) -> Vec<u8> {
+    let width = width as i32;
+    let height = (image.len() / 3) as i32 / width;
+    let mut out = Vec::with_capacity(image.len());
+    for y in 0..height {
+        for x in 0..width {
+            let sx = (x - dx).clamp(0, width - 1);
+            let sy = (y - dy).clamp(0, height - 1);
+            let i = ((sy * width + sx) * 3) as usize;
+            out.extend_from_slice(&image[i..i + 3]);
+        }
+    }
+    out
+}
+
+/// The whole criterion: the error bounds, and the alignment.
+fn verdict(
+    rendered: &[u8],
+    reference: &[u8],
+    width: u32,
+    max_mean: f64,
+    max_fraction: f64,
+) -> Result<(), String> {
+    let error = compare(rendered, reference);
+    if error.mean_absolute > max_mean {
+        return Err(format!(
+            "mean absolute error {:.3} > {max_mean}",
+            error.mean_absolute
+        ));
+    }
+    if error.fraction_over_8 > max_fraction {
+        return Err(format!(
+            "{:.2} % of pixels off by more than 8 levels > {:.0} %",
+            100.0 * error.fraction_over_8,
+            100.0 * max_fraction
+        ));
+    }
+    check_alignment(rendered, reference, width)
+}
+
 fn render_course(scene_path: &Path, width: u32, height: u32, rays_per_pixel: u32) -> Vec<u8> {
     let mut loaded = glint_io::load_scene(scene_path)
         .unwrap_or_else(|e| panic!("{} failed to load: {e}", scene_path.display()));
@@ -101,6 +190,22 @@ fn check_with_rays(
         100.0 * error.fraction_over_8,
         100.0 * max_fraction
     );
+    let reference = reference_image.as_raw();
+    if let Err(failure) = verdict(&rendered, reference, w, max_mean, max_fraction) {
+        panic!("{scene}: {failure}");
+    }
+    // Negative control: the same render shifted by one pixel, each way, must fail.
+    for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1)] {
+        let shift = shifted(&rendered, w, dx, dy);
+        let error = compare(&shift, reference);
+        let result = verdict(&shift, reference, w, max_mean, max_fraction);
+        println!(
+            "  shifted by ({dx}, {dy}): mean {:.3}, {:.2} % over 8: {result:?}",
+            error.mean_absolute,
+            100.0 * error.fraction_over_8
+        );
+        assert!(result.is_err(), "{scene} shifted by ({dx}, {dy}) passed");
+    }
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! The path tracer's per-sample work allocates nothing (ARCHITECTURE.md invariant): every
-//! material, every kind of light and a cube-map environment, traced through a counting global
-//! allocator. Alone in its test binary so no other test allocates on the counted thread.
+//! material (a textured one too), every kind of light and a cube-map environment, traced through
+//! a counting global allocator with the renderer's own Sobol' sampler and with the plain `Rng`.
+//! Alone in its test binary so no other test allocates on the counted thread.
 
 // The one unsafe item: a global allocator must implement the unsafe `GlobalAlloc` trait. It
 // forwards to `System` unchanged and only counts.
@@ -11,10 +12,11 @@ use std::cell::Cell;
 
 use glint_render::integrator::path::{PathIntegrator, PathSettings};
 use glint_render::integrator::FirstHit;
+use glint_render::path_sampler::{PathSampler, SobolPixel};
 use glint_render::sampling::Rng;
 use glint_render::{
-    Background, Camera, Color, CubeMap, GeometryDesc, Image, Instance, Light, Material, Projection,
-    Scene, SceneParts, Shape, Vec3,
+    Background, Camera, Color, ColorSource, CubeMap, GeometryDesc, Image, Instance, Light,
+    Material, Projection, Scene, SceneParts, Shape, Vec3,
 };
 
 struct CountingAllocator;
@@ -90,6 +92,16 @@ fn every_feature_scene() -> Scene {
             surface: Some(0),
             light: Some(1),
         },
+        // Textured: its BSDF is built per hit from the texel, not once per render.
+        Material::BlinnPhong {
+            diffuse: ColorSource {
+                color: Color::splat(0.8),
+                texture: Some(0),
+            },
+            specular: Color::splat(0.2).into(),
+            phong_exponent: 8.0,
+            mirror_coef: 0.0,
+        },
     ];
     let spheres: Vec<Shape> = (0..8)
         .map(|i| Shape::Sphere {
@@ -111,7 +123,7 @@ fn every_feature_scene() -> Scene {
             1.2,
         ),
         materials,
-        textures: vec![],
+        textures: vec![face(0.2)],
         lights: vec![
             Light::Point {
                 position: Vec3::new(1.0, 2.0, 1.0),
@@ -157,7 +169,8 @@ fn every_feature_scene() -> Scene {
                     },
                     Shape::Triangle { vertices: emitter },
                 ],
-                materials: vec![0, 8],
+                // The floor is the textured material, the triangle the emitter.
+                materials: vec![9, 8],
             },
         ],
         instances: vec![
@@ -185,25 +198,38 @@ fn tracing_paths_does_not_allocate() {
     let mut sum = Color::ZERO;
     let mut rays = 0;
     let before = ALLOCATIONS.with(Cell::get);
+    let camera_ray = |x: u32, y: u32, (ox, oy): (f32, f32)| {
+        scene.camera.ray(
+            x as f32 + ox,
+            y as f32 + oy,
+            width,
+            height,
+            width as f32 / height as f32,
+        )
+    };
     for y in 0..height {
         for x in 0..width {
+            let pixel = (y * width + x) as u64;
+            // The plain random stream.
             for s in 0..4 {
-                let mut rng = Rng::for_sample(1, (y * width + x) as u64, s);
-                let ray = scene.camera.ray(
-                    x as f32 + rng.next_f32(),
-                    y as f32 + rng.next_f32(),
-                    width,
-                    height,
-                    width as f32 / height as f32,
-                );
+                let mut rng = Rng::for_sample(1, pixel, s);
+                let ray = camera_ray(x, y, (rng.next_f32(), rng.next_f32()));
                 let mut first_hit = FirstHit::default();
                 sum += integrator.trace(&scene, &ray, &mut rng, &mut rays, &mut first_hit);
+            }
+            // The renderer's sampler: scrambled Sobol' per pixel, as `render_with_aovs` uses.
+            let sobol = SobolPixel::new(1, pixel, 4);
+            for s in 0..4 {
+                let mut sampler = sobol.sampler(s);
+                let ray = camera_ray(x, y, sampler.sample_2d(0));
+                let mut first_hit = FirstHit::default();
+                sum += integrator.trace(&scene, &ray, &mut sampler, &mut rays, &mut first_hit);
             }
         }
     }
     let allocations = ALLOCATIONS.with(Cell::get) - before;
     assert!(sum.is_finite() && sum.max_component() > 0.0);
-    assert!(rays > (width * height * 4) as u64);
+    assert!(rays > (width * height * 8) as u64);
     assert_eq!(
         allocations, 0,
         "{allocations} allocations while tracing {rays} rays"
