@@ -1,6 +1,6 @@
 //! Perspective and orthographic cameras of the course (slide001 pp.18-25, FORMAT.md 1.2).
 
-use crate::math::{Basis, Vec3};
+use crate::math::{Frame, Vec3};
 use crate::ray::Ray;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -16,7 +16,7 @@ pub enum Projection {
 pub struct Camera {
     pub projection: Projection,
     pub position: Vec3,
-    pub basis: Basis,
+    pub basis: Frame,
     pub focal_length: f32,
     pub image_plane_width: f32,
 }
@@ -32,7 +32,7 @@ impl Camera {
         Camera {
             projection,
             position,
-            basis: Basis::from_two(gaze, Vec3::Y),
+            basis: Frame::from_two(gaze, Vec3::Y),
             focal_length,
             image_plane_width,
         }

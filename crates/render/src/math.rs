@@ -380,15 +380,49 @@ impl Transform {
     }
 }
 
-/// An orthonormal basis (U, V, W), the lecture's camera frame.
+/// An orthonormal frame (U, V, W): the local x, y and z axes in world space. The one frame of
+/// the renderer: the lecture's camera and sampling bases (`from_two`, `from_one`, where W
+/// points against the given vector) and the shading frame around a normal (`from_normal`,
+/// W = the normal), with `to_local`/`to_world` between the spaces.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Basis {
+pub struct Frame {
     pub u: Vec3,
     pub v: Vec3,
     pub w: Vec3,
 }
 
-impl Basis {
+impl Frame {
+    /// A frame whose W is the unit `normal`, continuous everywhere except across n.z = 0 (Duff
+    /// et al., "Building an Orthonormal Frame, Revisited", 2017): branch-free and exact, unlike
+    /// the cross product with a fixed helper axis.
+    #[inline]
+    pub fn from_normal(normal: Vec3) -> Frame {
+        let sign = 1.0f32.copysign(normal.z);
+        let a = -1.0 / (sign + normal.z);
+        let b = normal.x * normal.y * a;
+        Frame {
+            u: Vec3::new(
+                1.0 + sign * normal.x * normal.x * a,
+                sign * b,
+                -sign * normal.x,
+            ),
+            v: Vec3::new(b, sign + normal.y * normal.y * a, -normal.y),
+            w: normal,
+        }
+    }
+
+    /// World-space `v` in this frame's coordinates.
+    #[inline]
+    pub fn to_local(self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.u), v.dot(self.v), v.dot(self.w))
+    }
+
+    /// Frame coordinates `v` in world space.
+    #[inline]
+    pub fn to_world(self, v: Vec3) -> Vec3 {
+        self.u * v.x + self.v * v.y + self.w * v.z
+    }
+
     /// The lecture's basis from two vectors (slide001 p.20): W = -a/|a|, U = b x W / |b x W|,
     /// V = W x U, with `a` the gaze and `b` the up vector.
     ///
@@ -397,7 +431,7 @@ impl Basis {
     /// b = (1,0,0) instead, except that we take whichever coordinate axis is least parallel to the
     /// gaze, so the frame is well defined for any gaze. For the course's straight-down camera
     /// (`StanfordBunny.json`, gaze (0,-1,0)) that is X, exactly KV's choice.
-    pub fn from_two(a: Vec3, b: Vec3) -> Basis {
+    pub fn from_two(a: Vec3, b: Vec3) -> Frame {
         let w = -a.normalized();
         let mut u = b.cross(w);
         if u.length_squared() < 1e-12 * b.length_squared().max(1e-30) || !u.is_finite() {
@@ -406,12 +440,12 @@ impl Basis {
         }
         let u = u.normalized();
         let v = w.cross(u);
-        Basis { u, v, w }
+        Frame { u, v, w }
     }
 
     /// The lecture's basis from one vector (slide001 p.18): W = -a/|a|, t = W with its
     /// smallest-magnitude component replaced by 1, U = t x W / |t x W|, V = W x U.
-    pub fn from_one(a: Vec3) -> Basis {
+    pub fn from_one(a: Vec3) -> Frame {
         let w = -a.normalized();
         let abs = w.abs();
         let mut t = w;
@@ -424,7 +458,7 @@ impl Basis {
         }
         let u = t.cross(w).normalized();
         let v = w.cross(u);
-        Basis { u, v, w }
+        Frame { u, v, w }
     }
 }
 

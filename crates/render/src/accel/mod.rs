@@ -12,7 +12,10 @@ pub mod packet;
 pub mod simd;
 pub mod triangle;
 pub mod wide;
+#[cfg(feature = "bench")]
 pub mod workload;
 
 pub use packet::{ALL_LANES, PACKET};
-pub use wide::{Isa, LocalHit, WideBvh};
+#[cfg(any(test, feature = "bench"))]
+pub use wide::Isa;
+pub use wide::{LocalHit, WideBvh};

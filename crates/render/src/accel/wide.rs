@@ -67,6 +67,7 @@ impl WideNode {
     }
 
     /// The union of the children's boxes.
+    #[cfg(any(test, feature = "bench"))]
     pub fn bounds(&self) -> Aabb {
         let mut b = Aabb::EMPTY;
         for slot in 0..WIDTH {
@@ -207,16 +208,20 @@ impl WideBvh {
     pub fn bounds(&self) -> Aabb {
         self.bounds
     }
+    #[cfg(any(test, feature = "bench"))]
     pub fn nodes(&self) -> &[WideNode] {
         &self.nodes
     }
+    #[cfg(any(test, feature = "bench"))]
     pub fn blocks(&self) -> &[TriangleBlock] {
         &self.blocks
     }
+    #[cfg(any(test, feature = "bench"))]
     pub fn isa(&self) -> Isa {
         self.isa
     }
     /// Chooses the kernel (tests compare the scalar and SIMD kernels).
+    #[cfg(any(test, feature = "bench"))]
     pub fn set_isa(&mut self, isa: Isa) {
         self.isa = if isa == Isa::Avx2 && Isa::detect() != Isa::Avx2 {
             Isa::Scalar

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use crate::camera::{Camera, Projection};
 use crate::geometry::Aabb;
-use crate::math::{Basis, Vec3};
+use crate::math::{Frame, Vec3};
 use crate::ray::Ray;
 use crate::sampling::{sample_cosine_hemisphere, Rng};
 use crate::scene::Scene;
@@ -96,7 +96,7 @@ pub fn secondary_rays(
             let mut rng = Rng::for_sample(seed, index as u64, 0);
             let local = sample_cosine_hemisphere(rng.next_f32(), rng.next_f32());
             // `from_one(a)` has W = −a: W is the normal, the hemisphere's +z.
-            let frame = Basis::from_one(-normal);
+            let frame = Frame::from_one(-normal);
             let direction = frame.u * local.x + frame.v * local.y + frame.w * local.z;
             Some((
                 Ray::new(origin, direction),

@@ -9,9 +9,9 @@ use crate::accel::PACKET;
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 
 use crate::light::Light;
-use crate::light_sampling::LightSampler;
+use crate::light::sampler::LightSampler;
 use crate::material::Material;
-use crate::math::{Basis, Color, Vec3};
+use crate::math::{Frame, Color, Vec3};
 use crate::ray::Ray;
 use crate::sampling::{mix64, sample_cosine_hemisphere, sample_uniform_sphere, Rng};
 use crate::scene::{Hit, Scene, SurfaceInteraction};
@@ -63,7 +63,7 @@ pub fn permute(i: u32, n: u32, seed: u32) -> u32 {
     if n <= 1 {
         return 0;
     }
-    crate::path_sampler::permute_with(i, n, crate::path_sampler::permute_mask(n), seed, seed % n)
+    crate::sampling::sobol::permute_with(i, n, crate::sampling::sobol::permute_mask(n), seed, seed % n)
 }
 
 /// Mirror reflection of direction `d` about unit normal `n`: r = d − 2(d·n)n (slide001 p.105).
@@ -246,6 +246,7 @@ pub(crate) type ShadeFirstHit<'a> = &'a dyn Fn(&Ray, Option<Hit>, &mut SampleCon
 /// `from_first_hit`, nine or more samples travel as packets of eight camera rays
 /// (`Scene::intersect_lanes`) and each hit is handed over; the samples are the same. (Fewer
 /// than eight samples, 1 or 4, go ray by ray: half-empty packets did not pay.)
+#[allow(clippy::too_many_arguments)] // One call per integrator family; a struct would only rename them.
 pub(crate) fn grid_samples(
     scene: &Scene,
     pixel: &PixelContext,
@@ -520,7 +521,7 @@ fn mirror(
     }
     let mut r = reflect(d, n);
     if roughness > 0.0 {
-        let basis = Basis::from_one(r);
+        let basis = Frame::from_one(r);
         let (u1, u2) = ctx.stratified_2d(SALT_GLOSSY ^ depth as u64);
         let u = -0.5 * roughness + u1 * roughness;
         let v = -0.5 * roughness + u2 * roughness;
@@ -689,8 +690,8 @@ fn diffuse_surface(
     if depth < ctx.max_depth {
         let (u1, u2) = ctx.stratified_2d(SALT_BOUNCE ^ depth as u64);
         let local = sample_cosine_hemisphere(u1, u2);
-        let frame = Basis::from_one(-n);
-        // Basis::from_one(a) has W = -a/|a|, so W = n here: the local z axis is the normal.
+        let frame = Frame::from_one(-n);
+        // Frame::from_one(a) has W = -a/|a|, so W = n here: the local z axis is the normal.
         let dir = frame.u * local.x + frame.v * local.y + frame.w * local.z;
         ctx.rays += 1;
         let incoming = ray_color(scene, &Ray::spawn(si.point, dir), depth + 1, false, ctx);

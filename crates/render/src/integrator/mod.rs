@@ -13,7 +13,7 @@ pub mod path;
 
 use std::ops::Range;
 
-use crate::bsdf::Bsdf;
+use crate::material::bsdf::Bsdf;
 use crate::material::Material;
 use crate::math::{Color, Vec3};
 use crate::ray::Ray;

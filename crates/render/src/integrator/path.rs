@@ -17,12 +17,13 @@
 
 use std::ops::Range;
 
-use crate::bsdf::{Bsdf, Frame};
+use crate::material::bsdf::Bsdf;
+use crate::math::Frame;
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
-use crate::light_sampling::LightSampler;
+use crate::light::sampler::LightSampler;
 use crate::material::{Material, MaterialId};
 use crate::math::Color;
-use crate::path_sampler::{PathSampler, SobolPixel};
+use crate::sampling::sobol::{PathSampler, SobolPixel};
 use crate::ray::Ray;
 use crate::scene::Scene;
 
@@ -152,14 +153,6 @@ impl PathIntegrator {
     fn material(&self, id: MaterialId) -> &PreparedMaterial {
         let last = self.materials.len() - 1;
         &self.materials[(id as usize).min(last)]
-    }
-
-    pub fn lights(&self) -> &LightSampler {
-        &self.lights
-    }
-
-    pub fn settings(&self) -> &PathSettings {
-        &self.settings
     }
 
     /// Radiance arriving along `camera_ray` (whose direction need not be unit), with random

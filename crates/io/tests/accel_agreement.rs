@@ -3,11 +3,9 @@
 //! and real meshes; and whole scenes with spheres, boxes, triangles and instances agree between
 //! the wide and the binary bottom level.
 
-mod accel_common;
-
-use accel_common::*;
 use glint_render::accel::workload;
 use glint_render::scene::AccelKind;
+use glint_render::testing::*;
 use glint_render::{Aabb, GeometryDesc, Instance, Matrix4, Ray, Scene, Shape, Transform, Vec3};
 
 fn bounds_of(tris: &[Tri]) -> Aabb {

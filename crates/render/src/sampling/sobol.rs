@@ -187,6 +187,7 @@ impl PathSampler for SobolSampler<'_> {
 
 /// The second dimension of Sobol's sequence (the first is the bit-reversed index): direction
 /// numbers v_k = v_{k−1} ⊕ (v_{k−1} >> 1), as in Kollig and Keller's `sobol2`.
+#[cfg(test)]
 #[inline]
 pub fn sobol_second_dimension(index: u32) -> u32 {
     sobol_second_dimension_reversed(index).reverse_bits()
@@ -235,21 +236,6 @@ const fn sobol_second_dimension_tables() -> [[u32; 256]; 4] {
         byte += 1;
     }
     tables
-}
-
-/// A fast hash-based approximation of Owen's nested uniform scrambling of the bits of `value`
-/// (Laine and Karras 2011, constants of pbrt-v4's `FastOwenScrambler`): each bit is flipped
-/// depending only on the bits above it, so stratification is kept.
-#[inline]
-pub fn owen_scramble(value: u32, seed: u32) -> u32 {
-    owen_scramble_reversed(value.reverse_bits(), seed)
-}
-
-/// `owen_scramble` of `reversed.reverse_bits()`: the hash works on reversed bits, so a caller
-/// that has them (the first Sobol' dimension is the reversed index itself) skips two reversals.
-#[inline]
-fn owen_scramble_reversed(reversed: u32, seed: u32) -> u32 {
-    owen_hash(reversed, seed).reverse_bits()
 }
 
 /// `owen_scramble_reversed` before its final reversal.

@@ -1,6 +1,8 @@
 //! Lights of the course: point lights, rectangular area lights and shape emitters.
 
-use crate::math::{Basis, Color, Vec3};
+pub mod sampler;
+
+use crate::math::{Frame, Color, Vec3};
 
 /// A light source. Emitters that are also visible geometry (shape lights, visible area lights)
 /// additionally appear in the scene as shapes with `Material::Emissive`.
@@ -35,7 +37,7 @@ pub enum Light {
 impl Light {
     /// The rectangle's edge vectors (full width along `u_edge`, full length along `v_edge`).
     pub fn area_edges(normal: Vec3, width: f32, length: f32) -> (Vec3, Vec3) {
-        let basis = Basis::from_one(normal);
+        let basis = Frame::from_one(normal);
         (basis.u * width, basis.v * length)
     }
 

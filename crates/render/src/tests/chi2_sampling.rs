@@ -19,12 +19,14 @@
 //! derived on paper, and each carries a negative control (a deliberately wrong BSDF or Fresnel
 //! that the same check must reject).
 
-use glint_render::bsdf::{
-    fresnel_dielectric, phong_lobe_pdf, sample_phong_lobe, Bsdf, Frame, Lobe,
+use crate::light::sampler::LightSampler;
+use crate::material::bsdf::{fresnel_dielectric, Bsdf, Lobe};
+use crate::math::Frame;
+use crate::sampling::warp::{
+    phong_lobe_pdf, sample_phong_lobe, sample_uniform_cone, uniform_cone_pdf,
 };
-use glint_render::light_sampling::{sample_uniform_cone, uniform_cone_pdf, LightSampler};
-use glint_render::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere, Rng};
-use glint_render::{
+use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere, Rng};
+use crate::{
     Background, Camera, Color, CubeMap, GeometryDesc, Image, Instance, Light, Material, Projection,
     Scene, SceneParts, Shape, Vec3,
 };
@@ -436,7 +438,7 @@ fn albedo_of_eval(eval: &dyn Fn(Vec3, Vec3) -> Color, wo: Vec3) -> f64 {
 /// The mean sampled weight f·|cos θi|/pdf (mean of the channels, 0 for a failed sample) over
 /// `samples` draws, with its standard error: an unbiased estimate of the albedo.
 fn albedo_by_sampling(
-    sample: &dyn Fn(f32, (f32, f32)) -> Option<glint_render::bsdf::BsdfSample>,
+    sample: &dyn Fn(f32, (f32, f32)) -> Option<crate::material::bsdf::BsdfSample>,
     samples: usize,
     seed: u64,
 ) -> (f64, f64) {
@@ -1282,5 +1284,5 @@ fn harness_rejects_a_wrong_pdf() {
     assert!(p_value < 1e-6, "p = {p_value}");
     // And the frame used to place lobes is orthonormal (a wrong one would skew every lobe).
     let frame = Frame::from_normal(Vec3::new(0.0, 0.6, 0.8));
-    assert!(frame.tangent.dot(frame.bitangent).abs() < 1e-6);
+    assert!(frame.u.dot(frame.v).abs() < 1e-6);
 }

@@ -2,16 +2,14 @@
 //! triangle there (it neither slips through the crack nor counts the surface twice), for the
 //! triangle test alone and for the wide BVH's closest hit with both kernels.
 
-mod accel_common;
-
-use accel_common::*;
-use glint_render::{Ray, Vec3};
+use crate::testing::*;
+use crate::{Ray, Vec3};
 
 /// From outside a convex closed mesh towards `target` on its surface: the ray enters there and
 /// leaves elsewhere, so exactly two triangles are met, and the closest hit is at t = 1.
 fn check_through(
     tris: &[Tri],
-    wides: &[glint_render::accel::WideBvh],
+    wides: &[crate::accel::WideBvh],
     origin: Vec3,
     target: Vec3,
     what: &str,

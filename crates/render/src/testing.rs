@@ -2,11 +2,11 @@
 //! random rays and meshes.
 #![allow(dead_code)]
 
-use glint_render::accel::triangle::{self, WoopRay};
-use glint_render::accel::{Isa, WideBvh};
-use glint_render::bvh::Bvh;
-use glint_render::sampling::Rng;
-use glint_render::{Aabb, Ray, Shape, Vec3};
+use crate::accel::triangle::{self, WoopRay};
+use crate::accel::{Isa, WideBvh};
+use crate::bvh::Bvh;
+use crate::sampling::Rng;
+use crate::{Aabb, Ray, Shape, Vec3};
 
 pub type Tri = [[f32; 3]; 3];
 
@@ -62,7 +62,7 @@ pub fn count_hits(tris: &[Tri], ray: &Ray) -> usize {
         .count()
 }
 
-/// The reference binary BVH of `glint_render::bvh` with the same watertight test.
+/// The reference binary BVH of `crate::bvh` with the same watertight test.
 pub struct BinaryReference {
     bvh: Bvh,
     order: Vec<u32>,
@@ -122,7 +122,7 @@ pub fn wide_closest(bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
 
 /// The wide BVH with each kernel this CPU has.
 pub fn wide_variants(shapes: &[Shape]) -> Vec<WideBvh> {
-    let built = glint_render::accel::build::build(shapes);
+    let built = crate::accel::build::build(shapes);
     let mut variants = vec![];
     let mut scalar = built.clone();
     scalar.set_isa(Isa::Scalar);

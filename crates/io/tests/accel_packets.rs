@@ -5,15 +5,13 @@
 //! holding NaN or infinite rays; over random soups, an exact-grid cube, the bunny, and whole
 //! scenes with spheres, boxes and transformed instances (the two-level path).
 
-mod accel_common;
-
-use accel_common::*;
 use glint_render::accel::workload;
 use glint_render::accel::{LocalHit, WideBvh, ALL_LANES, PACKET};
 use glint_render::sampling::Rng;
-use glint_render::scene::AccelKind;
+use glint_render::scene::{AccelKind, Hit};
+use glint_render::testing::*;
 use glint_render::{
-    Aabb, GeometryDesc, Hit, Instance, Matrix4, Ray, Scene, SceneParts, Shape, Transform, Vec3,
+    Aabb, GeometryDesc, Instance, Matrix4, Ray, Scene, SceneParts, Shape, Transform, Vec3,
 };
 
 fn bounds_of(tris: &[Tri]) -> Aabb {

@@ -16,11 +16,14 @@
 use crate::light::Light;
 use crate::material::Material;
 use crate::math::{Color, Vec3};
-use crate::sampling::{sample_uniform_sphere, sample_uniform_triangle};
+use crate::sampling::warp::{
+    sample_uniform_cone, sample_uniform_sphere, sample_uniform_triangle, uniform_cone_pdf,
+    uniform_sphere_pdf,
+};
 use crate::scene::{Background, Scene};
 use crate::texture::CubeMap;
 
-use std::f32::consts::{PI, TAU};
+use std::f32::consts::PI;
 
 /// A point chosen on a light for one shadow ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -262,11 +265,6 @@ impl LightSampler {
         }
     }
 
-    /// Number of sampled lights, the environment included.
-    pub fn light_count(&self) -> usize {
-        self.lights.len()
-    }
-
     /// Index of the environment light, if the background emits.
     pub fn environment_index(&self) -> Option<usize> {
         self.environment.as_ref().map(|_| self.lights.len() - 1)
@@ -463,7 +461,8 @@ impl LightSampler {
 
     /// Density per unit solid angle with which `sample_light(index, reference, ..)` returns
     /// `direction` (unit). Intersects the light's own geometry, so it costs O(triangles) for
-    /// meshes: for tests and tools; the integrator uses `pdf_emitter_hit`.
+    /// meshes: for tests; the integrator uses `pdf_emitter_hit`.
+    #[cfg(test)]
     pub fn pdf_light_direction(&self, index: usize, reference: Vec3, direction: Vec3) -> f32 {
         match self.lights.get(index) {
             None | Some(PreparedLight::Point { .. }) => 0.0,
@@ -637,6 +636,7 @@ fn area_sample(
 }
 
 /// Möller-Trumbore: distance along unit `direction` to the triangle, if it is hit.
+#[cfg(test)]
 fn intersect_triangle(origin: Vec3, direction: Vec3, triangle: &PreparedTriangle) -> Option<f32> {
     let p = direction.cross(triangle.edge2);
     let determinant = triangle.edge1.dot(p);
@@ -685,29 +685,8 @@ impl SphereCone {
 
     #[inline]
     fn frame_to_world(&self, local: Vec3) -> Vec3 {
-        crate::bsdf::Frame::from_normal(self.axis).to_world(local)
+        crate::math::Frame::from_normal(self.axis).to_world(local)
     }
-}
-
-/// A direction uniform in the cone of half-angle θmax around +z.
-#[inline]
-pub fn sample_uniform_cone(u1: f32, u2: f32, cos_theta_max: f32) -> Vec3 {
-    let cos_theta = 1.0 - u1 * (1.0 - cos_theta_max);
-    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = (TAU * u2).sin_cos();
-    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
-}
-
-/// Density of `sample_uniform_cone` per unit solid angle.
-#[inline]
-pub fn uniform_cone_pdf(cos_theta_max: f32) -> f32 {
-    1.0 / (TAU * (1.0 - cos_theta_max))
-}
-
-/// Density of `sampling::sample_uniform_sphere` per unit solid angle.
-#[inline]
-pub fn uniform_sphere_pdf() -> f32 {
-    1.0 / (4.0 * PI)
 }
 
 /// Face index, and (s, t) in [0, 1]² on it, that `CubeMap::lookup` reads for direction `d`.

@@ -10,11 +10,11 @@
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
-use glint_render::integrator::path::{PathIntegrator, PathSettings};
-use glint_render::integrator::FirstHit;
-use glint_render::path_sampler::{PathSampler, SobolPixel};
-use glint_render::sampling::Rng;
-use glint_render::{
+use crate::integrator::path::{PathIntegrator, PathSettings};
+use crate::integrator::FirstHit;
+use crate::sampling::sobol::{PathSampler, SobolPixel};
+use crate::sampling::Rng;
+use crate::{
     Background, Camera, Color, ColorSource, CubeMap, GeometryDesc, Image, Instance, Light,
     Material, Projection, Scene, SceneParts, Shape, Vec3,
 };

@@ -7,7 +7,7 @@
 use std::path::{Path, PathBuf};
 
 use glint_render::integrator::course::{shade_camera_ray, SampleContext};
-use glint_render::light_sampling::LightSampler;
+use glint_render::light::sampler::LightSampler;
 use glint_render::sampling::Rng;
 use glint_render::{render, Color, RenderSettings, Scene};
 

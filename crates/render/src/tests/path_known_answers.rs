@@ -4,10 +4,10 @@
 //! light, a triangle emitter and a sphere emitter, plus the render-loop properties the path
 //! tracer promises (thread-count independence, no allocation per sample, denoiser features).
 
-use glint_render::integrator::path::{PathIntegrator, PathSettings};
-use glint_render::integrator::FirstHit;
-use glint_render::sampling::Rng;
-use glint_render::{
+use crate::integrator::path::{PathIntegrator, PathSettings};
+use crate::integrator::FirstHit;
+use crate::sampling::Rng;
+use crate::{
     render, Background, Camera, Color, GeometryDesc, Instance, IntegratorKind, Light, Material,
     Projection, Ray, RenderSettings, Scene, SceneParts, Shape, Vec3,
 };

@@ -5,14 +5,15 @@
 //! Expected values are computed by hand from the lecture formulas (or from an independent
 //! geometric argument), never copied from the implementation's output.
 
-use glint_render::geometry::{
+use crate::geometry::{
     intersect_box, intersect_sphere, intersect_triangle, slab_interval, PrimitiveHit,
 };
-use glint_render::integrator::course::{reflect, refract, schlick};
-use glint_render::ray::SPAWN_EPSILON;
-use glint_render::sampling::{sample_uniform_sphere, Rng};
-use glint_render::{
-    Background, Basis, Camera, GeometryDesc, Instance, Material, Matrix4, Projection, Ray, Scene,
+use crate::integrator::course::{reflect, refract, schlick};
+use crate::math::Frame;
+use crate::ray::SPAWN_EPSILON;
+use crate::sampling::{sample_uniform_sphere, Rng};
+use crate::{
+    Background, Camera, GeometryDesc, Instance, Material, Matrix4, Projection, Ray, Scene,
     SceneParts, Shape, Transform, Vec3,
 };
 
@@ -44,7 +45,7 @@ fn assert_vec_close(actual: Vec3, expected: Vec3, tol: f32, what: &str) {
 
 /// |U| = |V| = |W| = 1, pairwise orthogonal, U x V = W (right-handed), all finite.
 #[track_caller]
-fn assert_orthonormal_right_handed(b: &Basis, what: &str) {
+fn assert_orthonormal_right_handed(b: &Frame, what: &str) {
     assert!(
         b.u.is_finite() && b.v.is_finite() && b.w.is_finite(),
         "{what}: non-finite basis {b:?}"
@@ -148,7 +149,7 @@ fn matrix_close(a: &Matrix4, b: &Matrix4, tol: f64) -> bool {
 
 #[test]
 fn basis_from_two_default_gaze_is_the_world_frame() {
-    let b = Basis::from_two(v(0.0, 0.0, -1.0), Vec3::Y);
+    let b = Frame::from_two(v(0.0, 0.0, -1.0), Vec3::Y);
     assert_vec_close(b.u, v(1.0, 0.0, 0.0), 1e-7, "U");
     assert_vec_close(b.v, v(0.0, 1.0, 0.0), 1e-7, "V");
     assert_vec_close(b.w, v(0.0, 0.0, 1.0), 1e-7, "W");
@@ -158,13 +159,13 @@ fn basis_from_two_default_gaze_is_the_world_frame() {
 fn basis_from_two_hand_computed_tilted_and_sideways_gazes() {
     // Camera at (0,3,4) looking at the origin: W = (0,3,4)/5, U = Y x W / |Y x W| = (1,0,0),
     // V = W x U = (0, 0.8, -0.6).
-    let b = Basis::from_two(v(0.0, -3.0, -4.0), Vec3::Y);
+    let b = Frame::from_two(v(0.0, -3.0, -4.0), Vec3::Y);
     assert_vec_close(b.w, v(0.0, 0.6, 0.8), 1e-6, "tilted W");
     assert_vec_close(b.u, v(1.0, 0.0, 0.0), 1e-6, "tilted U");
     assert_vec_close(b.v, v(0.0, 0.8, -0.6), 1e-6, "tilted V");
 
     // Looking along +X with up +Y: W = (-1,0,0), U = Y x W = (0,0,1), V = (0,1,0).
-    let b = Basis::from_two(v(2.0, 0.0, 0.0), Vec3::Y);
+    let b = Frame::from_two(v(2.0, 0.0, 0.0), Vec3::Y);
     assert_vec_close(b.w, v(-1.0, 0.0, 0.0), 1e-7, "+X gaze W");
     assert_vec_close(b.u, v(0.0, 0.0, 1.0), 1e-7, "+X gaze U");
     assert_vec_close(b.v, v(0.0, 1.0, 0.0), 1e-7, "+X gaze V");
@@ -188,7 +189,7 @@ fn basis_from_two_is_orthonormal_right_handed_with_w_against_gaze() {
         gazes.push(random_unit(&mut r) * lerp(0.01, 100.0, r.next_f32()));
     }
     for g in gazes {
-        let b = Basis::from_two(g, Vec3::Y);
+        let b = Frame::from_two(g, Vec3::Y);
         let what = format!("from_two({g:?})");
         assert_orthonormal_right_handed(&b, &what);
         assert_vec_close(b.w, -g / g.length(), 1e-6, &format!("{what}: W = -g/|g|"));
@@ -210,7 +211,7 @@ fn basis_from_two_degenerate_gaze_parallel_to_up() {
     // Gaze (0,-1,0) (StanfordBunny.json): W = (0,1,0), X x W = (0,0,1), so U = (0,0,1) and
     // V = W x U = (1,0,0): image-right is +Z, image-up is +X.
     for g in [v(0.0, -1.0, 0.0), v(0.0, -5.0, 0.0)] {
-        let b = Basis::from_two(g, Vec3::Y);
+        let b = Frame::from_two(g, Vec3::Y);
         let what = format!("from_two({g:?})");
         assert_orthonormal_right_handed(&b, &what);
         assert_vec_close(b.w, v(0.0, 1.0, 0.0), 1e-7, &format!("{what}: W"));
@@ -218,7 +219,7 @@ fn basis_from_two_degenerate_gaze_parallel_to_up() {
         assert_vec_close(b.v, v(1.0, 0.0, 0.0), 1e-7, &format!("{what}: V = W x U"));
     }
     // Gaze (0,1,0): W = (0,-1,0), U = X x W = (0,0,-1), V = W x U = (1,0,0).
-    let b = Basis::from_two(v(0.0, 1.0, 0.0), Vec3::Y);
+    let b = Frame::from_two(v(0.0, 1.0, 0.0), Vec3::Y);
     assert_orthonormal_right_handed(&b, "from_two((0,1,0))");
     assert_vec_close(b.w, v(0.0, -1.0, 0.0), 1e-7, "up gaze W");
     assert_vec_close(b.u, v(0.0, 0.0, -1.0), 1e-7, "up gaze U = X x W");
@@ -229,7 +230,7 @@ fn basis_from_two_degenerate_gaze_parallel_to_up() {
 fn basis_from_one_hand_computed() {
     // slide001 p.18: a = (0,0,-1): W = (0,0,1); smallest |component| of W is x (first of the
     // ties), so t = (1,0,1); U = t x W / |t x W| = (0,-1,0); V = W x U = (1,0,0).
-    let b = Basis::from_one(v(0.0, 0.0, -1.0));
+    let b = Frame::from_one(v(0.0, 0.0, -1.0));
     assert_vec_close(b.w, v(0.0, 0.0, 1.0), 1e-7, "W");
     assert_vec_close(b.u, v(0.0, -1.0, 0.0), 1e-7, "U");
     assert_vec_close(b.v, v(1.0, 0.0, 0.0), 1e-7, "V");
@@ -253,7 +254,7 @@ fn basis_from_one_is_orthonormal_right_handed_with_w_against_a() {
         dirs.push(random_unit(&mut r) * lerp(0.01, 50.0, r.next_f32()));
     }
     for a in dirs {
-        let b = Basis::from_one(a);
+        let b = Frame::from_one(a);
         let what = format!("from_one({a:?})");
         assert_orthonormal_right_handed(&b, &what);
         assert_vec_close(b.w, -a / a.length(), 1e-6, &format!("{what}: W = -a/|a|"));
@@ -1326,7 +1327,7 @@ fn random_target(r: &mut Rng, kind: Kind) -> Vec3 {
 
 /// Camera-like rays from random points 12 units around the scene towards random points on
 /// each shape; yields (ray, hit) for every ray that hits something.
-fn random_hits(scene: &Scene, seed: u64, per_kind: usize) -> Vec<(Ray, glint_render::Hit)> {
+fn random_hits(scene: &Scene, seed: u64, per_kind: usize) -> Vec<(Ray, crate::scene::Hit)> {
     let mut r = rng(seed);
     let mut out = Vec::new();
     for kind in [Kind::Sphere, Kind::Triangle, Kind::Box] {

@@ -6,11 +6,9 @@
 //! shape, on both bottom-level structures. And the path tracer, which builds the BSDF of an
 //! untextured material once per render, still reads a textured one's texture at each hit.
 
-mod accel_common;
-
-use accel_common::{random_rays, random_soup, rng, shapes_of};
-use glint_render::scene::AccelKind;
-use glint_render::{
+use crate::scene::AccelKind;
+use crate::testing::{random_rays, random_soup, rng, shapes_of};
+use crate::{
     render, Background, Camera, Color, ColorSource, GeometryDesc, Image, Instance, IntegratorKind,
     Light, Material, Matrix4, Projection, RenderSettings, Scene, SceneParts, Shape, Transform,
     Vec3,

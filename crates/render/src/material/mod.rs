@@ -1,5 +1,7 @@
 //! Materials: the course's shaders as one closed enum.
 
+pub mod bsdf;
+
 use crate::math::Color;
 use crate::texture::ColorSource;
 

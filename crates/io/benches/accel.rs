@@ -1,7 +1,7 @@
 //! Criterion benches of the ray engine (issue 3): BVH build, and closest-hit and shadow-ray
 //! throughput on the Stanford bunny for coherent camera rays and incoherent bounce rays, with
 //! the 8-wide BVH's AVX2 kernel, its scalar kernel, and the reference binary BVH, and camera
-//! and shadow rays in packets of eight; and a small whole-frame render. `cargo bench -p glint-render --bench accel`.
+//! and shadow rays in packets of eight; and a small whole-frame render. `cargo bench -p glint-io --bench accel`.
 //!
 //! The whole-program table over all workloads is `glint bench table`; the comparison with
 //! Embree is `bench/embree_compare.sh`.

@@ -35,54 +35,13 @@
 //! Only the dielectric tells inside from outside, by the sign of ωo.z.
 
 use crate::material::{Material, MaterialId};
-use crate::math::{Color, Vec3};
-use crate::sampling::{cosine_hemisphere_pdf, sample_cosine_hemisphere};
+use crate::math::{Color, Frame, Vec3};
+use crate::sampling::warp::{
+    cosine_hemisphere_pdf, phong_lobe_pdf, sample_cosine_hemisphere, sample_phong_lobe,
+};
 use crate::texture::{ColorSource, Image};
 
 use std::f32::consts::{FRAC_1_PI, TAU};
-
-/// An orthonormal frame whose `normal` is the local +z axis.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Frame {
-    pub tangent: Vec3,
-    pub bitangent: Vec3,
-    pub normal: Vec3,
-}
-
-impl Frame {
-    /// A frame around a unit normal, continuous everywhere except across n.z = 0 (Duff et al.,
-    /// "Building an Orthonormal Basis, Revisited", 2017): branch-free and exact, unlike the
-    /// cross product with a fixed helper axis.
-    #[inline]
-    pub fn from_normal(normal: Vec3) -> Frame {
-        let sign = 1.0f32.copysign(normal.z);
-        let a = -1.0 / (sign + normal.z);
-        let b = normal.x * normal.y * a;
-        Frame {
-            tangent: Vec3::new(
-                1.0 + sign * normal.x * normal.x * a,
-                sign * b,
-                -sign * normal.x,
-            ),
-            bitangent: Vec3::new(b, sign + normal.y * normal.y * a, -normal.y),
-            normal,
-        }
-    }
-
-    #[inline]
-    pub fn to_local(&self, v: Vec3) -> Vec3 {
-        Vec3::new(
-            v.dot(self.tangent),
-            v.dot(self.bitangent),
-            v.dot(self.normal),
-        )
-    }
-
-    #[inline]
-    pub fn to_world(&self, v: Vec3) -> Vec3 {
-        self.tangent * v.x + self.bitangent * v.y + self.normal * v.z
-    }
-}
 
 /// One reflectance model inside a `Bsdf`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -356,11 +315,13 @@ impl Bsdf {
     }
 
     /// f(ωo, ωi) of the non-specular lobes (deltas evaluate to zero).
+    #[cfg(test)]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Color {
         self.eval_and_pdf(wo, wi).0
     }
 
     /// Density per unit solid angle with which `sample` returns ωi from its non-specular lobes.
+    #[cfg(test)]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         self.eval_and_pdf(wo, wi).1
     }
@@ -572,38 +533,6 @@ fn mirror_direction(wo: Vec3) -> Vec3 {
     Vec3::new(-wo.x, -wo.y, wo.z)
 }
 
-/// A direction around +z with density (p+1)/(2π) · cos^p θ per unit solid angle: the lobe
-/// of Phong's and Blinn's highlights.
-#[inline]
-pub fn sample_phong_lobe(u1: f32, u2: f32, exponent: f32) -> Vec3 {
-    let cos_theta = u1.powf(1.0 / (exponent + 1.0));
-    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-    let (sin_phi, cos_phi) = (TAU * u2).sin_cos();
-    Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
-}
-
-/// Density of `sample_phong_lobe` per unit solid angle.
-#[inline]
-pub fn phong_lobe_pdf(cos_theta: f32, exponent: f32) -> f32 {
-    if cos_theta <= 0.0 {
-        return 0.0;
-    }
-    (exponent + 1.0) / TAU * cos_theta.powf(exponent)
-}
-
-/// The (u1, u2) that `sample_phong_lobe` maps to `direction`.
-#[inline]
-pub fn invert_phong_lobe(direction: Vec3, exponent: f32) -> (f32, f32) {
-    let u1 = direction.z.clamp(0.0, 1.0).powf(exponent + 1.0);
-    let phi = direction.y.atan2(direction.x);
-    let u2 = if phi < 0.0 {
-        phi / TAU + 1.0
-    } else {
-        phi / TAU
-    };
-    (u1, u2)
-}
-
 /// Unpolarised Fresnel reflectance of a smooth dielectric boundary (exact, not Schlick).
 /// `cos_theta_i` is the cosine on the incident side, measured against the normal whose back
 /// side has relative index `eta`; a negative cosine means the light arrives from the back.
@@ -665,6 +594,7 @@ fn sample_dielectric(wo: Vec3, eta: f32, u: f32) -> Option<BsdfSample> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::warp::invert_phong_lobe;
 
     #[test]
     fn frame_is_orthonormal_and_round_trips() {
@@ -676,10 +606,10 @@ mod tests {
             Vec3::new(0.0, 0.0, -1.0 + 1e-7).normalized(),
         ] {
             let frame = Frame::from_normal(normal);
-            assert!((frame.tangent.length() - 1.0).abs() < 1e-5);
-            assert!((frame.bitangent.length() - 1.0).abs() < 1e-5);
-            assert!(frame.tangent.dot(frame.bitangent).abs() < 1e-5);
-            assert!(frame.tangent.dot(normal).abs() < 1e-5);
+            assert!((frame.u.length() - 1.0).abs() < 1e-5);
+            assert!((frame.v.length() - 1.0).abs() < 1e-5);
+            assert!(frame.u.dot(frame.v).abs() < 1e-5);
+            assert!(frame.u.dot(normal).abs() < 1e-5);
             let v = Vec3::new(0.2, 0.7, -0.4);
             let back = frame.to_world(frame.to_local(v));
             assert!((back - v).length() < 1e-5);
