@@ -18,9 +18,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::{Args, Subcommand, ValueEnum};
+use glint_render::accel::instances::AccelKind;
 use glint_render::accel::workload::{self, Workload};
 use glint_render::accel::PACKET;
-use glint_render::scene::AccelKind;
 use glint_render::{Aabb, Camera, Light, Ray, Scene, SceneParts, Vec3};
 use rayon::prelude::*;
 

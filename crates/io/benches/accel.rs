@@ -10,9 +10,9 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use glint_render::accel::instances::AccelKind;
 use glint_render::accel::workload;
 use glint_render::accel::{Isa, WideBvh, PACKET};
-use glint_render::scene::AccelKind;
 use glint_render::{Ray, RenderSettings, Scene, SceneParts, Shape};
 
 fn bunny() -> SceneParts {
@@ -100,7 +100,13 @@ fn traverse(c: &mut Criterion) {
             b.iter(|| {
                 packets
                     .iter()
-                    .map(|p| wide.intersect_packet(p).iter().flatten().count())
+                    .map(|p| {
+                        wide.instances()
+                            .intersect_packet(p)
+                            .iter()
+                            .flatten()
+                            .count()
+                    })
                     .sum::<usize>()
             })
         },
@@ -117,7 +123,13 @@ fn traverse(c: &mut Criterion) {
             b.iter(|| {
                 packets
                     .iter()
-                    .map(|p| wide.occluded_packet(p).iter().filter(|&&o| o).count())
+                    .map(|p| {
+                        wide.instances()
+                            .occluded_packet(p)
+                            .iter()
+                            .filter(|&&o| o)
+                            .count()
+                    })
                     .sum::<usize>()
             })
         },

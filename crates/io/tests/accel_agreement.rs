@@ -3,8 +3,9 @@
 //! and real meshes; and whole scenes with spheres, boxes, triangles and instances agree between
 //! the wide and the binary bottom level.
 
+use glint_render::accel::instances::AccelKind;
 use glint_render::accel::workload;
-use glint_render::scene::AccelKind;
+use glint_render::scene::SurfaceNeeds;
 use glint_render::testing::*;
 use glint_render::{Aabb, GeometryDesc, Instance, Matrix4, Ray, Scene, Shape, Transform, Vec3};
 
@@ -159,8 +160,8 @@ fn nan_and_infinite_rays_do_not_crash() {
     for ray in &bad {
         let (a, b) = (wide.intersect(ray), binary.intersect(ray));
         assert_eq!(
-            a.map(|h| (h.t, wide.source_primitive(&h))),
-            b.map(|h| (h.t, binary.source_primitive(&h))),
+            a.map(|h| (h.t, wide.instances().source_primitive(&h))),
+            b.map(|h| (h.t, binary.instances().source_primitive(&h))),
             "{ray:?}"
         );
         assert_eq!(wide.occluded(ray), binary.occluded(ray), "{ray:?}");
@@ -267,8 +268,8 @@ fn mixed_scenes_agree_between_bottom_levels() {
     let wide = Scene::with_accel(mixed_parts(21), AccelKind::Wide);
     let binary = Scene::with_accel(mixed_parts(21), AccelKind::Binary);
     assert_eq!(
-        wide.unique_primitive_count(),
-        binary.unique_primitive_count()
+        wide.instances().unique_primitive_count(),
+        binary.instances().unique_primitive_count()
     );
     let mut r = rng(22);
     let bounds = wide.bounds();
@@ -286,9 +287,12 @@ fn mixed_scenes_agree_between_bottom_levels() {
                     (a.t - b.t).abs() <= 1e-5 * a.t.abs().max(1.0),
                     "{ray:?}: {a:?} vs {b:?}"
                 );
-                let (sa, sb) = (wide.surface(ray, &a), binary.surface(ray, &b));
-                if (wide.source_primitive(&a), sa.material)
-                    != (binary.source_primitive(&b), sb.material)
+                let (sa, sb) = (
+                    wide.surface(ray, &a, SurfaceNeeds::Uv),
+                    binary.surface(ray, &b, SurfaceNeeds::Uv),
+                );
+                if (wide.instances().source_primitive(&a), sa.material)
+                    != (binary.instances().source_primitive(&b), sb.material)
                 {
                     mismatches += 1;
                 } else {

@@ -5,10 +5,10 @@
 //! holding NaN or infinite rays; over random soups, an exact-grid cube, the bunny, and whole
 //! scenes with spheres, boxes and transformed instances (the two-level path).
 
+use glint_render::accel::instances::{AccelKind, Hit};
 use glint_render::accel::workload;
 use glint_render::accel::{LocalHit, WideBvh, ALL_LANES, PACKET};
 use glint_render::sampling::Rng;
-use glint_render::scene::{AccelKind, Hit};
 use glint_render::testing::*;
 use glint_render::{
     Aabb, GeometryDesc, Instance, Matrix4, Ray, Scene, SceneParts, Shape, Transform, Vec3,
@@ -293,10 +293,10 @@ fn check_scene(scene: &Scene, packets: &[Packet]) -> usize {
         if *lanes == ALL_LANES {
             assert_eq!(
                 closest.map(hit_bits),
-                scene.intersect_packet(rays).map(hit_bits)
+                scene.instances().intersect_packet(rays).map(hit_bits)
             );
             assert_eq!(
-                scene.occluded_packet(rays),
+                scene.instances().occluded_packet(rays),
                 std::array::from_fn(|l| occluded & (1 << l) != 0)
             );
         }

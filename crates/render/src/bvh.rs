@@ -7,6 +7,7 @@
 //! intersect primitives themselves in the traversal callback. The same code serves the
 //! bottom level (shapes of a mesh) and the top level (instances).
 
+use crate::accel::isa::Avx2;
 use crate::geometry::Aabb;
 use crate::math::Vec3;
 use crate::ray::Ray;
@@ -304,6 +305,8 @@ impl RayInverse {
 
 /// `RayInverse` for the eight rays of a packet, also as lanes for the 8-lane node test.
 struct PacketInverse {
+    /// The AVX2 node test where the CPU has it, chosen once per packet.
+    avx2: Option<Avx2>,
     rays: [RayInverse; 8],
     t_min: [f32; 8],
     origin: [[f32; 8]; 3],
@@ -315,6 +318,7 @@ impl PacketInverse {
     fn new(rays: &[Ray; 8]) -> PacketInverse {
         let inv = rays.each_ref().map(RayInverse::new);
         PacketInverse {
+            avx2: Avx2::detect(),
             t_min: rays.each_ref().map(|r| r.t_min),
             origin: std::array::from_fn(|a| std::array::from_fn(|l| inv[l].origin[a])),
             inv_dir: std::array::from_fn(|a| std::array::from_fn(|l| inv[l].inv_dir[a])),
@@ -325,14 +329,16 @@ impl PacketInverse {
     /// The rays of `active` whose `hits` passes: all at once with AVX2, else one by one.
     #[inline]
     fn hits(&self, node: &BvhNode, t_max: &[f32; 8], active: u8) -> u8 {
-        if let Some(mask) = crate::accel::simd::binary_node_lanes(
-            node.min,
+        if let Some(avx2) = self.avx2 {
+            let mask = crate::accel::simd::binary_node_lanes(
+                avx2,
+                node.min,
             node.max,
             &self.origin,
             &self.inv_dir,
             &self.t_min,
             t_max,
-        ) {
+            );
             return mask & active;
         }
         let mut hit = 0u8;

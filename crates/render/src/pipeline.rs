@@ -16,9 +16,11 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use rayon::prelude::*;
 
 use crate::film::{Features, Film};
+use crate::integrator::course::grid_size;
+use crate::integrator::course::CourseIntegrator;
 use crate::integrator::debug::{DebugIntegrator, DebugView};
 use crate::integrator::path::{PathIntegrator, PathSettings, DEFAULT_MAX_DEPTH};
-use crate::integrator::{CourseIntegrator, Integrator, PixelContext, Sample, TileCounters};
+use crate::integrator::{Integrator, PixelContext, Sample, TileCounters};
 use crate::math::{Color, Vec3};
 use crate::scene::Scene;
 
@@ -89,11 +91,6 @@ impl IntegratorKind {
             _ => grid_size(requested).pow(2),
         }
     }
-}
-
-/// Samples per axis of the course's jittered grid for `requested` rays per pixel.
-pub(crate) fn grid_size(requested: u32) -> u32 {
-    ((requested.max(1) as f64).sqrt().floor() as u32).max(1)
 }
 
 /// A rectangle of pixels, `x0..x1` by `y0..y1`, counted from the top-left corner of the image

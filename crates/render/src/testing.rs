@@ -127,9 +127,9 @@ pub fn wide_variants(shapes: &[Shape]) -> Vec<WideBvh> {
     let mut scalar = built.clone();
     scalar.set_isa(Isa::Scalar);
     variants.push(scalar);
-    if Isa::detect() == Isa::Avx2 {
+    if let Isa::Avx2(avx2) = Isa::detect() {
         let mut simd = built;
-        simd.set_isa(Isa::Avx2);
+        simd.set_isa(Isa::Avx2(avx2));
         variants.push(simd);
     } else {
         no_avx2_kernel();

@@ -11,12 +11,13 @@
 
 use rayon::prelude::*;
 
-use crate::accel::wide::{ChildRef, Isa, TriangleBlock, WideBvh, WideNode, BLOCK, WIDTH};
+use crate::accel::isa::Isa;
+use crate::accel::wide::{
+    ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH,
+};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
 
-/// The deepest a tree gets (levels of nodes below the root), whatever the input.
-pub const MAX_DEPTH: usize = 48;
 /// Below this depth the SAH chooses splits; deeper, median splits by count finish the job in
 /// at most log₂(2²⁷) more levels.
 const SAH_DEPTH: usize = 20;

@@ -1,13 +1,19 @@
 //! Glint's ray engine for the bottom level of the scene: an 8-wide BVH (`wide.rs`) built by
 //! binned SAH with a block-aware leaf cost (`build.rs`), triangles in blocks of four tested by
 //! the watertight algorithm of Woop, Benthin and Wald (`triangle.rs`), traversed with AVX2
-//! kernels chosen at run time (`simd.rs`, the one module with `unsafe`) or a scalar fallback.
+//! kernels (`simd.rs`, the one module with `unsafe`) or a scalar fallback, chosen once at
+//! build time (`isa.rs`) and applied in one place (`dispatch.rs`). The modules depend one way:
+//! `isa`, `triangle` <- `wide` (node layout, single-ray traversal) <- `packet` <- `simd` <-
+//! `dispatch`; `build` writes the layout of `wide`.
 //! The binary BVH of `crate::bvh` stays as the reference the tests compare against (and as
 //! the top level over instances). `packet.rs` traces eight coherent rays together (camera rays
 //! of a pixel block) with results identical to tracing them one by one. `workload.rs` holds the
 //! fixed ray sets that measure all this.
 
 pub mod build;
+pub mod instances;
+mod dispatch;
+pub mod isa;
 pub mod packet;
 pub mod simd;
 pub mod triangle;
@@ -15,7 +21,9 @@ pub mod wide;
 #[cfg(feature = "bench")]
 pub mod workload;
 
-pub use packet::{ALL_LANES, PACKET};
+#[cfg(feature = "bench")]
+pub use packet::ALL_LANES;
+pub use packet::PACKET;
 #[cfg(any(test, feature = "bench"))]
-pub use wide::Isa;
+pub use isa::Isa;
 pub use wide::{LocalHit, WideBvh};

@@ -41,6 +41,7 @@ use crate::ray::Ray;
 /// Rays per packet.
 pub const PACKET: usize = 8;
 /// Every lane of a packet.
+#[cfg(any(test, feature = "bench"))]
 pub const ALL_LANES: u8 = 0xff;
 
 /// One f32 per ray of a packet, aligned for 8-lane loads.
@@ -830,7 +831,8 @@ mod tests {
                 closest(&ScalarPacketKernel, &bvh, &p, &mut ArrayPacketStack::new()),
                 any(&ScalarPacketKernel, &bvh, &p, &mut ArrayPacketStack::new()),
             );
-            let avx2 = crate::accel::simd::packet_closest_any(&bvh, &p);
+            let avx2 = crate::accel::isa::Avx2::detect()
+                .map(|avx2| crate::accel::simd::packet_closest_any(avx2, &bvh, &p));
             for ((t, prim), occluded) in std::iter::once(scalar).chain(avx2) {
                 for l in 0..PACKET {
                     let expect = if lanes & (1 << l) != 0 {

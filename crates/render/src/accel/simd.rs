@@ -16,119 +16,107 @@
 //! `bench/README.md` for the figures.
 #![allow(unsafe_code)]
 
-use crate::accel::packet::{self, ArrayPacketStack, ScalarPacketKernel, PACKET};
-use crate::accel::wide::{self, LocalHit, WideBvh};
+use crate::accel::isa::Avx2;
+#[cfg(test)]
+use crate::accel::packet;
+use crate::accel::packet::PACKET;
+use crate::accel::wide::{LocalHit, WideBvh};
 use crate::ray::Ray;
 
-/// Whether this CPU runs the AVX2+FMA kernels.
+// Each entry point takes the `Avx2` proof (`accel/isa.rs`) that the CPU has AVX2 and FMA, so
+// the kernel is chosen once, where the `Isa` is; on other targets the proof cannot exist.
+
+/// Closest hit with the AVX2 kernels.
 #[inline]
-pub fn avx2_available() -> bool {
+pub(crate) fn closest(avx2: Avx2, bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
     #[cfg(target_arch = "x86_64")]
     {
-        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma")
+        let _ = avx2;
+        // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
+        unsafe { x86::closest(bvh, ray) }
     }
     #[cfg(not(target_arch = "x86_64"))]
+    match avx2 {}
+}
+
+/// Any hit with the AVX2 kernels.
+#[inline]
+pub(crate) fn any(avx2: Avx2, bvh: &WideBvh, ray: &Ray) -> bool {
+    #[cfg(target_arch = "x86_64")]
     {
-        false
+        let _ = avx2;
+        // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
+        unsafe { x86::any(bvh, ray) }
     }
+    #[cfg(not(target_arch = "x86_64"))]
+    match avx2 {}
 }
 
-/// Closest hit with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
-#[inline]
-pub(crate) fn closest(bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
-    #[cfg(target_arch = "x86_64")]
-    if avx2_available() {
-        // SAFETY: the CPU has AVX2 and FMA (checked just above).
-        return unsafe { x86::closest(bvh, ray) };
-    }
-    wide::closest(&wide::ScalarKernel, bvh, ray, &mut wide::ArrayStack::new())
-}
-
-/// Any hit with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
-#[inline]
-pub(crate) fn any(bvh: &WideBvh, ray: &Ray) -> bool {
-    #[cfg(target_arch = "x86_64")]
-    if avx2_available() {
-        // SAFETY: the CPU has AVX2 and FMA (checked just above).
-        return unsafe { x86::any(bvh, ray) };
-    }
-    wide::any(&wide::ScalarKernel, bvh, ray, &mut wide::ArrayStack::new())
-}
-
-/// `WideBvh::intersect_packet` with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
+/// `WideBvh::intersect_packet` with the AVX2 kernels.
 #[inline]
 pub(crate) fn intersect_packet(
+    avx2: Avx2,
     bvh: &WideBvh,
     rays: &[Ray; PACKET],
     lanes: u8,
 ) -> [Option<LocalHit>; PACKET] {
     #[cfg(target_arch = "x86_64")]
-    if avx2_available() {
-        // SAFETY: the CPU has AVX2 and FMA (checked just above).
-        return unsafe { x86::intersect_packet(bvh, rays, lanes) };
+    {
+        let _ = avx2;
+        // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
+        unsafe { x86::intersect_packet(bvh, rays, lanes) }
     }
-    packet::intersect(
-        &ScalarPacketKernel,
-        bvh,
-        rays,
-        lanes,
-        &mut ArrayPacketStack::new(),
-    )
+    #[cfg(not(target_arch = "x86_64"))]
+    match avx2 {}
 }
 
-/// `WideBvh::occluded_packet` with the AVX2 kernels (the scalar ones where the CPU lacks AVX2).
+/// `WideBvh::occluded_packet` with the AVX2 kernels.
 #[inline]
-pub(crate) fn occluded_packet(bvh: &WideBvh, rays: &[Ray; PACKET], lanes: u8) -> u8 {
+pub(crate) fn occluded_packet(avx2: Avx2, bvh: &WideBvh, rays: &[Ray; PACKET], lanes: u8) -> u8 {
     #[cfg(target_arch = "x86_64")]
-    if avx2_available() {
-        // SAFETY: the CPU has AVX2 and FMA (checked just above).
-        return unsafe { x86::occluded_packet(bvh, rays, lanes) };
+    {
+        let _ = avx2;
+        // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
+        unsafe { x86::occluded_packet(bvh, rays, lanes) }
     }
-    packet::occluded(
-        &ScalarPacketKernel,
-        bvh,
-        rays,
-        lanes,
-        &mut ArrayPacketStack::new(),
-    )
+    #[cfg(not(target_arch = "x86_64"))]
+    match avx2 {}
 }
 
-/// The packet traversal alone with the AVX2 kernel (`None` without AVX2), for tests of packets
-/// that `WideBvh::intersect_packet` would hand to single rays.
+/// The packet traversal alone with the AVX2 kernel, for tests of packets that
+/// `WideBvh::intersect_packet` would hand to single rays.
 #[cfg(test)]
 pub(crate) fn packet_closest_any(
+    avx2: Avx2,
     bvh: &WideBvh,
     p: &packet::PacketRays,
-) -> Option<((packet::Lanes, [u32; PACKET]), u32)> {
-    #[cfg(target_arch = "x86_64")]
-    if avx2_available() {
-        // SAFETY: the CPU has AVX2 and FMA (checked just above).
-        return Some(unsafe { x86::packet_closest_any(bvh, p) });
-    }
-    let _ = (bvh, p);
-    None
+) -> ((packet::Lanes, [u32; PACKET]), u32) {
+    let _ = avx2;
+    // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
+    unsafe { x86::packet_closest_any(bvh, p) }
 }
 
 /// The slab test of the binary BVH (`bvh::RayInverse::hits`) for eight rays against one node,
-/// the same operations lane by lane: the mask of rays that hit it within [t_min, t_max], or
-/// `None` where the CPU lacks AVX2 (the caller then tests ray by ray). For the top level's
-/// packet traversal (`Bvh::traverse_packet`).
+/// the same operations lane by lane: the mask of rays that hit it within [t_min, t_max]. For
+/// the top level's packet traversal (`Bvh::traverse_packet`).
 #[inline]
 pub(crate) fn binary_node_lanes(
+    avx2: Avx2,
     min: [f32; 3],
     max: [f32; 3],
     origin: &[[f32; 8]; 3],
     inv_dir: &[[f32; 8]; 3],
     t_min: &[f32; 8],
     t_max: &[f32; 8],
-) -> Option<u8> {
+) -> u8 {
     #[cfg(target_arch = "x86_64")]
-    if avx2_available() {
-        // SAFETY: the CPU has AVX2 and FMA (checked just above).
-        return Some(unsafe { x86::binary_node_lanes(min, max, origin, inv_dir, t_min, t_max) });
+    {
+        let _ = avx2;
+        // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
+        unsafe { x86::binary_node_lanes(min, max, origin, inv_dir, t_min, t_max) }
     }
-    let _ = (min, max, origin, inv_dir, t_min, t_max);
-    None
+    #[cfg(not(target_arch = "x86_64"))]
+    match avx2 {}
 }
 
 #[cfg(target_arch = "x86_64")]

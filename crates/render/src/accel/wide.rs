@@ -21,7 +21,7 @@
 //! hit. The box and block tests are the `Kernel`: AVX2 in `simd.rs` when the CPU has it, the
 //! scalar `ScalarKernel` here otherwise. Both compute the same thing.
 
-use crate::accel::packet::{self, ArrayPacketStack, ScalarPacketKernel, PACKET};
+use crate::accel::isa::Isa;
 use crate::accel::triangle::{self, WoopRay};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
@@ -162,24 +162,6 @@ impl ChildRef {
     }
 }
 
-/// Which kernel traverses: AVX2+FMA where the CPU has it, else scalar.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Isa {
-    Scalar,
-    Avx2,
-}
-
-impl Isa {
-    /// The best this CPU runs.
-    pub fn detect() -> Isa {
-        if crate::accel::simd::avx2_available() {
-            Isa::Avx2
-        } else {
-            Isa::Scalar
-        }
-    }
-}
-
 /// An 8-wide BVH over one geometry's shapes, with its triangles in blocks.
 #[derive(Clone, Debug)]
 pub struct WideBvh {
@@ -223,17 +205,14 @@ impl WideBvh {
     /// Chooses the kernel (tests compare the scalar and SIMD kernels).
     #[cfg(any(test, feature = "bench"))]
     pub fn set_isa(&mut self, isa: Isa) {
-        self.isa = if isa == Isa::Avx2 && Isa::detect() != Isa::Avx2 {
-            Isa::Scalar
-        } else {
-            isa
-        };
+        self.isa = isa;
     }
     /// Number of primitive slots (block lanes, padding included, then shapes).
     pub fn primitive_slots(&self) -> usize {
         self.blocks.len() * BLOCK + self.shapes.len()
     }
     /// The index in the geometry as given of primitive `primitive`.
+    #[cfg(any(test, feature = "bench"))]
     pub fn source_index(&self, primitive: u32) -> u32 {
         self.source[primitive as usize]
     }
@@ -259,71 +238,6 @@ impl WideBvh {
         self.blocks.len() * std::mem::size_of::<TriangleBlock>()
             + self.shapes.len() * std::mem::size_of::<Shape>()
             + self.source.len() * std::mem::size_of::<u32>()
-    }
-
-    /// The closest hit with t in `[ray.t_min, ray.t_max]`. Ties in t go to the primitive given
-    /// first, so the answer depends neither on the traversal order nor on the structure.
-    #[inline]
-    pub fn intersect(&self, ray: &Ray) -> Option<LocalHit> {
-        let (t, primitive) = self.intersect_preliminary(ray)?;
-        Some(self.finish(ray, t, primitive))
-    }
-
-    /// `intersect` without the barycentrics: (t, primitive). `finish` adds them.
-    #[inline]
-    pub fn intersect_preliminary(&self, ray: &Ray) -> Option<(f32, u32)> {
-        if !ray_is_valid(ray) {
-            return None;
-        }
-        match self.isa {
-            Isa::Avx2 => crate::accel::simd::closest(self, ray),
-            Isa::Scalar => closest(&ScalarKernel, self, ray, &mut ArrayStack::new()),
-        }
-    }
-
-    /// True when any primitive meets the ray with t in `[ray.t_min, ray.t_max]`.
-    #[inline]
-    pub fn occluded(&self, ray: &Ray) -> bool {
-        if !ray_is_valid(ray) {
-            return false;
-        }
-        match self.isa {
-            Isa::Avx2 => crate::accel::simd::any(self, ray),
-            Isa::Scalar => any(&ScalarKernel, self, ray, &mut ArrayStack::new()),
-        }
-    }
-
-    /// Closest hits of the rays in `lanes` (bit l for `rays[l]`) traced together as a packet
-    /// (`packet.rs`): in each such lane exactly what `intersect` returns for that ray alone;
-    /// `None` in the other lanes. For coherent rays (camera rays of a pixel block).
-    #[inline]
-    pub fn intersect_packet(&self, rays: &[Ray; PACKET], lanes: u8) -> [Option<LocalHit>; PACKET] {
-        match self.isa {
-            Isa::Avx2 => crate::accel::simd::intersect_packet(self, rays, lanes),
-            Isa::Scalar => packet::intersect(
-                &ScalarPacketKernel,
-                self,
-                rays,
-                lanes,
-                &mut ArrayPacketStack::new(),
-            ),
-        }
-    }
-
-    /// The rays of `lanes` that `occluded` would report occluded, traced as a packet: bit l
-    /// set for `rays[l]`.
-    #[inline]
-    pub fn occluded_packet(&self, rays: &[Ray; PACKET], lanes: u8) -> u8 {
-        match self.isa {
-            Isa::Avx2 => crate::accel::simd::occluded_packet(self, rays, lanes),
-            Isa::Scalar => packet::occluded(
-                &ScalarPacketKernel,
-                self,
-                rays,
-                lanes,
-                &mut ArrayPacketStack::new(),
-            ),
-        }
     }
 
     /// Whether primitive `a` comes before `b` in the geometry as given (ties in t go to the
@@ -372,7 +286,7 @@ impl WideBvh {
 
 /// Rays with NaN or infinite components, or an empty window, meet nothing.
 #[inline(always)]
-fn ray_is_valid(ray: &Ray) -> bool {
+pub(crate) fn ray_is_valid(ray: &Ray) -> bool {
     ray.origin.is_finite() && ray.direction.is_finite() && ray.t_min <= ray.t_max
 }
 
@@ -409,7 +323,10 @@ pub(crate) trait Stack {
 }
 
 /// Entries a traversal stack needs: at most 7 per level, and the build caps the depth.
-pub(crate) const STACK_SIZE: usize = 7 * crate::accel::build::MAX_DEPTH + 8;
+pub(crate) const STACK_SIZE: usize = 7 * MAX_DEPTH + 8;
+
+/// The deepest a tree gets (levels of nodes below the root), whatever the input.
+pub(crate) const MAX_DEPTH: usize = 48;
 
 /// A zero-initialised stack (the scalar path; the SIMD path keeps an uninitialised one).
 pub(crate) struct ArrayStack {

@@ -19,7 +19,7 @@ use crate::geometry::Aabb;
 use crate::math::{Frame, Vec3};
 use crate::ray::Ray;
 use crate::sampling::{sample_cosine_hemisphere, Rng};
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceNeeds};
 
 /// How far secondary rays start off the surface, relative to the scene's bounding-box diagonal.
 pub const SURFACE_OFFSET: f32 = 1e-4;
@@ -87,7 +87,7 @@ pub fn secondary_rays(
         .enumerate()
         .map(|(index, ray)| {
             let hit = scene.intersect(ray)?;
-            let surface = scene.surface(ray, &hit);
+            let surface = scene.surface(ray, &hit, SurfaceNeeds::Uv);
             let mut normal = surface.normal;
             if normal.dot(ray.direction) > 0.0 {
                 normal = -normal;

@@ -14,7 +14,8 @@ use crate::material::Material;
 use crate::math::{Frame, Color, Vec3};
 use crate::ray::Ray;
 use crate::sampling::{mix64, sample_cosine_hemisphere, sample_uniform_sphere, Rng};
-use crate::scene::{Hit, Scene, SurfaceInteraction};
+use crate::accel::instances::Hit;
+use crate::scene::{Scene, SurfaceInteraction, SurfaceNeeds};
 use crate::texture::ColorSource;
 
 /// Per-sample state handed to an integrator: the sample's random stream and where the sample
@@ -238,6 +239,11 @@ impl Integrator for CourseIntegrator {
     }
 }
 
+/// Samples per axis of the course's jittered grid for `requested` rays per pixel.
+pub(crate) fn grid_size(requested: u32) -> u32 {
+    ((requested.max(1) as f64).sqrt().floor() as u32).max(1)
+}
+
 /// The shading of a camera ray whose first hit is already known (traced in a packet).
 pub(crate) type ShadeFirstHit<'a> = &'a dyn Fn(&Ray, Option<Hit>, &mut SampleContext) -> Color;
 
@@ -259,7 +265,7 @@ pub(crate) fn grid_samples(
 ) {
     let pixel_index = pixel.index();
     let all = pixel.samples_per_pixel;
-    let grid = crate::pipeline::grid_size(all);
+    let grid = grid_size(all);
     // Sample `s`: its camera ray and context.
     let camera_sample = |s: u32| {
         let mut rng = Rng::for_sample(pixel.seed, pixel_index, s as u64);
@@ -347,7 +353,7 @@ fn shade(
     let Some(hit) = hit else {
         return scene.background_radiance(ray.direction);
     };
-    let si = scene.surface(ray, &hit);
+    let si = scene.surface(ray, &hit, SurfaceNeeds::Uv);
     let d = ray.direction.normalized();
     let v = -d;
     // Two-sided shading (FORMAT.md A6): opaque surfaces face the viewer.

@@ -7,7 +7,7 @@ use crate::integrator::course::grid_samples;
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 use crate::math::{Color, Vec3};
 use crate::ray::Ray;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceNeeds};
 
 /// Which property of the first hit a debug view shows.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -34,7 +34,7 @@ impl DebugIntegrator {
     fn radiance(&self, scene: &Scene, ray: &Ray) -> Color {
         match self.view {
             DebugView::Normals => match scene.intersect(ray) {
-                Some(hit) => (scene.surface(ray, &hit).normal + Vec3::ONE) * 0.5,
+                Some(hit) => (scene.surface(ray, &hit, SurfaceNeeds::Uv).normal + Vec3::ONE) * 0.5,
                 None => Color::ZERO,
             },
             // The camera ray was counted by the grid's sample already.

@@ -17,9 +17,8 @@ use crate::material::bsdf::Bsdf;
 use crate::material::Material;
 use crate::math::{Color, Vec3};
 use crate::ray::Ray;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceNeeds};
 
-pub(crate) use course::CourseIntegrator;
 
 /// One pixel as an integrator sees it.
 #[derive(Clone, Copy, Debug)]
@@ -92,7 +91,7 @@ impl FirstHit {
                 ..FirstHit::default()
             };
         };
-        let si = scene.surface(&ray, &hit);
+        let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
         let bsdf = Bsdf::from_material(&scene.materials, &scene.textures, si.material, si.uv);
         let albedo = match Material::get(&scene.materials, si.material) {
             Material::Emissive { radiance, .. } if bsdf.is_black() => radiance.clamp01(),

@@ -25,7 +25,7 @@ use crate::material::{Material, MaterialId};
 use crate::math::Color;
 use crate::sampling::sobol::{PathSampler, SobolPixel};
 use crate::ray::Ray;
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceNeeds};
 
 /// Path-length controls of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -201,7 +201,7 @@ impl PathIntegrator {
                 }
                 break;
             };
-            let si = scene.surface_without_uv(&ray, &hit);
+            let si = scene.surface(&ray, &hit, SurfaceNeeds::Geometry);
             let material = self.material(si.material);
 
             // Light emitted by the surface towards the ray's origin. Emitters are one-sided, and
@@ -260,7 +260,7 @@ impl PathIntegrator {
                 _ if behind_emitter => &Bsdf::BLACK,
                 Some(bsdf) => bsdf,
                 None => {
-                    let uv = scene.surface(&ray, &scene.complete(&ray, &hit)).uv;
+                    let uv = scene.surface(&ray, &hit, SurfaceNeeds::Uv).uv;
                     textured =
                         Bsdf::from_material(&scene.materials, &scene.textures, si.material, uv);
                     &textured

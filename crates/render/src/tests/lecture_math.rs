@@ -12,6 +12,7 @@ use crate::integrator::course::{reflect, refract, schlick};
 use crate::math::Frame;
 use crate::ray::SPAWN_EPSILON;
 use crate::sampling::{sample_uniform_sphere, Rng};
+use crate::scene::SurfaceNeeds;
 use crate::{
     Background, Camera, GeometryDesc, Instance, Material, Matrix4, Projection, Ray, Scene,
     SceneParts, Shape, Transform, Vec3,
@@ -1327,7 +1328,11 @@ fn random_target(r: &mut Rng, kind: Kind) -> Vec3 {
 
 /// Camera-like rays from random points 12 units around the scene towards random points on
 /// each shape; yields (ray, hit) for every ray that hits something.
-fn random_hits(scene: &Scene, seed: u64, per_kind: usize) -> Vec<(Ray, crate::scene::Hit)> {
+fn random_hits(
+    scene: &Scene,
+    seed: u64,
+    per_kind: usize,
+) -> Vec<(Ray, crate::accel::instances::Hit)> {
     let mut r = rng(seed);
     let mut out = Vec::new();
     for kind in [Kind::Sphere, Kind::Triangle, Kind::Box] {
@@ -1351,7 +1356,7 @@ fn reflected_rays_never_hit_their_own_primitive() {
     let mut counts = [0usize; 3];
     let mut failures = Vec::new();
     for (ray, hit) in random_hits(&scene, 10, 4000) {
-        let si = scene.surface(&ray, &hit);
+        let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
         let kind = classify(si.point);
         counts[kind as usize] += 1;
         assert_close(si.normal.length(), 1.0, 1e-5, "unit normal");
@@ -1398,7 +1403,7 @@ fn refracted_ray_into_a_sphere_hits_its_far_side() {
         let target = random_in_ball(&mut r, Vec3::ZERO, 0.999);
         let ray = Ray::new(origin, target - origin);
         let hit = scene.intersect(&ray).expect("aimed at the sphere");
-        let si = scene.surface(&ray, &hit);
+        let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
         let t = refract(ray.direction.normalized(), si.normal, 1.0, 1.5).expect("no TIR");
         let inner = Ray::spawn(si.point, t);
         let h2 = scene
@@ -1443,7 +1448,7 @@ fn shadow_rays_towards_a_light_on_the_same_side_are_not_occluded() {
             let Some(hit) = scene.intersect(&ray) else {
                 panic!("{name}: ray aimed at the shape missed");
             };
-            let si = scene.surface(&ray, &hit);
+            let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
             // The side the ray came from.
             let n = if si.normal.dot(ray.direction) > 0.0 {
                 -si.normal
@@ -1525,7 +1530,7 @@ fn scene_returns_the_closest_of_overlapping_shapes() {
     let at = |t_min: f32, t_max: f32| {
         let ray = ray_window(Vec3::ZERO, d, t_min, t_max);
         scene.intersect(&ray).map(|h| {
-            let si = scene.surface(&ray, &h);
+            let si = scene.surface(&ray, &h, SurfaceNeeds::Uv);
             (h.t, si.point, si.normal)
         })
     };
@@ -1650,7 +1655,7 @@ fn instanced_ellipsoid_hit_point_and_normal() {
         1e-5,
         "axial t (world-space t, not object-space)",
     );
-    let si = scene.surface(&ray, &hit);
+    let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
     assert_vec_close(si.point, v(2.0, 1.0, -5.5), 1e-5, "axial point");
     assert_vec_close(si.normal, Vec3::Z, 1e-5, "axial normal");
     // Along +Y from below: bottom at y = 1 - 2 = -1, t = 4 from y = -5.
@@ -1689,7 +1694,7 @@ fn instanced_ellipsoid_hit_point_and_normal() {
         let ray = Ray::new(e, (q - e) * k);
         let hit = scene.intersect(&ray).expect("visible point");
         assert_close(hit.t * k, 1.0, 2e-5, "t of the aimed point (relative)");
-        let si = scene.surface(&ray, &hit);
+        let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
         assert_vec_close(si.point, q, 1e-4, "world hit point");
         assert_close(si.normal.length(), 1.0, 1e-5, "unit world normal");
         assert_vec_close(si.normal, grad, 5e-4, "analytic normal at the aimed point");
@@ -1731,7 +1736,7 @@ fn instanced_rotated_box_normal_and_shadow_flag() {
     let ray = Ray::new(Vec3::ZERO, v(0.0, 0.0, -1.0));
     let hit = scene.intersect(&ray).expect("hit the rotated box");
     assert_close(hit.t, 4.0, 1e-5, "front face at z = -4");
-    let si = scene.surface(&ray, &hit);
+    let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
     assert_vec_close(
         si.normal,
         Vec3::Z,
@@ -1826,7 +1831,7 @@ fn far_sphere_hit_points_are_accurate_enough_for_the_spawn_epsilon() {
             let origin = v(r.next_f32(), r.next_f32(), 0.0);
             let ray = Ray::new(origin, (target - origin).normalized());
             let hit = scene.intersect(&ray).expect("aimed at the sphere");
-            let si = scene.surface(&ray, &hit);
+            let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
             max_err = max_err.max(((si.point - centre).length() - radius).abs());
             // Non-grazing reflections only (|cos| > 0.1): a point off the surface by delta
             // re-hits at ~delta / cos, which must stay below SPAWN_EPSILON.

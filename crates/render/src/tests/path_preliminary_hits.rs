@@ -6,7 +6,8 @@
 //! shape, on both bottom-level structures. And the path tracer, which builds the BSDF of an
 //! untextured material once per render, still reads a textured one's texture at each hit.
 
-use crate::scene::AccelKind;
+use crate::accel::instances::AccelKind;
+use crate::scene::SurfaceNeeds;
 use crate::testing::{random_rays, random_soup, rng, shapes_of};
 use crate::{
     render, Background, Camera, Color, ColorSource, GeometryDesc, Image, Instance, IntegratorKind,
@@ -79,12 +80,19 @@ fn preliminary_hits_complete_to_the_hits_of_intersect() {
                     continue;
                 };
                 hits += 1;
-                assert_eq!(scene.complete(&ray, &preliminary), hit, "{ray:?}");
-                let mut surface = scene.surface(&ray, &hit);
-                surface.uv = (0.0, 0.0);
+                assert_eq!(scene.accel.complete(&ray, &preliminary), hit, "{ray:?}");
+                // A preliminary hit completes to the surface of the full hit, uv included.
+                let surface = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
                 assert_eq!(
-                    scene.surface_without_uv(&ray, &preliminary),
+                    scene.surface(&ray, &preliminary, SurfaceNeeds::Uv),
                     surface,
+                    "{ray:?}"
+                );
+                let mut without_uv = surface;
+                without_uv.uv = (0.0, 0.0);
+                assert_eq!(
+                    scene.surface(&ray, &preliminary, SurfaceNeeds::Geometry),
+                    without_uv,
                     "{ray:?}"
                 );
             }
