@@ -1,4 +1,5 @@
-//! Stand-alone triangle meshes (`.obj`, `.ply`), outside any scene file: what `glint bench`
+//! Stand-alone triangle meshes (`.obj` through the one OBJ reader of `obj.rs`, `.ply`), outside
+//! any scene file: what `glint bench`
 //! traces and what the acceleration tests and benches load from `../shared/models`.
 
 use std::fs::File;
@@ -82,49 +83,12 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
                 path: path.to_path_buf(),
                 source,
             })?;
-            load_obj(&mut BufReader::new(file)).map_err(format_error)
+            crate::obj::read_obj(&mut BufReader::new(file)).map_err(format_error)
         }
         _ => Err(MeshError::UnknownFormat {
             path: path.to_path_buf(),
         }),
     }
-}
-
-fn load_obj(reader: &mut impl std::io::BufRead) -> Result<Mesh, String> {
-    #[allow(clippy::needless_update)]
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ignore_points: true,
-        ignore_lines: true,
-        ..Default::default()
-    };
-    let (models, _materials) = tobj::load_obj_buf(reader, &options, |_| Ok(Default::default()))
-        .map_err(|error| format!("not a readable OBJ file ({error})"))?;
-    let mut mesh = Mesh::default();
-    for model in &models {
-        let base = mesh.positions.len() as u32;
-        let positions = &model.mesh.positions;
-        for p in positions.chunks_exact(3) {
-            let p = Vec3::new(p[0], p[1], p[2]);
-            if !p.is_finite() {
-                return Err(format!("a vertex of `{}` is not finite", model.name));
-            }
-            mesh.positions.push(p);
-        }
-        let count = (positions.len() / 3) as u32;
-        for face in model.mesh.indices.chunks_exact(3) {
-            if face.iter().any(|&i| i >= count) {
-                return Err(format!(
-                    "a face in `{}` uses a vertex that does not exist",
-                    model.name
-                ));
-            }
-            mesh.triangles
-                .push([base + face[0], base + face[1], base + face[2]]);
-        }
-    }
-    Ok(mesh)
 }
 
 #[cfg(test)]

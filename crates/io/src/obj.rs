@@ -3,16 +3,27 @@
 //! the course gives one shader per mesh.
 
 use std::fs::File;
-use std::io::BufReader;
+use std::io::{BufRead, BufReader};
 use std::path::Path;
 
 use glint_render::Vec3;
+
+use crate::mesh::Mesh;
 
 /// The triangles of an OBJ file, polygons fan-triangulated (`al.obj` has faces of 3 to 23
 /// vertices). Errors are messages for a warning.
 pub(crate) fn load_triangles(path: &Path) -> Result<Vec<[Vec3; 3]>, String> {
     let file = File::open(path).map_err(|error| error.to_string())?;
-    let mut reader = BufReader::new(file);
+    let mesh = read_obj(&mut BufReader::new(file))?;
+    Ok((0..mesh.triangles.len())
+        .map(|index| mesh.triangle(index))
+        .collect())
+}
+
+/// The one OBJ reader: scene meshes (`load_triangles`) and stand-alone meshes
+/// (`crate::load_mesh`) both read through it. A face that names a vertex that does not exist
+/// or is not finite is an error.
+pub(crate) fn read_obj(reader: &mut impl BufRead) -> Result<Mesh, String> {
     // `..Default::default()` is needless today, but tobj's optional features (merging,
     // reordering) add fields, and feature unification could turn them on.
     #[allow(clippy::needless_update)]
@@ -26,31 +37,31 @@ pub(crate) fn load_triangles(path: &Path) -> Result<Vec<[Vec3; 3]>, String> {
         ..Default::default()
     };
     // Never open the material library: the course ignores OBJ materials.
-    let (models, _materials) =
-        tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default()))
-            .map_err(|error| format!("not a readable OBJ file ({error})"))?;
-    let mut triangles = Vec::new();
+    let (models, _materials) = tobj::load_obj_buf(reader, &options, |_| Ok(Default::default()))
+        .map_err(|error| format!("not a readable OBJ file ({error})"))?;
+    let mut mesh = Mesh::default();
     for model in &models {
-        let positions = &model.mesh.positions;
-        let vertex = |index: u32| -> Option<Vec3> {
-            let start = index as usize * 3;
-            let coordinates = positions.get(start..start + 3)?;
-            Some(Vec3::new(coordinates[0], coordinates[1], coordinates[2]))
-                .filter(|vertex| vertex.is_finite())
-        };
+        let base = mesh.positions.len() as u32;
+        let positions: Vec<Vec3> = model
+            .mesh
+            .positions
+            .chunks_exact(3)
+            .map(|p| Vec3::new(p[0], p[1], p[2]))
+            .collect();
         for face in model.mesh.indices.chunks_exact(3) {
-            match (vertex(face[0]), vertex(face[1]), vertex(face[2])) {
-                (Some(a), Some(b), Some(c)) => triangles.push([a, b, c]),
-                _ => {
-                    return Err(format!(
-                        "a face in `{}` uses a vertex that does not exist or is not finite",
-                        model.name
-                    ))
-                }
+            let usable = |index: u32| positions.get(index as usize).is_some_and(|v| v.is_finite());
+            if !face.iter().all(|&index| usable(index)) {
+                return Err(format!(
+                    "a face in `{}` uses a vertex that does not exist or is not finite",
+                    model.name
+                ));
             }
+            mesh.triangles
+                .push([base + face[0], base + face[1], base + face[2]]);
         }
+        mesh.positions.extend(positions);
     }
-    Ok(triangles)
+    Ok(mesh)
 }
 
 #[cfg(test)]

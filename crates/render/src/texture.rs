@@ -53,6 +53,17 @@ impl ColorSource {
             texture: None,
         }
     }
+
+    /// The colour at texture coordinates `uv`: the constant times the texel, or the constant
+    /// alone without a texture (or with one that is not in `textures`). The one texture lookup
+    /// of both integrator families.
+    #[inline]
+    pub fn resolve(&self, textures: &[Image], uv: (f32, f32)) -> Color {
+        match self.texture.and_then(|id| textures.get(id as usize)) {
+            Some(image) => self.color.mul_elem(image.lookup(uv.0, uv.1)),
+            None => self.color,
+        }
+    }
 }
 
 impl From<Color> for ColorSource {

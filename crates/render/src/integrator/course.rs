@@ -9,14 +9,13 @@ use crate::accel::PACKET;
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 
 use crate::light::Light;
-use crate::light::sampler::LightSampler;
+use crate::light::sampler::{course_light_point, LightPoint, LightSampler};
 use crate::material::Material;
 use crate::math::{Frame, Color, Vec3};
 use crate::ray::Ray;
-use crate::sampling::{mix64, sample_cosine_hemisphere, sample_uniform_sphere, Rng};
+use crate::sampling::{mix64, sample_cosine_hemisphere, Rng};
 use crate::accel::instances::Hit;
 use crate::scene::{Scene, SurfaceInteraction, SurfaceNeeds};
-use crate::texture::ColorSource;
 
 /// Per-sample state handed to an integrator: the sample's random stream and where the sample
 /// sits in the pixel's jittered grid (area lights and glossy reflection stratify against it).
@@ -95,110 +94,24 @@ pub fn schlick(cos: f32, refractive_index: f32) -> f32 {
     r0 + (1.0 - r0) * (1.0 - cos.clamp(0.0, 1.0)).powi(5)
 }
 
-fn resolve(scene: &Scene, source: &ColorSource, si: &SurfaceInteraction) -> Color {
-    match source.texture {
-        Some(id) => match scene.textures.get(id as usize) {
-            Some(image) => source.color.mul_elem(image.lookup(si.uv.0, si.uv.1)),
-            None => source.color,
-        },
-        None => source.color,
-    }
-}
-
-/// A point on a light chosen for one shadow ray, with what the integrators need of it.
-struct LightSample {
-    position: Vec3,
-    /// Unit normal of the emitter at `position` (None for point lights).
-    normal: Option<Vec3>,
-    /// Probability density of `position` per unit area (1 for point lights).
-    pdf_area: f32,
-}
-
 /// Salt values keeping the 2-D sample streams of different uses apart.
 const SALT_LIGHT: u64 = 0x1157;
 const SALT_GLOSSY: u64 = 0x6105;
 const SALT_BOUNCE: u64 = 0xb0c3;
 
 /// Picks a point on `light` as seen from `p`. `exact` requests the deterministic point the
-/// course uses with one ray per pixel (an area light's centre, FORMAT.md 4.5).
+/// course uses with one ray per pixel (an area light's centre, FORMAT.md 4.5); otherwise the
+/// point comes from the sample's stratified light cell (no random number for point lights).
 fn sample_light(
     light: &Light,
     light_index: usize,
     p: Vec3,
     ctx: &mut SampleContext,
     exact: bool,
-) -> LightSample {
-    match light {
-        Light::Point { position, .. } => LightSample {
-            position: *position,
-            normal: None,
-            pdf_area: 1.0,
-        },
-        Light::Area {
-            position,
-            normal,
-            width,
-            length,
-            ..
-        } => {
-            let (u_edge, v_edge) = Light::area_edges(*normal, *width, *length);
-            let (u1, u2) = if exact {
-                (0.5, 0.5)
-            } else {
-                ctx.stratified_2d(SALT_LIGHT ^ light_index as u64)
-            };
-            let area = (width * length).abs().max(f32::MIN_POSITIVE);
-            LightSample {
-                position: *position + u_edge * (u1 - 0.5) + v_edge * (u2 - 0.5),
-                normal: Some(normal.normalized()),
-                pdf_area: 1.0 / area,
-            }
-        }
-        Light::Sphere { center, radius, .. } => {
-            // Uniform on the hemisphere facing p: the far side cannot light p.
-            let to_p = (p - *center).normalized();
-            let dir = if exact {
-                to_p
-            } else {
-                let (u1, u2) = ctx.stratified_2d(SALT_LIGHT ^ light_index as u64);
-                let d = sample_uniform_sphere(u1, u2);
-                if d.dot(to_p) < 0.0 {
-                    -d
-                } else {
-                    d
-                }
-            };
-            let area = 2.0 * std::f32::consts::PI * radius * radius;
-            LightSample {
-                position: *center + dir * radius.abs(),
-                normal: Some(dir),
-                pdf_area: 1.0 / area.max(f32::MIN_POSITIVE),
-            }
-        }
-        Light::Triangles { .. } => {
-            // The prepared table of the one light sampler: the triangle by area in O(log n).
-            let u = if exact {
-                (0.5, 1.0 / 3.0)
-            } else {
-                ctx.stratified_2d(SALT_LIGHT ^ light_index as u64)
-            };
-            let point = ctx
-                .lights
-                .and_then(|lights| lights.triangle_point(light_index, u, exact));
-            match point {
-                Some((position, normal, pdf_area, _)) => LightSample {
-                    position,
-                    normal: Some(normal),
-                    pdf_area,
-                },
-                None => LightSample {
-                    position: p,
-                    normal: None,
-                    pdf_area: 0.0,
-                },
-            }
-        }
-    }
+) -> LightPoint {
+    let u = (!exact && !matches!(light, Light::Point { .. }))
+        .then(|| ctx.stratified_2d(SALT_LIGHT ^ light_index as u64));
+    course_light_point(ctx.lights, light, light_index, p, u)
 }
 
 /// The course's recursive ray tracer (slide001; FORMAT.md 4): the lecture's shading formulas
@@ -364,7 +277,7 @@ fn shade(
     };
     match Material::get(&scene.materials, si.material) {
         Material::Lambertian { diffuse } => {
-            let kd = resolve(scene, diffuse, &si);
+            let kd = diffuse.resolve(&scene.textures, si.uv);
             direct(scene, &si, ctx, |l| kd * n.dot(l).max(0.0))
         }
         Material::BlinnPhong {
@@ -373,8 +286,8 @@ fn shade(
             phong_exponent,
             mirror_coef,
         } => {
-            let kd = resolve(scene, diffuse, &si);
-            let ks = resolve(scene, specular, &si);
+            let kd = diffuse.resolve(&scene.textures, si.uv);
+            let ks = specular.resolve(&scene.textures, si.uv);
             let shaded = blinn_phong(scene, &si, n, v, kd, ks, *phong_exponent, ctx);
             if *mirror_coef > 0.0 {
                 shaded * (1.0 - mirror_coef)
@@ -388,8 +301,8 @@ fn shade(
             specular,
             phong_exponent,
         } => {
-            let kd = resolve(scene, diffuse, &si);
-            let ks = resolve(scene, specular, &si);
+            let kd = diffuse.resolve(&scene.textures, si.uv);
+            let ks = specular.resolve(&scene.textures, si.uv);
             let p = *phong_exponent;
             direct(scene, &si, ctx, |l| {
                 let r = -l + n * (2.0 * l.dot(n));
@@ -402,7 +315,7 @@ fn shade(
             mirror_coef,
         } => {
             // Additive, as the lecture writes it (FORMAT.md A7): c = c_Lambertian + km·c_mirror.
-            let kd = resolve(scene, diffuse, &si);
+            let kd = diffuse.resolve(&scene.textures, si.uv);
             direct(scene, &si, ctx, |l| kd * n.dot(l).max(0.0))
                 + mirror(scene, &si, d, n, 0.0, depth, ctx) * *mirror_coef
         }
@@ -413,8 +326,8 @@ fn shade(
             mirror_coef,
             roughness,
         } => {
-            let kd = resolve(scene, diffuse, &si);
-            let ks = resolve(scene, specular, &si);
+            let kd = diffuse.resolve(&scene.textures, si.uv);
+            let ks = specular.resolve(&scene.textures, si.uv);
             let shaded = blinn_phong(scene, &si, n, v, kd, ks, *phong_exponent, ctx);
             shaded * (1.0 - mirror_coef)
                 + mirror(scene, &si, d, n, *roughness, depth, ctx) * *mirror_coef
@@ -433,10 +346,10 @@ fn shade(
             ctx,
         ),
         Material::CoolToWarm { diffuse } => {
-            cool_to_warm(scene, &si, n, resolve(scene, diffuse, &si))
+            cool_to_warm(scene, &si, n, diffuse.resolve(&scene.textures, si.uv))
         }
         Material::Diffuse { diffuse } => {
-            let kd = resolve(scene, diffuse, &si);
+            let kd = diffuse.resolve(&scene.textures, si.uv);
             diffuse_surface(scene, &si, n, kd, depth, ctx)
         }
         Material::Emissive {

@@ -13,7 +13,11 @@
 //!   proportion to luminance × texel solid angle with a row/column piecewise-constant
 //!   distribution (pbrt's `PiecewiseConstant2D`, here over the cube's texels).
 
+#[cfg(test)]
+use crate::geometry::intersect_triangle;
 use crate::light::Light;
+#[cfg(test)]
+use crate::ray::Ray;
 use crate::material::Material;
 use crate::math::{Color, Vec3};
 use crate::sampling::warp::{
@@ -45,6 +49,90 @@ pub struct LightSample {
     /// Whether a BSDF-sampled ray can hit this light (it has emissive geometry or is the
     /// environment); if not, light sampling is the only estimator and takes the full weight.
     pub reachable_by_bsdf: bool,
+}
+
+/// A point on an emitter, by area: what the course integrator asks of a light, and what the
+/// path tracer's area sampling converts to a `LightSample` per unit solid angle (pbrt-v4's
+/// `ShapeSample` beside its `LightLiSample`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct LightPoint {
+    pub position: Vec3,
+    /// Unit normal of the emitter at `position` (`None` for point lights).
+    pub normal: Option<Vec3>,
+    /// Density of `position` per unit area (1 for point lights, 0 for no point).
+    pub pdf_area: f32,
+}
+
+/// The course integrator's point on light `index` (`light`) for shading point `p`, with the
+/// course's conventions: an area light's rectangle and emitting triangles by area (triangles
+/// from the prepared table of `lights`), a sphere light on the hemisphere facing `p`, a point
+/// light itself. `u` is the sample; `None` asks for the deterministic point of one ray per
+/// pixel (the rectangle's centre, the sphere's point nearest `p`, the centroid of the triangle
+/// at the middle of the area table: FORMAT.md 4.5).
+pub(crate) fn course_light_point(
+    lights: Option<&LightSampler>,
+    light: &Light,
+    index: usize,
+    p: Vec3,
+    u: Option<(f32, f32)>,
+) -> LightPoint {
+    match light {
+        Light::Point { position, .. } => LightPoint {
+            position: *position,
+            normal: None,
+            pdf_area: 1.0,
+        },
+        Light::Area {
+            position,
+            normal,
+            width,
+            length,
+            ..
+        } => {
+            let (u_edge, v_edge) = Light::area_edges(*normal, *width, *length);
+            let (u1, u2) = u.unwrap_or((0.5, 0.5));
+            let area = (width * length).abs().max(f32::MIN_POSITIVE);
+            LightPoint {
+                position: *position + u_edge * (u1 - 0.5) + v_edge * (u2 - 0.5),
+                normal: Some(normal.normalized()),
+                pdf_area: 1.0 / area,
+            }
+        }
+        Light::Sphere { center, radius, .. } => {
+            // Uniform on the hemisphere facing p: the far side cannot light p.
+            let to_p = (p - *center).normalized();
+            let dir = match u {
+                None => to_p,
+                Some((u1, u2)) => {
+                    let d = sample_uniform_sphere(u1, u2);
+                    if d.dot(to_p) < 0.0 {
+                        -d
+                    } else {
+                        d
+                    }
+                }
+            };
+            let area = 2.0 * PI * radius * radius;
+            LightPoint {
+                position: *center + dir * radius.abs(),
+                normal: Some(dir),
+                pdf_area: 1.0 / area.max(f32::MIN_POSITIVE),
+            }
+        }
+        Light::Triangles { .. } => {
+            let point = lights.and_then(|lights| {
+                lights.triangle_point(index, u.unwrap_or((0.5, 1.0 / 3.0)), u.is_none())
+            });
+            match point {
+                Some((point, _)) => point,
+                None => LightPoint {
+                    position: p,
+                    normal: None,
+                    pdf_area: 0.0,
+                },
+            }
+        }
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -311,8 +399,8 @@ impl LightSampler {
         reference: Vec3,
         u: (f32, f32),
     ) -> Option<LightSample> {
-        let (position, normal, inverse_area, radiance) = self.triangle_point(index, u, false)?;
-        let mut sample = area_sample(reference, position, normal, inverse_area, radiance)?;
+        let (point, radiance) = self.triangle_point(index, u, false)?;
+        let mut sample = area_sample(reference, point, radiance)?;
         sample.reachable_by_bsdf = self.reachable_by_bsdf(index);
         Some(sample)
     }
@@ -320,14 +408,14 @@ impl LightSampler {
     /// A point on light `index` when it is a set of emitting triangles: the triangle chosen by
     /// area with `u.0` (binary search in the prepared table, O(log n)), the point uniform on it
     /// with the rest of `u.0` and `u.1`, or its centroid when `centroid` (the course's one ray
-    /// per pixel). Returns the point, the triangle's unit normal, the density per unit area of
-    /// the whole light, and its radiance.
+    /// per pixel). Returns the point (with the triangle's unit normal and the density per unit
+    /// area of the whole light) and the light's radiance.
     pub(crate) fn triangle_point(
         &self,
         index: usize,
         u: (f32, f32),
         centroid: bool,
-    ) -> Option<(Vec3, Vec3, f32, Color)> {
+    ) -> Option<(LightPoint, Color)> {
         let PreparedLight::Triangles {
             first,
             count,
@@ -364,8 +452,12 @@ impl LightSampler {
         } else {
             sample_uniform_triangle(u0, u.1)
         };
-        let position = triangle.v0 + triangle.edge1 * b1 + triangle.edge2 * b2;
-        Some((position, triangle.normal, inverse_area, radiance))
+        let point = LightPoint {
+            position: triangle.v0 + triangle.edge1 * b1 + triangle.edge2 * b2,
+            normal: Some(triangle.normal),
+            pdf_area: inverse_area,
+        };
+        Some((point, radiance))
     }
 
     /// A point on light `index` as seen from `reference`; the pdf is per unit solid angle of
@@ -407,8 +499,12 @@ impl LightSampler {
                 area,
                 radiance,
             } => {
-                let position = *center + *u_edge * (u.0 - 0.5) + *v_edge * (u.1 - 0.5);
-                area_sample(reference, position, *normal, 1.0 / area, *radiance).map(|s| {
+                let point = LightPoint {
+                    position: *center + *u_edge * (u.0 - 0.5) + *v_edge * (u.1 - 0.5),
+                    normal: Some(*normal),
+                    pdf_area: 1.0 / area,
+                };
+                area_sample(reference, point, *radiance).map(|s| {
                     LightSample {
                         reachable_by_bsdf,
                         ..s
@@ -500,7 +596,16 @@ impl LightSampler {
                         if cos_light <= 0.0 {
                             return None;
                         }
-                        let distance = intersect_triangle(reference, direction, triangle)?;
+                        let vertices = [
+                            triangle.v0,
+                            triangle.v0 + triangle.edge1,
+                            triangle.v0 + triangle.edge2,
+                        ];
+                        let ray = Ray {
+                            t_min: f32::MIN_POSITIVE,
+                            ..Ray::new(reference, direction)
+                        };
+                        let distance = intersect_triangle(&ray, &vertices)?.t;
                         Some(distance * distance / (cos_light * area))
                     })
                     .sum()
@@ -602,13 +707,13 @@ fn mean(c: Color) -> f32 {
 
 /// A point sampled by area on a one-sided planar emitter, converted to solid angle.
 #[inline]
-fn area_sample(
-    reference: Vec3,
-    position: Vec3,
-    normal: Vec3,
-    pdf_area: f32,
-    radiance: Color,
-) -> Option<LightSample> {
+fn area_sample(reference: Vec3, point: LightPoint, radiance: Color) -> Option<LightSample> {
+    let LightPoint {
+        position,
+        normal,
+        pdf_area,
+    } = point;
+    let normal = normal?;
     let to_light = position - reference;
     let distance_squared = to_light.length_squared();
     if distance_squared <= 0.0 {
@@ -633,29 +738,6 @@ fn area_sample(
         is_delta: false,
         reachable_by_bsdf: false,
     })
-}
-
-/// Möller-Trumbore: distance along unit `direction` to the triangle, if it is hit.
-#[cfg(test)]
-fn intersect_triangle(origin: Vec3, direction: Vec3, triangle: &PreparedTriangle) -> Option<f32> {
-    let p = direction.cross(triangle.edge2);
-    let determinant = triangle.edge1.dot(p);
-    if determinant.abs() < 1e-12 {
-        return None;
-    }
-    let inverse = 1.0 / determinant;
-    let s = origin - triangle.v0;
-    let b1 = s.dot(p) * inverse;
-    if !(0.0..=1.0).contains(&b1) {
-        return None;
-    }
-    let q = s.cross(triangle.edge1);
-    let b2 = direction.dot(q) * inverse;
-    if b2 < 0.0 || b1 + b2 > 1.0 {
-        return None;
-    }
-    let t = triangle.edge2.dot(q) * inverse;
-    (t > 0.0).then_some(t)
 }
 
 /// The cone of directions under which a sphere is seen from outside it.

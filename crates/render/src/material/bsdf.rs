@@ -200,7 +200,7 @@ impl Bsdf {
     }
 
     fn from_plain_material(material: &Material, textures: &[Image], uv: (f32, f32)) -> Bsdf {
-        let color = |source: &ColorSource| resolve_color(textures, source, uv).clamp01();
+        let color = |source: &ColorSource| source.resolve(textures, uv).clamp01();
         match material {
             Material::Lambertian { diffuse }
             | Material::Diffuse { diffuse }
@@ -453,15 +453,6 @@ fn mirror_lobe(roughness: f32) -> Lobe {
         }
     } else {
         Lobe::SpecularReflection
-    }
-}
-
-/// A colour parameter at texture coordinates `uv` (colour ⊙ texel, FORMAT.md A9).
-#[inline]
-pub fn resolve_color(textures: &[Image], source: &ColorSource, uv: (f32, f32)) -> Color {
-    match source.texture.and_then(|id| textures.get(id as usize)) {
-        Some(image) => source.color.mul_elem(image.lookup(uv.0, uv.1)),
-        None => source.color,
     }
 }
 
