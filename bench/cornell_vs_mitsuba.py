@@ -7,7 +7,7 @@ For the Cornell box of ../shared/refs/cornell at 256x256, in one run on this mac
      --repeats + 1 runs (the first also compiles Dr.Jit's kernels, later ones find them cached).
   2. Its error E_M = relMSE(mitsuba_64, reference_4096), with
      relMSE(a, r) = mean over pixels and channels of (a - r)^2 / (r^2 + 0.01)
-     (the same measure as crates/render/tests/path_cornell.rs).
+     (the same measure as crates/io/tests/path_cornell.rs).
   3. Glint finds the sample count N at which its own error reaches E_M: one probe render at 64 spp
      gives its per-sample variance, errors are modelled as a/N + c with c the reference's own
      noise (estimated from Mitsuba's figures), N is predicted, then raised by 5% until the error

@@ -13,13 +13,30 @@
 //! work around (unknown keys, dangling references, missing files) is returned as warnings next
 //! to the scene.
 //!
-//! ```no_run
-//! let loaded = glint_io::load_scene(std::path::Path::new("oneSphere.xml"))?;
+//! ```
+//! use std::path::Path;
+//!
+//! // A course scene in JSON (XML works the same way); `path` names it in diagnostics and
+//! // locates its assets.
+//! let text = r#"{ "scene": {
+//!     "camera": [{ "_name": "main", "_type": "perspective", "position": "0 0 3",
+//!                  "viewDir": "0 0 -1", "focalLength": 1.0, "imagePlaneWidth": 1.0 }],
+//!     "light": [{ "_type": "point", "position": "2 2 3", "intensity": "1 1 1" }],
+//!     "shader": [{ "_name": "red", "_type": "Lambertian", "diffuse": "0.8 0.1 0.1" }],
+//!     "shape": [{ "_name": "ball", "_type": "sphere", "shader": { "_ref": "red" },
+//!                 "center": "0 0 0", "radius": 1.0 }],
+//!     "bgColor": "0.2 0.2 0.2" } }"#;
+//! let loaded = glint_io::load_scene_from_text(text, Path::new("ball.json"))?;
 //! for warning in &loaded.warnings {
 //!     eprintln!("{warning}");
 //! }
 //! let scene = glint_render::Scene::new(loaded.parts);
-//! # Ok::<(), glint_io::SceneError>(())
+//! let settings = glint_render::RenderSettings { width: 16, height: 16, ..Default::default() };
+//! let (film, _stats) = glint_render::render(&scene, &settings, &|_| true).expect("not cancelled");
+//! let output = std::env::temp_dir().join("glint-doc-ball.png");
+//! glint_io::write_image(&output, &film)?;
+//! # std::fs::remove_file(&output).ok();
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 #![forbid(unsafe_code)]

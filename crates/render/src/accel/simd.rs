@@ -10,7 +10,7 @@
 //! `target_feature` functions after run-time detection, and reading the uninitialised
 //! traversal stacks below their top. The benchmarks that justified it: `glint bench table`
 //! (`cargo run --release -p glint -- bench table`) and the `accel` criterion bench
-//! (`cargo bench -p glint-render --bench accel`), which time this kernel against
+//! (`cargo bench -p glint-io --bench accel`), which time this kernel against
 //! `Isa::Scalar` on the same BVH, and for packets `glint bench table --packets` /
 //! `glint bench rays --packets` (packet against single-ray traversal on the same rays); see
 //! `bench/README.md` for the figures.

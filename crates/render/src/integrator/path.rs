@@ -2,7 +2,7 @@
 //! next-event estimation on every light, multiple importance sampling between BSDF and light
 //! sampling (Veach's power heuristic), Russian roulette and a depth cap. It solves the
 //! rendering equation with the BSDFs of `bsdf.rs` and the emitters of `light_sampling.rs`, and
-//! is checked against Mitsuba 3 (`tests/path_cornell.rs`).
+//! is checked against Mitsuba 3 (`crates/io/tests/path_cornell.rs`).
 //!
 //! The structure is pbrt-v4's `PathIntegrator::Li` (`src/pbrt/cpu/integrators.cpp`) and
 //! Mitsuba 3's `path` plugin: one loop over path vertices, emission at each hit weighted against

@@ -9,3 +9,4 @@ mod lecture_math;
 mod path_known_answers;
 mod path_no_allocation;
 mod path_preliminary_hits;
+mod pipeline;

@@ -217,7 +217,7 @@ fn tracing_paths_does_not_allocate() {
                 let mut first_hit = FirstHit::default();
                 sum += integrator.trace(&scene, &ray, &mut rng, &mut rays, &mut first_hit);
             }
-            // The renderer's sampler: scrambled Sobol' per pixel, as `render_with_aovs` uses.
+            // The renderer's sampler: scrambled Sobol' per pixel, as the pipeline uses.
             let sobol = SobolPixel::new(1, pixel, 4);
             for s in 0..4 {
                 let mut sampler = sobol.sampler(s);
