@@ -10,7 +10,13 @@
 //! cargo run --release -p glint-io --example image_digest -- ../shared/scenes/course
 //! ```
 
-use std::path::{Path, PathBuf};
+// The corpus walk the corpus tests use.
+#[path = "../tests/common/mod.rs"]
+mod common;
+
+use common::scene_files;
+
+use std::path::PathBuf;
 
 use glint_render::{render, IntegratorKind, RenderSettings, Scene};
 
@@ -30,24 +36,6 @@ fn fnv1a(hash: &mut u64, values: impl IntoIterator<Item = f32>) {
     }
 }
 
-fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<_> = std::fs::read_dir(dir)
-        .expect("corpus directory readable")
-        .map(|e| e.expect("directory entry").path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            scene_files(&path, out);
-        } else if matches!(
-            path.extension().and_then(|e| e.to_str()),
-            Some("xml" | "json")
-        ) {
-            out.push(path);
-        }
-    }
-}
-
 fn main() {
     let dir = PathBuf::from(
         std::env::args()
@@ -55,7 +43,7 @@ fn main() {
             .unwrap_or_else(|| "../shared/scenes/course".into()),
     );
     let mut files = Vec::new();
-    scene_files(&dir, &mut files);
+    files.extend(scene_files(&dir));
     for path in &files {
         let name = path
             .strip_prefix(&dir)

@@ -2,54 +2,20 @@
 //! scene loads, with exactly the warnings listed here, and specific scenes build what the
 //! course means.
 
+mod common;
+
 use std::path::{Path, PathBuf};
+
+use common::{corpus, scene_files};
 
 use glint_io::{load_scene, Diagnostic, LoadedScene, Severity};
 use glint_render::{
     Background, ColorSource, Light, Material, Matrix4, Projection, SceneParts, Shape, Vec3,
 };
 
-const SHARED: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../../../shared");
-
-/// The course corpus, or `None` (with a message) when `../shared` is not there. Under CI the
-/// corpus is required.
-fn corpus() -> Option<PathBuf> {
-    let directory = Path::new(SHARED).join("scenes/course");
-    if directory.is_dir() {
-        return Some(directory);
-    }
-    let message = format!(
-        "the course corpus {} is absent, so the corpus tests cannot run",
-        directory.display()
-    );
-    if std::env::var_os("CI").is_some() {
-        panic!("{message} (CI is set, so this is a failure)");
-    }
-    eprintln!("SKIPPED: {message}");
-    None
-}
-
 fn load(relative: &str) -> Option<LoadedScene> {
     let path = corpus()?.join(relative);
     Some(load_scene(&path).unwrap_or_else(|error| panic!("{relative} failed to load:\n{error}")))
-}
-
-fn scene_files(directory: &Path, found: &mut Vec<PathBuf>) {
-    let mut entries: Vec<_> = std::fs::read_dir(directory)
-        .unwrap()
-        .map(|entry| entry.unwrap().path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            scene_files(&path, found);
-        } else if matches!(
-            path.extension().and_then(|extension| extension.to_str()),
-            Some("xml" | "json")
-        ) {
-            found.push(path);
-        }
-    }
 }
 
 /// Warnings each corpus file must produce: (file, part of the message, how many). Files not
@@ -96,7 +62,7 @@ const EXPECTED_WARNINGS: &[(&str, &str, usize)] = &[
 fn every_corpus_scene_loads_with_the_expected_warnings() {
     let Some(corpus) = corpus() else { return };
     let mut files = Vec::new();
-    scene_files(&corpus, &mut files);
+    files.extend(scene_files(&corpus));
     assert!(files.len() >= 80, "only {} scene files found", files.len());
     let mut failures = Vec::new();
     let mut checked_expectations = 0;

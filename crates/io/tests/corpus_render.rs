@@ -2,39 +2,13 @@
 //! renders at a small size with no panic and no NaN pixel. Files that need an asset that
 //! exists nowhere still load (with the documented warning) and render without it.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
+
+use common::{corpus as corpus_dir, scene_files};
 
 use glint_render::{render, RenderSettings, Scene};
-
-fn corpus_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/course");
-    if dir.is_dir() {
-        Some(dir)
-    } else if std::env::var_os("CI").is_some() {
-        panic!("../shared/scenes/course is missing: CI must provide the course corpus");
-    } else {
-        eprintln!("SKIPPED: ../shared/scenes/course is absent, so the corpus cannot be checked");
-        None
-    }
-}
-
-fn scene_files(dir: &Path, out: &mut Vec<PathBuf>) {
-    let mut entries: Vec<_> = std::fs::read_dir(dir)
-        .expect("corpus directory readable")
-        .map(|e| e.expect("directory entry").path())
-        .collect();
-    entries.sort();
-    for path in entries {
-        if path.is_dir() {
-            scene_files(&path, out);
-        } else if matches!(
-            path.extension().and_then(|e| e.to_str()),
-            Some("xml" | "json")
-        ) {
-            out.push(path);
-        }
-    }
-}
 
 /// Scenes that reference assets absent from every public copy (SOURCES.md, FORMAT.md A17):
 /// the loader must warn about them, and they render without the asset.
@@ -50,7 +24,7 @@ const MISSING_ASSETS: &[(&str, &str)] = &[
 fn every_corpus_scene_loads_and_renders_without_nan() {
     let Some(dir) = corpus_dir() else { return };
     let mut files = Vec::new();
-    scene_files(&dir, &mut files);
+    files.extend(scene_files(&dir));
     assert!(
         files.len() > 80,
         "expected the whole corpus, found {}",
@@ -110,7 +84,7 @@ fn every_corpus_scene_loads_and_renders_without_nan() {
 fn example_scenes_load_cleanly() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
     let mut files = Vec::new();
-    scene_files(&dir, &mut files);
+    files.extend(scene_files(&dir));
     assert!(!files.is_empty(), "no example scenes in {}", dir.display());
     for path in files {
         let loaded = glint_io::load_scene(&path)

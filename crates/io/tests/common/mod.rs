@@ -1,0 +1,47 @@
+//! What the tests (and `examples/image_digest.rs`) that read the course corpus share.
+#![allow(dead_code)]
+
+use std::path::{Path, PathBuf};
+
+/// The course corpus, `../shared/scenes/course` beside the repository, or `None` (with a
+/// message) when it is not there. Under CI the corpus is required: its absence is a failure.
+pub fn corpus() -> Option<PathBuf> {
+    let directory = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes/course");
+    if directory.is_dir() {
+        return Some(directory);
+    }
+    let message = format!(
+        "the course corpus {} is absent, so the corpus tests cannot run",
+        directory.display()
+    );
+    if std::env::var_os("CI").is_some() {
+        panic!("{message} (CI is set, so this is a failure)");
+    }
+    eprintln!("SKIPPED: {message}");
+    None
+}
+
+/// Every `.xml` and `.json` file below `directory`, in sorted order.
+pub fn scene_files(directory: &Path) -> Vec<PathBuf> {
+    let mut found = Vec::new();
+    collect(directory, &mut found);
+    found
+}
+
+fn collect(directory: &Path, found: &mut Vec<PathBuf>) {
+    let mut entries: Vec<_> = std::fs::read_dir(directory)
+        .expect("corpus directory readable")
+        .map(|entry| entry.expect("directory entry").path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            collect(&path, found);
+        } else if matches!(
+            path.extension().and_then(|extension| extension.to_str()),
+            Some("xml" | "json")
+        ) {
+            found.push(path);
+        }
+    }
+}
