@@ -4,8 +4,6 @@
 
 mod common;
 
-use std::path::{Path, PathBuf};
-
 use common::{corpus, scene_files};
 
 use glint_io::{load_scene, Diagnostic, LoadedScene, Severity};
