@@ -42,14 +42,8 @@ fn main() {
             .nth(1)
             .unwrap_or_else(|| "../shared/scenes/course".into()),
     );
-    let mut files = Vec::new();
-    files.extend(scene_files(&dir));
-    for path in &files {
-        let name = path
-            .strip_prefix(&dir)
-            .unwrap()
-            .to_string_lossy()
-            .replace('\\', "/");
+    let files = scene_files(&dir);
+    for (path, name) in &files {
         let loaded = match glint_io::load_scene(path) {
             Ok(loaded) => loaded,
             Err(error) => {

@@ -23,20 +23,14 @@ const MISSING_ASSETS: &[(&str, &str)] = &[
 #[test]
 fn every_corpus_scene_loads_and_renders_without_nan() {
     let Some(dir) = corpus_dir() else { return };
-    let mut files = Vec::new();
-    files.extend(scene_files(&dir));
+    let files = scene_files(&dir);
     assert!(
         files.len() > 80,
         "expected the whole corpus, found {}",
         files.len()
     );
     let mut failures = Vec::new();
-    for path in &files {
-        let relative = path
-            .strip_prefix(&dir)
-            .unwrap()
-            .to_string_lossy()
-            .replace('\\', "/");
+    for (path, relative) in &files {
         let loaded = match glint_io::load_scene(path) {
             Ok(loaded) => loaded,
             Err(e) => {
@@ -83,10 +77,9 @@ fn every_corpus_scene_loads_and_renders_without_nan() {
 #[test]
 fn example_scenes_load_cleanly() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    let mut files = Vec::new();
-    files.extend(scene_files(&dir));
+    let files = scene_files(&dir);
     assert!(!files.is_empty(), "no example scenes in {}", dir.display());
-    for path in files {
+    for (path, _) in files {
         let loaded = glint_io::load_scene(&path)
             .unwrap_or_else(|e| panic!("{} failed to load: {e}", path.display()));
         assert!(

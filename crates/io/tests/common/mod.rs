@@ -21,11 +21,22 @@ pub fn corpus() -> Option<PathBuf> {
     None
 }
 
-/// Every `.xml` and `.json` file below `directory`, in sorted order.
-pub fn scene_files(directory: &Path) -> Vec<PathBuf> {
+/// Every `.xml` and `.json` file below `directory`, in sorted order, with its name relative
+/// to `directory` (forward slashes).
+pub fn scene_files(directory: &Path) -> Vec<(PathBuf, String)> {
     let mut found = Vec::new();
     collect(directory, &mut found);
     found
+        .into_iter()
+        .map(|path| {
+            let relative = path
+                .strip_prefix(directory)
+                .expect("below the directory")
+                .to_string_lossy()
+                .replace('\\', "/");
+            (path, relative)
+        })
+        .collect()
 }
 
 fn collect(directory: &Path, found: &mut Vec<PathBuf>) {
