@@ -44,6 +44,7 @@
 mod build;
 mod desc;
 mod diagnostic;
+mod display;
 mod image_io;
 mod json;
 mod mesh;
@@ -58,7 +59,13 @@ mod xml;
 use std::path::Path;
 
 pub use diagnostic::{Diagnostic, SceneError, Severity};
-pub use image_io::{output_format, write_image, EncodeError, ImageWriteError, OutputFormat};
+pub use display::{
+    DisplayTransform, PngEncoding, ToneMap, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD,
+};
+pub use image_io::{
+    output_format, write_image, write_image_with, EncodeError, ImageWriteError, OutputFormat,
+    WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
+};
 pub use mesh::{load_mesh, Mesh, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
 
