@@ -81,7 +81,11 @@ pub(crate) fn cube_face_paths(prefix: &str, extension: &str) -> [String; 6] {
 fn cube_face_extension(directory: &Path, prefix: &str) -> &'static str {
     ["png", "exr", "hdr"]
         .into_iter()
-        .find(|extension| directory.join(format!("{prefix}posX.{extension}")).is_file())
+        .find(|extension| {
+            directory
+                .join(format!("{prefix}posX.{extension}"))
+                .is_file()
+        })
         .unwrap_or("png")
 }
 
@@ -349,8 +353,18 @@ fn encode_exr(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), Enco
     let mut channels = smallvec::SmallVec::new();
     rgb("", ["R", "G", "B"], &film.pixels, &mut channels);
     if let Some(features) = &film.features {
-        rgb(ALBEDO_LAYER, ["R", "G", "B"], &features.albedo, &mut channels);
-        rgb(NORMAL_LAYER, ["X", "Y", "Z"], &features.normal, &mut channels);
+        rgb(
+            ALBEDO_LAYER,
+            ["R", "G", "B"],
+            &features.albedo,
+            &mut channels,
+        );
+        rgb(
+            NORMAL_LAYER,
+            ["X", "Y", "Z"],
+            &features.normal,
+            &mut channels,
+        );
         channels.push(AnyChannel::new(
             DEPTH_CHANNEL,
             FlatSamples::F32(features.depth.clone()),
@@ -524,7 +538,10 @@ mod tests {
                 // EXR stores f32 exactly; Radiance HDR's shared exponent keeps ~1 % .
                 let tolerance = if extension == "exr" { 0.0 } else { 0.01 };
                 for (a, b) in loaded.to_array().into_iter().zip(expected) {
-                    assert!((a - b).abs() <= tolerance * b.max(1.0), "{extension}: {a} vs {b}");
+                    assert!(
+                        (a - b).abs() <= tolerance * b.max(1.0),
+                        "{extension}: {a} vs {b}"
+                    );
                 }
             }
         }
@@ -586,10 +603,9 @@ mod tests {
             tone_map: ToneMap::Aces,
             ..DisplayTransform::default()
         });
-        for (encoding, transfer, srgb_chunk) in [
-            (PngEncoding::Course, "linear", false),
-            (aces, "sRGB", true),
-        ] {
+        for (encoding, transfer, srgb_chunk) in
+            [(PngEncoding::Course, "linear", false), (aces, "sRGB", true)]
+        {
             let path = directory.path().join("out.png");
             let options = WriteOptions { png: encoding };
             write_image_with(&path, &film, &options).unwrap();
