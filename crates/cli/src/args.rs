@@ -83,6 +83,9 @@ pub enum Command {
     },
     /// Measure the ray engine: `glint bench table`, `glint bench rays`, `glint bench make-rays`.
     Bench(crate::bench::BenchArgs),
+    /// Compare image B with reference A (PNG, EXR): MAE, RMSE, PSNR, pixels off by more than
+    /// N levels, NVIDIA's FLIP and its heat map; exit 1 past a --threshold.
+    Diff(crate::diff::DiffArgs),
 }
 
 /// Options shared by both forms.
@@ -324,6 +327,9 @@ impl Cli {
                 Some(Command::Render { scene, options }) => (scene, options),
                 Some(Command::Bench(_)) => {
                     return Err(UsageError("`glint bench` is not a render".to_string()))
+                }
+                Some(Command::Diff(_)) => {
+                    return Err(UsageError("`glint diff` is not a render".to_string()))
                 }
                 None => match self.input {
                     Some(scene) if !scene.as_os_str().is_empty() => (scene, self.options),
