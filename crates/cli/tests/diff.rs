@@ -280,5 +280,8 @@ fn exr_images_compare_in_linear_and_as_displayed() {
     let report = String::from_utf8(run.stdout).unwrap();
     assert_eq!(number_after(&report, "8-bit:", "MAE "), 0.0, "{report}");
     // Level 188 decodes to 0.502886, not 0.5: the 8-bit rounding (one level is ~0.0055 here).
-    assert!((number_after(&report, "linear:", "MAE ") - 0.002886).abs() < 1e-5, "{report}");
+    assert!(
+        (number_after(&report, "linear:", "MAE ") - 0.002886).abs() < 1e-5,
+        "{report}"
+    );
 }
