@@ -13,15 +13,15 @@
 //! - FLIP (Andersson et al. 2020, LDR-FLIP through the `nv-flip` crate, 67 pixels per degree):
 //!   the mean of its per-pixel error map over the 8-bit images as displayed.
 //!
-//! Exit status: 0 within every `--threshold`, 1 past one, 2 bad input (an unreadable file,
-//! images of different sizes, non-finite values).
+//! Exit status: 0 within every `--threshold`, 1 past one (or when the heat map cannot be
+//! written), 2 bad input (an unreadable file, images of different sizes, non-finite values).
 
 use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use glint_io::{DisplayTransform, PngEncoding, Transfer, TRANSFER_KEYWORD};
+use glint_io::{DisplayTransform, Transfer, TRANSFER_KEYWORD};
 use glint_render::Color;
 
 /// `glint diff` arguments.
@@ -62,7 +62,8 @@ Examples:
   glint diff reference.png mine.png
   glint diff reference.png mine.png --threshold mae=1.5,over=2 --heatmap flip.png
 
-Exit status: 0 within every threshold, 1 past one, 2 bad input (unreadable, different sizes).";
+Exit status: 0 within every threshold, 1 past one (or the heat map cannot be written), 2 bad
+input (unreadable, different sizes).";
 
 /// `--png-transfer` values.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -215,7 +216,7 @@ pub fn read_image(path: &Path, png_transfer: PngTransferArg) -> Result<DiffImage
             .chunks_exact(3)
             .map(|c| Color::new(c[0], c[1], c[2]))
             .collect();
-        let levels = PngEncoding::Display(DisplayTransform::default()).to_rgb8(&colors);
+        let levels = DisplayTransform::default().to_rgb8(&colors);
         return Ok(DiffImage {
             width,
             height,

@@ -3,7 +3,7 @@
 //!
 //! EXR output never goes through this: it keeps the film's linear values as they are.
 
-use glint_render::Color;
+use glint_render::{Color, Film};
 
 /// How `write_image_with` turns linear values into a PNG's 8-bit values.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -96,19 +96,11 @@ impl PngEncoding {
         }
     }
 
-    /// The 8-bit RGB values of `pixels` (linear RGB), three per pixel.
-    pub fn to_rgb8(&self, pixels: &[Color]) -> Vec<u8> {
+    /// The film's 8-bit RGB values, three per pixel.
+    pub fn to_rgb8(&self, film: &Film) -> Vec<u8> {
         match self {
-            PngEncoding::Course => pixels
-                .iter()
-                .flat_map(|c| c.to_array())
-                .map(course_level)
-                .collect(),
-            PngEncoding::Display(transform) => pixels
-                .iter()
-                .flat_map(|&c| transform.apply(c).to_array())
-                .map(rounded_level)
-                .collect(),
+            PngEncoding::Course => film.to_rgb8_course(),
+            PngEncoding::Display(transform) => transform.to_rgb8(&film.pixels),
         }
     }
 }
@@ -158,6 +150,16 @@ impl Transfer {
 }
 
 impl DisplayTransform {
+    /// The 8-bit RGB values of linear `pixels`, three per pixel: `apply`, then the nearest
+    /// level.
+    pub fn to_rgb8(&self, pixels: &[Color]) -> Vec<u8> {
+        pixels
+            .iter()
+            .flat_map(|&c| self.apply(c).to_array())
+            .map(rounded_level)
+            .collect()
+    }
+
     /// Exposure, curve and transfer function applied to one linear colour: code values in
     /// [0, 1]. NaN becomes 0.
     pub fn apply(&self, color: Color) -> Color {
@@ -166,15 +168,6 @@ impl DisplayTransform {
         self.tone_map
             .apply(exposed)
             .map(|v| self.transfer.encode(v.clamp(0.0, 1.0)))
-    }
-}
-
-/// The course's 8-bit level: clamp, floor(c·255); NaN is 0 (`Film::to_rgb8_course`).
-fn course_level(v: f32) -> u8 {
-    if v.is_nan() {
-        0
-    } else {
-        (v.clamp(0.0, 1.0) * 255.0).floor() as u8
     }
 }
 
@@ -289,25 +282,12 @@ mod tests {
     }
 
     #[test]
-    fn course_encoding_is_the_films() {
-        let pixels = vec![
-            Color::new(0.5, 1.5, -1.0),
-            Color::new(f32::NAN, 0.999, 0.003_921_6),
-        ];
-        let film = glint_render::Film {
-            pixels: pixels.clone(),
-            ..glint_render::Film::new(2, 1)
-        };
-        assert_eq!(PngEncoding::Course.to_rgb8(&pixels), film.to_rgb8_course());
-    }
-
-    #[test]
     fn default_display_is_clamp_srgb_rounded() {
-        let encoding = PngEncoding::Display(DisplayTransform::default());
-        // 0.18 -> 0.4613561 * 255 = 117.65 -> 118; 2.0 clips to 255; negative to 0.
+        // 0.18 -> 0.4613561 * 255 = 117.65 -> 118; 2.0 clips to 255; negative and NaN to 0.
         assert_eq!(
-            encoding.to_rgb8(&[Color::new(0.18, 2.0, -0.5)]),
-            vec![118, 255, 0]
+            DisplayTransform::default()
+                .to_rgb8(&[Color::new(0.18, 2.0, -0.5), Color::new(f32::NAN, 0.0, 1.0)]),
+            vec![118, 255, 0, 0, 0, 255]
         );
     }
 

@@ -319,7 +319,7 @@ fn encode_png(
     };
     encoder.add_text_chunk(TRANSFER_KEYWORD.to_owned(), transfer.to_owned())?;
     let mut png = encoder.write_header()?;
-    png.write_image_data(&encoding.to_rgb8(&film.pixels))?;
+    png.write_image_data(&encoding.to_rgb8(film))?;
     png.finish()?;
     Ok(())
 }
@@ -624,7 +624,7 @@ mod tests {
             assert_eq!(info.srgb.is_some(), srgb_chunk);
             let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
             reader.next_frame(&mut pixels).unwrap();
-            assert_eq!(&pixels[..3], encoding.to_rgb8(&film.pixels).as_slice());
+            assert_eq!(&pixels[..3], encoding.to_rgb8(&film).as_slice());
         }
     }
 }
