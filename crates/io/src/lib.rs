@@ -1,5 +1,6 @@
 //! Glint's I/O: the course's XML and JSON scene files into the renderer's `SceneParts`, OBJ
-//! meshes and PNG textures with them, and the rendered film out as PNG or EXR.
+//! meshes and textures with them (8-bit as the course reads them, EXR and Radiance HDR as float),
+//! and the rendered film out as PNG (the course's conversion or a display transform) or EXR.
 //!
 //! Loading runs in three stages (DESIGN.md, habits 1-2):
 //! 1. **parse**: XML (roxmltree) or JSON (jsonc-parser) into one located tree (`tree.rs`), the
