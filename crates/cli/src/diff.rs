@@ -28,7 +28,7 @@ use glint_render::Color;
 #[derive(Args, Debug)]
 #[command(after_help = DIFF_HELP)]
 pub struct DiffArgs {
-    /// The reference image (PNG, EXR or Radiance HDR).
+    /// The reference image (PNG, EXR or Radiance HDR; alpha is ignored).
     #[arg(value_name = "A")]
     pub reference: PathBuf,
 
@@ -55,6 +55,10 @@ pub struct DiffArgs {
     /// convention (its renders apply no gamma).
     #[arg(long, value_name = "HOW", value_enum, default_value_t = PngTransferArg::Auto)]
     pub png_transfer: PngTransferArg,
+
+    /// Print help (`glint` turns off `-h`, which is the image height for renders).
+    #[arg(short = '?', long, action = clap::ArgAction::Help)]
+    pub help: Option<bool>,
 }
 
 const DIFF_HELP: &str = "\

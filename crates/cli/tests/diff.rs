@@ -224,6 +224,9 @@ fn bad_input_exits_2_with_a_clear_message() {
     let heatmap = glint(dir.path(), &["diff", a, a, "--heatmap", "map.jpg"]);
     assert_eq!(heatmap.status.code(), Some(2), "{}", text(&heatmap));
     assert!(!dir.path().join("map.jpg").exists());
+    let help = glint(dir.path(), &["diff", "--help"]);
+    assert_eq!(help.status.code(), Some(0), "{}", text(&help));
+    assert!(String::from_utf8_lossy(&help.stdout).contains("--threshold"));
     let threshold = glint(dir.path(), &["diff", a, a, "--threshold", "ssim=0.9"]);
     assert_eq!(threshold.status.code(), Some(2), "{}", text(&threshold));
     // Nothing but the two test images was left in the directory.
