@@ -11,6 +11,7 @@
 #
 #   scripts/readme-examples.sh                  run them all
 #   CARGO_TARGET_DIR=$PWD/target scripts/readme-examples.sh   reuse this checkout's build
+#                                               (default: one build inside the clone)
 #   GLINT_SHARED=/path/to/shared                the course corpus (default: ../shared)
 #
 # Ends with `readme-examples: N passed, N failed`; exits 1 if any failed.
@@ -27,6 +28,9 @@ trap 'rm -rf "$work"' EXIT
 git clone --quiet "$repo" "$work/glint"
 ln -s "$(cd "$shared" && pwd)" "$work/shared"
 export CARGO_INSTALL_ROOT="$work/root"
+# `cargo install` builds in a temporary directory of its own unless told otherwise: share one
+# with the README's `cargo run --release` so the release build is made once.
+export CARGO_TARGET_DIR="${CARGO_TARGET_DIR:-$work/glint/target}"
 export PATH="$CARGO_INSTALL_ROOT/bin:$PATH"
 cd "$work/glint" || exit 1
 
