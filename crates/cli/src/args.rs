@@ -20,6 +20,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
+use glint_io::{DisplayTransform, PngEncoding, ToneMap, Transfer};
 use glint_render::{Color, IntegratorKind, RenderSettings};
 
 /// Largest accepted image side. Pixel indices are computed in `u32` in places, and a bigger
@@ -36,9 +37,12 @@ Examples:
   glint -i scene.xml -o out.png -w 250 -h 250 -r 16
   glint render scene.json -o out.exr --background 0.2,0.2,0.2
 
-Output is PNG (8-bit, clamped, floor(c*255), no gamma, as the course writes it) or EXR
-(linear 32-bit float), chosen by the extension. Without -o the image goes to the scene's
-name with .png in the current directory.
+Output is PNG or EXR (linear 32-bit float, with albedo, normal and depth layers), chosen by
+the extension. A PNG from the course integrator (and the normals and depth views) is written
+as the course writes it: clamped, floor(c*255), no gamma. One from the path tracer (and the
+albedo view) gets the display transform: exposure, tone curve (clamp), sRGB; --exposure,
+--tonemap and --transfer change it, for any integrator. Without -o the image goes to the
+scene's name with .png in the current directory.
 
 Exit status: 0 success, 1 failure (e.g. the image cannot be written), 2 bad scene or bad
 arguments, 130 interrupted (Ctrl-C; nothing is written).";
@@ -79,6 +83,9 @@ pub enum Command {
     },
     /// Measure the ray engine: `glint bench table`, `glint bench rays`, `glint bench make-rays`.
     Bench(crate::bench::BenchArgs),
+    /// Compare image B with reference A (PNG, EXR): MAE, RMSE, PSNR, pixels off by more than
+    /// N levels, NVIDIA's FLIP and its heat map; exit 1 past a --threshold.
+    Diff(crate::diff::DiffArgs),
 }
 
 /// Options shared by both forms.
@@ -133,6 +140,21 @@ pub struct Options {
           default_value_t = IntegratorArg::Course)]
     pub integrator: IntegratorArg,
 
+    /// PNG only: exposure in stops (values times 2^EV) before the tone curve. Giving it, or
+    /// --tonemap or --transfer, turns on the display transform for any integrator.
+    #[arg(long, value_name = "EV", allow_negative_numbers = true, value_parser = parse_exposure,
+          help_heading = PNG_HEADING)]
+    pub exposure: Option<f32>,
+
+    /// PNG only: tone curve. `clamp` (alias `none`): clip each channel to [0,1]; `aces`: Hill's
+    /// fitted ACES RRT+ODT; `agx`: Wrensch's minimal AgX [default: clamp].
+    #[arg(long, value_name = "CURVE", value_enum, help_heading = PNG_HEADING)]
+    pub tonemap: Option<ToneMapArg>,
+
+    /// PNG only: transfer function, `srgb` (IEC 61966-2-1) or `linear` [default: srgb].
+    #[arg(long, value_name = "FUNCTION", value_enum, help_heading = PNG_HEADING)]
+    pub transfer: Option<TransferArg>,
+
     /// Also print the settings and the loading time.
     #[arg(short = 'v', long, action = ArgAction::SetTrue)]
     pub verbose: bool,
@@ -159,6 +181,39 @@ pub struct Options {
 }
 
 const COURSE_NO_EFFECT: &str = "Course options accepted for its scripts, with no effect";
+const PNG_HEADING: &str = "PNG output transform (EXR is always linear and untouched)";
+
+/// `--tonemap` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToneMapArg {
+    // An 8-bit PNG clips somewhere: "no curve" is the per-channel clip.
+    #[value(alias = "none")]
+    Clamp,
+    Aces,
+    Agx,
+}
+
+/// `--transfer` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransferArg {
+    Srgb,
+    Linear,
+}
+
+/// Parses `--exposure`: a finite number of stops, within ±64 (2^64 overflows nothing in f32,
+/// and no scene needs more).
+pub fn parse_exposure(text: &str) -> Result<f32, String> {
+    let value: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if !value.is_finite() || value.abs() > 64.0 {
+        return Err(format!(
+            "the exposure must be a number of stops between -64 and 64, got {text}"
+        ));
+    }
+    Ok(value)
+}
 
 /// `--integrator` / `--shader` values.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -257,6 +312,8 @@ pub struct Job {
     pub settings: RenderSettings,
     pub threads: usize,
     pub background: Option<Color>,
+    /// How a PNG output's 8-bit values are made.
+    pub png: PngEncoding,
     pub verbose: bool,
     /// Notes about accepted options that have no effect, printed before rendering.
     pub notes: Vec<String>,
@@ -270,6 +327,9 @@ impl Cli {
                 Some(Command::Render { scene, options }) => (scene, options),
                 Some(Command::Bench(_)) => {
                     return Err(UsageError("`glint bench` is not a render".to_string()))
+                }
+                Some(Command::Diff(_)) => {
+                    return Err(UsageError("`glint diff` is not a render".to_string()))
                 }
                 None => match self.input {
                     Some(scene) if !scene.as_os_str().is_empty() => (scene, self.options),
@@ -306,6 +366,14 @@ impl Options {
                 "--split {split} has no effect: glint always builds a binned-SAH BVH"
             ));
         }
+        let display_options =
+            self.exposure.is_some() || self.tonemap.is_some() || self.transfer.is_some();
+        if display_options && output_is_exr(&output) {
+            notes.push(
+                "--exposure/--tonemap/--transfer have no effect on an EXR: it keeps linear values"
+                    .into(),
+            );
+        }
         if self.winwidth.is_some() || self.winheight.is_some() {
             notes.push("--winwidth/--winheight have no effect: glint has no preview window".into());
         }
@@ -338,10 +406,41 @@ impl Options {
                 .threads
                 .map_or(available_threads.max(1), |n| n as usize),
             background: self.background.map(Rgb::to_color),
+            png: png_encoding(self.integrator, self.exposure, self.tonemap, self.transfer),
             verbose: self.verbose,
             notes,
         })
     }
+}
+
+/// The PNG conversion: the display transform when any of its options is given, else the
+/// integrator's own. The course integrator keeps the course's conversion (its reference images
+/// were made with it), and so do the data views `normals` and `depth`; the path tracer and the
+/// `albedo` view, which are colours, get the display transform's defaults (clamp, sRGB), as
+/// pbrt and Mitsuba write PNGs.
+pub fn png_encoding(
+    integrator: IntegratorArg,
+    exposure: Option<f32>,
+    tonemap: Option<ToneMapArg>,
+    transfer: Option<TransferArg>,
+) -> PngEncoding {
+    let display_by_default = matches!(integrator, IntegratorArg::Path | IntegratorArg::Albedo);
+    if !display_by_default && exposure.is_none() && tonemap.is_none() && transfer.is_none() {
+        return PngEncoding::Course;
+    }
+    let defaults = DisplayTransform::default();
+    PngEncoding::Display(DisplayTransform {
+        exposure: exposure.unwrap_or(defaults.exposure),
+        tone_map: tonemap.map_or(defaults.tone_map, |tonemap| match tonemap {
+            ToneMapArg::Clamp => ToneMap::Clamp,
+            ToneMapArg::Aces => ToneMap::Aces,
+            ToneMapArg::Agx => ToneMap::Agx,
+        }),
+        transfer: transfer.map_or(defaults.transfer, |transfer| match transfer {
+            TransferArg::Srgb => Transfer::Srgb,
+            TransferArg::Linear => Transfer::Linear,
+        }),
+    })
 }
 
 /// The scene's file name with `.png`, in the current directory.
@@ -516,5 +615,72 @@ mod tests {
         assert!(parse_rgb("1,2,3,4").is_err());
         assert!(parse_rgb("-1,0,0").is_err());
         assert!(parse_rgb("").is_err());
+    }
+
+    #[test]
+    fn png_conversion_follows_the_integrator_unless_asked() {
+        let png = |args: &[&str]| {
+            let mut all = vec!["-i", "s.xml"];
+            all.extend_from_slice(args);
+            job(&all).unwrap().png
+        };
+        assert_eq!(png(&[]), PngEncoding::Course);
+        assert_eq!(png(&["--integrator", "normals"]), PngEncoding::Course);
+        assert_eq!(png(&["--integrator", "depth"]), PngEncoding::Course);
+        let display = PngEncoding::Display(DisplayTransform::default());
+        assert_eq!(png(&["--integrator", "path"]), display);
+        assert_eq!(png(&["--integrator", "albedo"]), display);
+        // Any display option turns it on, for the course integrator too.
+        assert_eq!(png(&["--tonemap", "none"]), display);
+        assert_eq!(
+            png(&[
+                "--integrator",
+                "path",
+                "--exposure",
+                "-1.5",
+                "--tonemap",
+                "agx",
+                "--transfer",
+                "linear"
+            ]),
+            PngEncoding::Display(DisplayTransform {
+                exposure: -1.5,
+                tone_map: ToneMap::Agx,
+                transfer: Transfer::Linear,
+            })
+        );
+        assert_eq!(
+            png(&["--tonemap", "aces"]),
+            PngEncoding::Display(DisplayTransform {
+                tone_map: ToneMap::Aces,
+                ..DisplayTransform::default()
+            })
+        );
+    }
+
+    #[test]
+    fn bad_display_options_are_usage_errors() {
+        for args in [
+            ["--exposure", "nan"],
+            ["--exposure", "100"],
+            ["--tonemap", "reinhard"],
+            ["--transfer", "gamma"],
+        ] {
+            let mut all = vec!["-i", "s.xml"];
+            all.extend_from_slice(&args);
+            assert!(job(&all).is_err(), "{args:?}");
+        }
+    }
+
+    #[test]
+    fn display_options_on_an_exr_get_a_note() {
+        let job = job(&["-i", "s.xml", "-o", "o.exr", "--exposure", "2"]).unwrap();
+        assert!(
+            job.notes
+                .iter()
+                .any(|note| note.contains("no effect on an EXR")),
+            "{:?}",
+            job.notes
+        );
     }
 }

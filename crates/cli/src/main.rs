@@ -7,6 +7,7 @@
 
 mod args;
 mod bench;
+mod diff;
 mod run;
 
 use std::io::IsTerminal;
@@ -33,6 +34,10 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         };
+    }
+    if let Some(crate::args::Command::Diff(args)) = &cli.command {
+        let status = diff::run(args, &mut std::io::stdout(), &mut std::io::stderr());
+        return ExitCode::from(status);
     }
     let available = std::thread::available_parallelism().map_or(1, |n| n.get());
     let job = match cli.into_job(available) {

@@ -257,7 +257,8 @@ pub fn run(
         );
     }
 
-    let write = glint_io::write_image(&job.output, &film);
+    let options = glint_io::WriteOptions { png: job.png };
+    let write = glint_io::write_image_with(&job.output, &film, &options);
     write.map_err(Failure::Write)?;
 
     let _ = writeln!(err, "{}", closing_line(job, &stats, render_time));
@@ -371,6 +372,7 @@ mod tests {
             },
             threads: 2,
             background: None,
+            png: glint_io::PngEncoding::Course,
             verbose: false,
             notes: Vec::new(),
         };

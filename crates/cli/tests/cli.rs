@@ -334,8 +334,9 @@ fn exr_output_is_linear_float() {
 }
 
 /// `--integrator path` with an .exr output writes the beauty as R, G, B and the denoiser
-/// features as `albedo.*` and `normal.*` channels; the sphere's albedo is its Lambertian
-/// colour and its centre normal faces the camera.
+/// features under Blender's pass names (`Denoising Albedo.R/G/B`, `Denoising Normal.X/Y/Z`,
+/// `Depth.Z`); the sphere's albedo is its Lambertian colour, its centre normal faces the
+/// camera and its depth is the distance to its front pole.
 #[test]
 fn path_tracer_exr_has_albedo_and_normal_layers() {
     let dir = scene_dir();
@@ -371,9 +372,14 @@ fn path_tracer_exr_has_albedo_and_normal_layers() {
     };
     let centre = 3 * 9 + 4;
     // The test scene's sphere is Lambertian (0, 0, 1).
-    assert_eq!(channel("albedo.B")[centre], 1.0);
-    assert_eq!(channel("albedo.R")[centre], 0.0);
-    assert!(channel("normal.B")[centre] > 0.99);
+    assert_eq!(channel("Denoising Albedo.B")[centre], 1.0);
+    assert_eq!(channel("Denoising Albedo.R")[centre], 0.0);
+    assert!(channel("Denoising Normal.Z")[centre] > 0.99);
+    assert!(channel("Denoising Normal.X")[centre].abs() < 0.1);
+    // Camera at the origin, sphere of radius 1 centred at z = -5.
+    let depth = channel("Depth.Z")[centre];
+    assert!((depth - 4.0).abs() < 0.05, "{depth}");
+    assert_eq!(channel("Depth.Z")[0], 0.0, "a missed ray has depth 0");
     assert!(channel("B")[centre] > 0.0);
     assert_eq!(channel("R").len(), 9 * 7);
 }
