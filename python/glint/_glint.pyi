@@ -1,0 +1,66 @@
+# Type stubs for the native module `glint._glint` (src/lib.rs). Use it through `glint`.
+
+from collections.abc import Callable
+from typing import Any, Optional, Union, final
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "SceneError",
+    "SceneWarning",
+    "Scene",
+    "load_scene",
+    "load_scene_text",
+    "_restore",
+    "render",
+    "write_image",
+    "TILE_SIZE",
+]
+
+TILE_SIZE: int
+
+class SceneError(ValueError):
+    file: str
+    line: int
+    column: int
+    message: str
+
+class SceneWarning(UserWarning):
+    file: str
+    line: int
+    column: int
+    message: str
+
+@final
+class Scene:
+    @property
+    def name(self) -> str: ...
+    @property
+    def warnings(self) -> list[SceneWarning]: ...
+    def __reduce__(self) -> tuple[Any, tuple[str, Optional[str]]]: ...
+
+def load_scene(path: str) -> Scene: ...
+def load_scene_text(text: str, path: str) -> Scene: ...
+def _restore(path: str, text: Optional[str] = None) -> Scene: ...
+def render(
+    scene: Scene,
+    width: int,
+    height: int,
+    spp: int,
+    integrator: str,
+    seed: int,
+    threads: Optional[int],
+    max_depth: Optional[int],
+    aspect: Optional[float],
+    bounds: Optional[tuple[int, int, int, int]],
+    features: bool,
+    progress: Optional[Callable[[float], object]],
+) -> Union[npt.NDArray[np.float32], dict[str, npt.NDArray[np.float32]]]: ...
+def write_image(
+    path: str,
+    beauty: npt.NDArray[np.float32],
+    albedo: Optional[npt.NDArray[np.float32]] = None,
+    normal: Optional[npt.NDArray[np.float32]] = None,
+    depth: Optional[npt.NDArray[np.float32]] = None,
+) -> None: ...
