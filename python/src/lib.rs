@@ -208,17 +208,22 @@ fn located_exception<'py, T: pyo3::PyTypeInfo>(
 }
 
 /// `OSError(errno, strerror, filename)`, which Python turns into `FileNotFoundError` and its
-/// siblings, or a plain `OSError(text)` when the error has no errno.
+/// siblings; an error without an errno (wrapped by a library) gets the subclass of its kind
+/// and `text` as its message, and `filename` too.
 fn os_error(py: Python<'_>, error: &std::io::Error, path: &Path, text: String) -> PyErr {
+    let filename = path.display().to_string();
     let Some(errno) = error.raw_os_error() else {
-        return PyOSError::new_err(text);
+        let exception = PyErr::from(std::io::Error::new(error.kind(), text));
+        // Best effort: the exception is right without the attribute too.
+        let _ = exception.value(py).setattr("filename", filename);
+        return exception;
     };
     let strerror = py
         .import("os")
         .and_then(|os| os.call_method1("strerror", (errno,)))
         .and_then(|message| message.extract::<String>())
         .unwrap_or(text);
-    PyOSError::new_err((errno, strerror, path.display().to_string()))
+    PyOSError::new_err((errno, strerror, filename))
 }
 
 fn scene_error(py: Python<'_>, error: glint_io::SceneError) -> PyErr {

@@ -91,7 +91,7 @@ def test_the_seed_changes_the_noise_but_not_the_picture(spheres):
         (dict(crop=(0, 4, 0, 4)), TypeError, "pair of slices"),
         (dict(crop=np.s_[0:4:2, 0:4]), ValueError, "step 1"),
         (dict(crop=np.s_[4:4, 0:4]), ValueError, "empty"),
-        (dict(spp=-1), OverflowError, "negative"),
+        (dict(spp=-1), OverflowError, "spp"),
     ],
 )
 def test_bad_settings_raise_before_rendering(spheres, kwargs, error, words):
@@ -227,6 +227,7 @@ def test_write_image_refuses_bad_input_and_leaves_no_file(tmp_path):
         glint.write_image(tmp_path / "x.exr", np.zeros((4, 4), np.float32))
     with pytest.raises(ValueError, match="go together"):
         glint.write_image(tmp_path / "x.exr", {"beauty": image, "depth": image[..., 0]})
-    with pytest.raises(FileNotFoundError):
+    with pytest.raises(FileNotFoundError) as caught:
         glint.write_image(tmp_path / "missing" / "x.exr", image)
+    assert caught.value.filename == str(tmp_path / "missing" / "x.exr")
     assert list(tmp_path.iterdir()) == []

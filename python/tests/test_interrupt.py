@@ -64,7 +64,7 @@ def test_the_gil_is_released_while_rendering():
 
     def work():
         rendered.append(
-            glint.render(scene, width=128, height=128, spp=16, integrator="path", threads=1)
+            glint.render(scene, width=128, height=128, spp=64, integrator="path", threads=1)
         )
         done.set()
 
