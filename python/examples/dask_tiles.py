@@ -16,8 +16,9 @@ from __future__ import annotations
 import argparse
 import time
 
-import glint
 import numpy as np
+
+import glint
 
 
 def render_tiles(client, scene, width, height, tile=64, **settings) -> np.ndarray:
@@ -62,16 +63,18 @@ def main() -> None:
     with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True) as cluster:
         with Client(cluster) as client:
             start = time.perf_counter()
-            frame = render_tiles(
-                client, scene, args.width, args.height, tile=args.tile, **settings
-            )
+            frame = render_tiles(client, scene, args.width, args.height, tile=args.tile, **settings)
             dask_time = time.perf_counter() - start
     print(f"dask: {args.workers} workers, {dask_time:.2f} s")
     if args.compare:
         start = time.perf_counter()
         single = glint.render(
-            scene, width=args.width, height=args.height, spp=args.spp,
-            integrator=args.integrator, threads=args.workers,
+            scene,
+            width=args.width,
+            height=args.height,
+            spp=args.spp,
+            integrator=args.integrator,
+            threads=args.workers,
         )
         single_time = time.perf_counter() - start
         same = np.array_equal(single.view(np.uint32), frame.view(np.uint32))

@@ -31,7 +31,7 @@ import json
 import os
 import warnings
 from collections.abc import Mapping
-from typing import Callable, Optional, Union
+from typing import Callable, Union
 
 import numpy as np
 
@@ -113,7 +113,7 @@ def load_scene(path: PathLike) -> Scene:
     return scene
 
 
-def _text_path(format: str, base_dir: Optional[PathLike], name: Optional[str]) -> str:
+def _text_path(format: str, base_dir: PathLike | None, name: str | None) -> str:
     if format not in ("json", "xml"):
         raise ValueError(f"format must be 'json' or 'xml', not {format!r}")
     name = name if name is not None else f"<text>.{format}"
@@ -123,8 +123,8 @@ def _text_path(format: str, base_dir: Optional[PathLike], name: Optional[str]) -
 def load_scene_text(
     text: str,
     format: str = "json",
-    base_dir: Optional[PathLike] = None,
-    name: Optional[str] = None,
+    base_dir: PathLike | None = None,
+    name: str | None = None,
 ) -> Scene:
     """Loads a scene from its text, in the course's JSON (``format="json"``) or XML.
 
@@ -140,8 +140,10 @@ def load_scene_text(
     ...         <imagePlaneWidth>1</imagePlaneWidth></camera>
     ...     </scene>''', format="xml")
     >>> warning = caught[0].message
-    >>> type(warning).__name__, warning.file, warning.line, warning.column, warning.message
-    ('SceneWarning', '<text>.xml', 1, 1, 'the scene has no shapes; the image shows only the background')
+    >>> type(warning).__name__, warning.file, warning.line, warning.column
+    ('SceneWarning', '<text>.xml', 1, 1)
+    >>> warning.message
+    'the scene has no shapes; the image shows only the background'
     >>> glint.render(scene, width=2, height=2)[0, 0].tolist()  # only the blue background
     [0.0, 0.0, 1.0]
     >>> glint.load_scene_text('{"scene": {"camera": 7}}')
@@ -157,7 +159,7 @@ def load_scene_text(
 
 
 def scene_from_dict(
-    scene: Mapping, base_dir: Optional[PathLike] = None, name: str = "<dict>.json"
+    scene: Mapping, base_dir: PathLike | None = None, name: str = "<dict>.json"
 ) -> Scene:
     """Loads a scene given as the course's JSON document in Python objects (``{"scene": ...}``).
 
@@ -168,7 +170,7 @@ def scene_from_dict(
     >>> bad = {"scene": {**BALL["scene"], "bgColor": "0.2 0.2"}}
     >>> glint.scene_from_dict(bad)
     Traceback (most recent call last):
-    glint.SceneError: <dict>.json:38:16: expected three numbers ("x y z") for `bgColor`, found `0.2 0.2`
+    glint.SceneError: <dict>.json:38:16: expected three numbers ... found `0.2 0.2`
         "bgColor": "0.2 0.2"
                    ^
     """
@@ -182,7 +184,8 @@ def _bounds(crop: Crop, width: int, height: int) -> tuple[int, int, int, int]:
     """``(x0, x1, y0, y1)`` of a numpy-style crop ``(rows, columns)``."""
     if not (isinstance(crop, tuple) and len(crop) == 2 and all(isinstance(s, slice) for s in crop)):
         raise TypeError(
-            f"crop must be a pair of slices (rows, columns) such as np.s_[0:16, 32:48], not {crop!r}"
+            "crop must be a pair of slices (rows, columns) such as np.s_[0:16, 32:48], "
+            f"not {crop!r}"
         )
     (y0, y1, y_step), (x0, x1, x_step) = crop[0].indices(height), crop[1].indices(width)
     if x_step != 1 or y_step != 1:
@@ -199,13 +202,13 @@ def render(
     spp: int = 1,
     integrator: str = "course",
     seed: int = 0,
-    threads: Optional[int] = None,
-    max_depth: Optional[int] = None,
-    aspect: Optional[float] = None,
-    crop: Optional[Crop] = None,
+    threads: int | None = None,
+    max_depth: int | None = None,
+    aspect: float | None = None,
+    crop: Crop | None = None,
     features: bool = False,
-    progress: Optional[Callable[[float], object]] = None,
-) -> Union[np.ndarray, dict[str, np.ndarray]]:
+    progress: Callable[[float], object] | None = None,
+) -> np.ndarray | dict[str, np.ndarray]:
     """Renders ``scene`` into a linear float32 array of shape ``(height, width, 3)``.
 
     The arguments are the CLI's: ``spp`` samples per pixel (``-r``; the course's integrators
@@ -275,7 +278,7 @@ def _float32(name: str, array: object, dimensions: int) -> np.ndarray:
     return array
 
 
-def write_image(path: PathLike, image: Union[np.ndarray, Mapping[str, np.ndarray]]) -> None:
+def write_image(path: PathLike, image: np.ndarray | Mapping[str, np.ndarray]) -> None:
     """Writes an image as the CLI does, by the file name's extension: ``.png`` (8-bit, the
     course's conversion: clamp, floor(c * 255), no gamma) or ``.exr`` (linear float32).
 

@@ -1,7 +1,7 @@
 # Type stubs for the native module `glint._glint` (src/lib.rs). Use it through `glint`.
 
 from collections.abc import Callable
-from typing import Any, Optional, Union, final
+from typing import Any, final
 
 import numpy as np
 import numpy.typing as npt
@@ -38,11 +38,11 @@ class Scene:
     def name(self) -> str: ...
     @property
     def warnings(self) -> list[SceneWarning]: ...
-    def __reduce__(self) -> tuple[Any, tuple[str, Optional[str]]]: ...
+    def __reduce__(self) -> tuple[Any, tuple[str, str | None]]: ...
 
 def load_scene(path: str) -> Scene: ...
 def load_scene_text(text: str, path: str) -> Scene: ...
-def _restore(path: str, text: Optional[str] = None) -> Scene: ...
+def _restore(path: str, text: str | None = None) -> Scene: ...
 def render(
     scene: Scene,
     width: int,
@@ -50,17 +50,17 @@ def render(
     spp: int,
     integrator: str,
     seed: int,
-    threads: Optional[int],
-    max_depth: Optional[int],
-    aspect: Optional[float],
-    bounds: Optional[tuple[int, int, int, int]],
+    threads: int | None,
+    max_depth: int | None,
+    aspect: float | None,
+    bounds: tuple[int, int, int, int] | None,
     features: bool,
-    progress: Optional[Callable[[float], object]],
-) -> Union[npt.NDArray[np.float32], dict[str, npt.NDArray[np.float32]]]: ...
+    progress: Callable[[float], object] | None,
+) -> npt.NDArray[np.float32] | dict[str, npt.NDArray[np.float32]]: ...
 def write_image(
     path: str,
     beauty: npt.NDArray[np.float32],
-    albedo: Optional[npt.NDArray[np.float32]] = None,
-    normal: Optional[npt.NDArray[np.float32]] = None,
-    depth: Optional[npt.NDArray[np.float32]] = None,
+    albedo: npt.NDArray[np.float32] | None = None,
+    normal: npt.NDArray[np.float32] | None = None,
+    depth: npt.NDArray[np.float32] | None = None,
 ) -> None: ...

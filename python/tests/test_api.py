@@ -6,10 +6,11 @@ import json
 import pickle
 import warnings
 
-import glint
 import numpy as np
 import pytest
 from conftest import THREE_SPHERES, read_exr
+
+import glint
 
 
 @pytest.fixture(scope="module")
@@ -168,7 +169,8 @@ def test_warnings_are_python_warnings_with_locations(tmp_path):
     warning = messages[0]
     assert warning.file == str(path)
     assert "bgColour" in warning.message
-    assert (path.read_text().splitlines()[warning.line - 1]).find('"bgColour"') == warning.column - 1
+    line = path.read_text().splitlines()[warning.line - 1]
+    assert line.find('"bgColour"') == warning.column - 1
     assert str(warning).startswith(f"{path}:{warning.line}:{warning.column}: ")
     # Shown as raised by the caller (this file), not by glint's own code.
     assert [w.filename for w in caught] == [__file__]

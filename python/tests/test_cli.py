@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import subprocess
 
-import glint
 import numpy as np
 import pytest
 from conftest import THREE_SPHERES, read_exr
+
+import glint
 
 
 def bits(array: np.ndarray) -> np.ndarray:

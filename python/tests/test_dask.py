@@ -7,10 +7,11 @@ import importlib.util
 import os
 from pathlib import Path
 
-import glint
 import numpy as np
 import pytest
 from conftest import THREE_SPHERES
+
+import glint
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "dask_tiles.py"
 
@@ -32,9 +33,12 @@ def test_dask_tiles_on_two_processes_give_the_single_process_image():
     scene = glint.load_scene(THREE_SPHERES)
     settings = dict(spp=4, integrator="path", seed=21, threads=1)
     width, height = 100, 70  # tiles of 32: ragged at the right and bottom edges
-    with LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
-    ) as cluster, Client(cluster) as client:
+    with (
+        LocalCluster(
+            n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None
+        ) as cluster,
+        Client(cluster) as client,
+    ):
         frame = load_example().render_tiles(client, scene, width, height, tile=32, **settings)
         # The tasks really ran in the two worker processes, not here.
         pids = client.run(os.getpid)

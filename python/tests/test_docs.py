@@ -8,9 +8,10 @@ import os
 import subprocess
 import sys
 
+import pytest
+
 import glint
 import glint._glint
-import pytest
 
 
 def test_docstring_examples_run():

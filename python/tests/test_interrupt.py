@@ -9,9 +9,10 @@ import sys
 import threading
 import time
 
-import glint
 import pytest
 from conftest import THREE_SPHERES
+
+import glint
 
 # A render long enough to interrupt: about a thousand tiles of path-traced pixels.
 LONG = dict(width=512, height=512, spp=64, integrator="path", threads=2)
