@@ -22,6 +22,7 @@ use glint_render::{
 use numpy::ndarray::{Array2, Array3, ArrayView2, ArrayView3};
 use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyOSError, PyUserWarning, PyValueError};
+use pyo3::panic::PanicException;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
@@ -377,9 +378,10 @@ fn render_waiting(
     let outcome = Slot::new();
     std::thread::scope(|threads| {
         let (on_tile, outcome_ref) = (&on_tile, &outcome);
-        threads.spawn(move || outcome_ref.put(glint_render::render(scene, settings, on_tile)));
+        let worker =
+            threads.spawn(move || outcome_ref.put(glint_render::render(scene, settings, on_tile)));
         let mut reported = None;
-        loop {
+        let result = loop {
             let finished = py.detach(|| outcome.take(Some(POLL)));
             let checked = py.check_signals().and_then(|()| {
                 let Some(callback) = progress else {
@@ -399,22 +401,38 @@ fn render_waiting(
                 Ok(())
             });
             if let Err(error) = checked {
+                // The render stops at the end of the tiles in flight and returns `Cancelled`.
                 cancel.store(true, Ordering::Relaxed);
-                if finished.is_none() {
-                    // Wait for the tiles in flight; the render then returns `Cancelled`.
-                    py.detach(|| outcome.take(None));
-                }
-                return Err(error);
+                break Err(error);
             }
-            match finished {
-                None => continue,
-                Some(Ok(rendered)) => return Ok(rendered),
-                Some(Err(RenderError::Invalid(why))) => return Err(PyValueError::new_err(why)),
-                // Only this function cancels, and it returns above when it does.
-                Some(Err(RenderError::Cancelled)) => {
-                    return Err(PyValueError::new_err("the render was cancelled"))
+            if let Some(finished) = finished {
+                break Ok(finished);
+            }
+            if worker.is_finished() {
+                // Gone without a result unless it put one just after the wait timed out.
+                match outcome.take(Some(Duration::ZERO)) {
+                    Some(finished) => break Ok(finished),
+                    None => break Err(PanicException::new_err("the render thread panicked")),
                 }
             }
+        };
+        // Join here, so that a panic in the render thread becomes an exception rather than a
+        // panic of the scope.
+        if let Err(payload) = py.detach(|| worker.join()) {
+            let why = payload
+                .downcast_ref::<&str>()
+                .map(|text| text.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            return Err(PanicException::new_err(format!(
+                "the renderer panicked: {why}"
+            )));
+        }
+        match result? {
+            Ok(rendered) => Ok(rendered),
+            Err(RenderError::Invalid(why)) => Err(PyValueError::new_err(why)),
+            // Only this function cancels, and then `result` is the exception that made it.
+            Err(RenderError::Cancelled) => Err(PyValueError::new_err("the render was cancelled")),
         }
     })
 }
