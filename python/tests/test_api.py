@@ -92,7 +92,7 @@ def test_the_seed_changes_the_noise_but_not_the_picture(spheres):
         (dict(crop=(0, 4, 0, 4)), TypeError, "pair of slices"),
         (dict(crop=np.s_[0:4:2, 0:4]), ValueError, "step 1"),
         (dict(crop=np.s_[4:4, 0:4]), ValueError, "empty"),
-        (dict(spp=-1), OverflowError, "spp"),
+        (dict(spp=-1), OverflowError, "out of range"),
     ],
 )
 def test_bad_settings_raise_before_rendering(spheres, kwargs, error, words):
