@@ -60,12 +60,15 @@ def main() -> None:
 
     scene = glint.load_scene(args.scene)
     settings = dict(spp=args.spp, integrator=args.integrator, threads=1)
+    started = time.perf_counter()
     with LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True) as cluster:
         with Client(cluster) as client:
+            up = time.perf_counter() - started
+            print(f"cluster of {args.workers} worker processes up in {up:.2f} s")
             start = time.perf_counter()
             frame = render_tiles(client, scene, args.width, args.height, tile=args.tile, **settings)
             dask_time = time.perf_counter() - start
-    print(f"dask: {args.workers} workers, {dask_time:.2f} s")
+    print(f"dask: {args.workers} workers x 1 thread, tiles of {args.tile}: {dask_time:.2f} s")
     if args.compare:
         start = time.perf_counter()
         single = glint.render(
