@@ -223,7 +223,9 @@ def render(
     With ``features=True`` the result is a dict: ``beauty``, ``albedo`` and ``normal``
     (``(H, W, 3)``) and ``depth`` (``(H, W)``), the first-hit layers a denoiser takes.
 
-    The GIL is released while rendering. Ctrl-C raises ``KeyboardInterrupt`` once the tiles
+    Samples that come out NaN or infinite are left out of their pixels, as in the CLI, with a
+    ``RuntimeWarning`` saying how many and where the first was. The GIL is released while
+    rendering. Ctrl-C raises ``KeyboardInterrupt`` once the tiles
     being rendered are done. ``progress``, when given, is called on the calling thread with
     the fraction done (0 to 1, ending with 1.0), at most about ten times a second; an exception
     it raises stops the render and is raised here.

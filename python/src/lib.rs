@@ -353,8 +353,33 @@ fn render<'py>(
     settings.validate().map_err(PyValueError::new_err)?;
 
     let scene = &scene.get().scene;
-    let (film, _stats) = render_waiting(py, scene, &settings, progress.as_ref())?;
+    let (film, stats) = render_waiting(py, scene, &settings, progress.as_ref())?;
+    if stats.nonfinite_samples > 0 {
+        warn_nonfinite(py, &stats)?;
+    }
     film_to_python(py, film)
+}
+
+/// The CLI's warning about samples that were NaN or infinite (and left out of their pixels),
+/// as a `RuntimeWarning` pointing at the caller of `glint.render`.
+fn warn_nonfinite(py: Python<'_>, stats: &RenderStats) -> PyResult<()> {
+    let first = stats
+        .first_nonfinite_pixel
+        .map(|(x, y)| format!("; the first in pixel ({x}, {y}) from the top-left"))
+        .unwrap_or_default();
+    let count = stats.nonfinite_samples;
+    let (plural, were) = if count == 1 {
+        ("", "was")
+    } else {
+        ("s", "were")
+    };
+    let message = format!(
+        "{count} sample{plural} returned NaN or infinity and {were} left out of the image{first}"
+    );
+    let message = std::ffi::CString::new(message).expect("the message has no NUL");
+    let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
+    // Stack level 2: the code that called `glint.render` in `__init__.py`.
+    PyErr::warn(py, &category, &message, 2)
 }
 
 /// Runs the render on a helper thread; the caller waits without the GIL and, every `POLL`,
