@@ -21,6 +21,7 @@ use glint_render::{
     Material, MaterialId, Matrix4, SceneParts, Shape, TextureId, Transform, Vec3,
 };
 
+use crate::assets::Assets;
 use crate::desc::{
     ColorDesc, LightKindDesc, Located, SceneDesc, ShaderKindDesc, ShapeDesc, ShapeKindDesc, Span,
     TextureDesc, TransformOperation, TransformStep,
@@ -32,9 +33,10 @@ use crate::obj::load_triangles;
 pub(crate) fn build(
     desc: &SceneDesc,
     base_directory: &Path,
+    assets: &dyn Assets,
     diagnostics: &mut Diagnostics,
 ) -> Result<SceneParts, SceneError> {
-    let mut builder = Builder::new(desc, base_directory, diagnostics);
+    let mut builder = Builder::new(desc, base_directory, assets, diagnostics);
     builder.declare_textures();
     builder.create_materials();
     builder.declare_definitions();
@@ -55,6 +57,8 @@ type MeshCache = HashMap<PathBuf, Option<Rc<Vec<[Vec3; 3]>>>>;
 struct Builder<'desc, 'diagnostics, 'text> {
     desc: &'desc SceneDesc,
     base_directory: &'desc Path,
+    /// Where meshes, textures and environment maps are read from.
+    assets: &'desc dyn Assets,
     diagnostics: &'diagnostics mut Diagnostics<'text>,
     materials: Vec<Material>,
     material_by_name: HashMap<&'desc str, MaterialId>,
@@ -81,11 +85,13 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
     fn new(
         desc: &'desc SceneDesc,
         base_directory: &'desc Path,
+        assets: &'desc dyn Assets,
         diagnostics: &'diagnostics mut Diagnostics<'text>,
     ) -> Self {
         Builder {
             desc,
             base_directory,
+            assets,
             diagnostics,
             materials: Vec::new(),
             material_by_name: HashMap::new(),
@@ -285,7 +291,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         }
         let source = &declaration.source_file;
         let path = self.resolve_path(&source.value);
-        let loaded = match load_image(&path) {
+        let loaded = match load_image(&path, self.assets) {
             Ok(image) => {
                 self.textures.push(image);
                 Some((self.textures.len() - 1) as TextureId)
@@ -426,7 +432,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         if let Some(cached) = self.meshes.get(&path) {
             return cached.clone();
         }
-        let loaded = match load_triangles(&path) {
+        let loaded = match load_triangles(&path, self.assets) {
             Ok(triangles) if triangles.is_empty() => {
                 self.diagnostics.warn(
                     file.span,
@@ -768,7 +774,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             .or(background.scene_bg_color.as_ref())
             .map_or(Vec3::ZERO, |color| color.value);
         if let Some(prefix) = &background.env_map_prefix {
-            match load_cube_map(self.base_directory, &prefix.value) {
+            match load_cube_map(self.base_directory, &prefix.value, self.assets) {
                 Ok(map) => return Background::CubeMap(Box::new(map)),
                 // FORMAT.md 2.1, A17: `data/reef_` never existed; a missing map means no map.
                 Err(error) => self.diagnostics.warn(
@@ -782,7 +788,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         }
         if let Some(cross) = &background.env_map_vertical_cross {
             let path = self.resolve_path(&cross.value);
-            let faces = load_image(&path)
+            let faces = load_image(&path, self.assets)
                 .map_err(|error| format!("cannot read ({}): {error}", path.display()))
                 .and_then(|image| cut_vertical_cross(&image));
             match faces {

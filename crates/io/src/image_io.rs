@@ -7,11 +7,18 @@ use std::path::{Path, PathBuf};
 
 use glint_render::{Color, CubeMap, Film, Image, Vec3};
 
+use crate::assets::Assets;
+
 /// Reads a texture or environment-map image. The course applies no gamma anywhere
 /// (FORMAT.md 1.3), so a texel is its 8-bit value / 255; alpha is dropped.
-pub(crate) fn load_image(path: &Path) -> Result<Image, String> {
-    let reader = image::ImageReader::open(path)
-        .map_err(|error| error.to_string())?
+pub(crate) fn load_image(path: &Path, assets: &dyn Assets) -> Result<Image, String> {
+    let bytes = assets.read(path).map_err(|error| error.to_string())?;
+    decode_image(&bytes)
+}
+
+/// Decodes an image held in memory, its format told by its content.
+pub(crate) fn decode_image(bytes: &[u8]) -> Result<Image, String> {
+    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
         .with_guessed_format()
         .map_err(|error| error.to_string())?;
     let decoded = reader.decode().map_err(|error| error.to_string())?;
@@ -93,11 +100,15 @@ pub(crate) fn cut_vertical_cross(cross: &Image) -> Result<[Image; 6], String> {
 }
 
 /// Loads the six faces named by `envMapPrefix`, resolved against `directory`.
-pub(crate) fn load_cube_map(directory: &Path, prefix: &str) -> Result<CubeMap, String> {
+pub(crate) fn load_cube_map(
+    directory: &Path,
+    prefix: &str,
+    assets: &dyn Assets,
+) -> Result<CubeMap, String> {
     let mut faces = Vec::with_capacity(6);
     for name in cube_face_paths(prefix) {
         let path = directory.join(&name);
-        let face = load_image(&path)
+        let face = load_image(&path, assets)
             .map_err(|error| format!("cannot read face `{name}` ({}): {error}", path.display()))?;
         faces.push(face);
     }
@@ -385,7 +396,7 @@ mod tests {
                 .save(directory.path().join(name))
                 .unwrap();
         }
-        let map = load_cube_map(directory.path(), "sky_").unwrap();
+        let map = load_cube_map(directory.path(), "sky_", &crate::FileSystem).unwrap();
         let directions = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
         for (direction, color) in directions.into_iter().zip(colors) {
             let expected = Vec3::new(
@@ -404,7 +415,7 @@ mod tests {
     #[test]
     fn missing_cube_map_face_names_the_file() {
         let directory = tempfile::tempdir().unwrap();
-        let error = load_cube_map(directory.path(), "data/reef_").unwrap_err();
+        let error = load_cube_map(directory.path(), "data/reef_", &crate::FileSystem).unwrap_err();
         assert!(error.contains("data/reef_posX.png"), "{error}");
     }
 }

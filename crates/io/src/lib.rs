@@ -41,6 +41,7 @@
 
 #![forbid(unsafe_code)]
 
+mod assets;
 mod build;
 mod desc;
 mod diagnostic;
@@ -57,6 +58,7 @@ mod xml;
 
 use std::path::Path;
 
+pub use assets::{Assets, FileSystem, MemoryAssets};
 pub use diagnostic::{Diagnostic, SceneError, Severity};
 pub use image_io::{output_format, write_image, EncodeError, ImageWriteError, OutputFormat};
 pub use mesh::{load_mesh, Mesh, MeshError};
@@ -93,8 +95,39 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
     }
 }
 
-/// Loads a scene from its text. `path` names it in diagnostics and locates its assets.
+/// Loads a scene from its text. `path` names it in diagnostics and locates its assets, which
+/// are read from the file system.
 pub fn load_scene_from_text(text: &str, path: &Path) -> Result<LoadedScene, SceneError> {
+    load_scene_with_assets(text, path, &FileSystem)
+}
+
+/// Loads a scene from its text, reading the meshes, textures and environment maps it names
+/// from `assets` (paths joined to `path`'s folder): [`MemoryAssets`] where there is no file
+/// system, as in the browser.
+///
+/// ```
+/// use std::path::Path;
+/// use glint_io::{load_scene_with_assets, MemoryAssets};
+///
+/// let scene = r#"<scene><camera type="perspective" name="main">
+///     <position>0 0 3</position><viewDir>0 0 -1</viewDir>
+///     <focalLength>1.0</focalLength><imagePlaneWidth>1.0</imagePlaneWidth></camera>
+///   <light type="point"><position>0 2 3</position><intensity>1 1 1</intensity></light>
+///   <shader name="grey" type="Lambertian"><diffuse>0.5 0.5 0.5</diffuse></shader>
+///   <shape type="mesh" name="tri"><file>data/tri.obj</file><shader ref="grey"/></shape>
+/// </scene>"#;
+/// let mut assets = MemoryAssets::new();
+/// assets.insert("dropped/data/tri.obj", b"v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n".to_vec());
+/// let loaded = load_scene_with_assets(scene, Path::new("dropped/scene.xml"), &assets)?;
+/// assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+/// assert_eq!(loaded.parts.geometries.iter().map(|g| g.shapes.len()).sum::<usize>(), 1);
+/// # Ok::<(), glint_io::SceneError>(())
+/// ```
+pub fn load_scene_with_assets(
+    text: &str,
+    path: &Path,
+    assets: &dyn Assets,
+) -> Result<LoadedScene, SceneError> {
     // A byte-order mark is not part of line 1's columns.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut diagnostics = Diagnostics::new(path, text);
@@ -105,7 +138,7 @@ pub fn load_scene_from_text(text: &str, path: &Path) -> Result<LoadedScene, Scen
     };
     let desc = read::read_document(&root, format, &mut diagnostics)?;
     let base_directory = path.parent().unwrap_or(Path::new(""));
-    let parts = build::build(&desc, base_directory, &mut diagnostics)?;
+    let parts = build::build(&desc, base_directory, assets, &mut diagnostics)?;
     Ok(LoadedScene {
         parts,
         warnings: diagnostics.into_warnings(),

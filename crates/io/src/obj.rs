@@ -2,19 +2,19 @@
 //! and texture coordinates are not used, and materials (`mtllib`, `usemtl`) are ignored because
 //! the course gives one shader per mesh.
 
-use std::fs::File;
-use std::io::{BufRead, BufReader};
+use std::io::BufRead;
 use std::path::Path;
 
 use glint_render::Vec3;
 
+use crate::assets::Assets;
 use crate::mesh::Mesh;
 
 /// The triangles of an OBJ file, polygons fan-triangulated (`al.obj` has faces of 3 to 23
 /// vertices). Errors are messages for a warning.
-pub(crate) fn load_triangles(path: &Path) -> Result<Vec<[Vec3; 3]>, String> {
-    let file = File::open(path).map_err(|error| error.to_string())?;
-    let mesh = read_obj(&mut BufReader::new(file))?;
+pub(crate) fn load_triangles(path: &Path, assets: &dyn Assets) -> Result<Vec<[Vec3; 3]>, String> {
+    let bytes = assets.read(path).map_err(|error| error.to_string())?;
+    let mesh = read_obj(&mut bytes.as_slice())?;
     Ok((0..mesh.triangles.len())
         .map(|index| mesh.triangle(index))
         .collect())
@@ -77,7 +77,7 @@ mod tests {
             "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 2 0\nusemtl x\nf 1 2 3 4 5\n",
         )
         .unwrap();
-        let triangles = load_triangles(&path).unwrap();
+        let triangles = load_triangles(&path, &crate::FileSystem).unwrap();
         assert_eq!(triangles.len(), 3);
         assert_eq!(
             triangles[0],
@@ -89,7 +89,8 @@ mod tests {
 
     #[test]
     fn missing_file_is_an_error_message() {
-        let error = load_triangles(Path::new("/nonexistent/file.obj")).unwrap_err();
+        let error =
+            load_triangles(Path::new("/nonexistent/file.obj"), &crate::FileSystem).unwrap_err();
         assert!(error.contains("No such file"), "{error}");
     }
 
@@ -109,9 +110,11 @@ mod tests {
         for (index, contents) in cases.iter().enumerate() {
             let path = directory.path().join(format!("case{index}.obj"));
             std::fs::write(&path, contents).unwrap();
-            let _ = load_triangles(&path);
+            let _ = load_triangles(&path, &crate::FileSystem);
         }
         let path = directory.path().join("case7.obj");
-        assert!(load_triangles(&path).unwrap_err().contains("not finite"));
+        assert!(load_triangles(&path, &crate::FileSystem)
+            .unwrap_err()
+            .contains("not finite"));
     }
 }

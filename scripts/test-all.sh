@@ -1,0 +1,81 @@
+#!/usr/bin/env bash
+# The one test command (README, .ci/run): installs what is missing, builds once, runs every
+# suite, and closes with one line per suite and the totals.
+#   scripts/test-all.sh              install what is missing, then test everything
+#   scripts/test-all.sh --no-install test with what is installed (a suite missing something fails
+#                                    under CI=1 and says SKIPPED otherwise)
+# Suites: the Rust workspace (`cargo test --workspace`: unit, reference-image, corpus, Mitsuba,
+# software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh), and each
+# front end's own script (`FOLDER/ci.sh install|test`, listed in SUITES below).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+
+# Front-end suites, each a script with `install` and `test` subcommands.
+SUITES=()
+
+install=1
+if [ "${1:-}" = "--no-install" ]; then
+  install=0
+fi
+
+if ! command -v cargo >/dev/null 2>&1; then
+  if [ -x "$HOME/.cargo/bin/cargo" ]; then
+    export PATH="$HOME/.cargo/bin:$PATH"
+  elif [ "$install" = 1 ]; then
+    echo "== installing Rust (rustup, stable)"
+    curl --proto '=https' --tlsv1.2 -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal
+    export PATH="$HOME/.cargo/bin:$PATH"
+  else
+    echo "error: cargo not found" >&2
+    exit 1
+  fi
+fi
+
+if [ "$install" = 1 ]; then
+  for suite in "${SUITES[@]}"; do
+    echo "== $suite: install"
+    "$suite/ci.sh" install
+  done
+fi
+
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
+declare -A result
+
+# Totals from the `test result:` lines cargo prints, one per test binary.
+cargo_totals() {
+  awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($i == "passed;") p += $(i-1); if ($i == "failed;") f += $(i-1) } }
+       END { printf "%d passed, %d failed", p, f }' "$1"
+}
+
+echo "== cargo test --workspace"
+status=0
+cargo test --workspace --locked 2>&1 | tee "$logs/cargo.log" || status=$?
+result[cargo]="$(cargo_totals "$logs/cargo.log")$([ "$status" = 0 ] || echo " (exit $status)")"
+failed=$status
+
+echo "== course images bit for bit (scripts/same-images.sh)"
+status=0
+scripts/same-images.sh 2>&1 | tee "$logs/same-images.log" || status=$?
+result[same-images]=$(tail -n 1 "$logs/same-images.log")
+[ "$status" = 0 ] || failed=1
+
+for suite in "${SUITES[@]}"; do
+  echo "== $suite: test"
+  status=0
+  "$root/$suite/ci.sh" test 2>&1 | tee "$logs/suite.log" || status=$?
+  result[$suite]="$(tail -n 1 "$logs/suite.log")$([ "$status" = 0 ] || echo " (exit $status)")"
+  [ "$status" = 0 ] || failed=1
+done
+
+echo
+echo "== summary"
+for name in cargo same-images "${SUITES[@]}"; do
+  printf '%-12s %s\n' "$name" "${result[$name]}"
+done
+if [ "$failed" != 0 ]; then
+  echo "FAILED" >&2
+  exit 1
+fi
+echo "all suites passed"
