@@ -5,7 +5,8 @@
 #                          OpenEXR (the tests' EXR reader) and mypy (stubtest)
 #   python/ci.sh test      builds the wheel once (pip install ./python: maturin, release), builds
 #                          the `glint` CLI for the equality tests, runs pytest, ruff, rustfmt and
-#                          clippy on the module; ends with `python: N passed, N failed`
+#                          clippy on the module; ends with `python: N passed, N failed` (the
+#                          pytest tests and the four lint checks)
 # With CI set, anything missing is a failure, never a skip.
 set -euo pipefail
 

@@ -41,6 +41,7 @@ from glint._glint import TILE_SIZE, Scene, SceneError, SceneWarning
 __all__ = [
     "BALL",
     "INTEGRATORS",
+    "RGB",
     "TILE_SIZE",
     "Scene",
     "SceneError",
@@ -56,6 +57,7 @@ __all__ = [
 
 PathLike = Union[str, "os.PathLike[str]"]
 Crop = tuple[slice, slice]
+RGB = tuple[float, float, float]
 
 #: The integrators :func:`render` knows, as the CLI's ``--integrator`` names them.
 INTEGRATORS = ("course", "path", "normals", "albedo", "depth")
@@ -95,10 +97,12 @@ def _issue_warnings(scene: Scene) -> None:
         warnings.warn(warning, stacklevel=3)
 
 
-def load_scene(path: PathLike) -> Scene:
+def load_scene(path: PathLike, background: RGB | None = None) -> Scene:
     """Loads a course scene file, XML or JSON, and builds it for rendering.
 
-    Meshes, textures and environment maps are found relative to the file's directory. What the
+    Meshes, textures and environment maps are found relative to the file's directory.
+    ``background=(r, g, b)`` replaces the scene's background, as the CLI's ``--background``
+    does (the course's reference renders used ``(0.2, 0.2, 0.2)``). What the
     loader works around (unknown keys, missing textures...) is issued as a :class:`SceneWarning`
     naming ``file:line:col``; a scene that cannot be loaded raises :class:`SceneError` (with
     ``file``, ``line``, ``column`` and ``message``), a file that cannot be read ``OSError``
@@ -108,9 +112,16 @@ def load_scene(path: PathLike) -> Scene:
     Traceback (most recent call last):
     FileNotFoundError: [Errno 2] No such file or directory: 'no/such/scene.xml'
     """
-    scene = _glint.load_scene(os.fspath(path))
+    scene = _glint.load_scene(os.fspath(path), _rgb(background))
     _issue_warnings(scene)
     return scene
+
+
+def _rgb(background: RGB | None) -> RGB | None:
+    if background is None:
+        return None
+    r, g, b = (float(c) for c in background)
+    return (r, g, b)
 
 
 def _text_path(format: str, base_dir: PathLike | None, name: str | None) -> str:
@@ -125,12 +136,13 @@ def load_scene_text(
     format: str = "json",
     base_dir: PathLike | None = None,
     name: str | None = None,
+    background: RGB | None = None,
 ) -> Scene:
     """Loads a scene from its text, in the course's JSON (``format="json"``) or XML.
 
     Diagnostics name the text ``name`` (default ``<text>.json`` or ``<text>.xml``) inside
     ``base_dir``, and assets are found relative to ``base_dir`` (default: the current
-    directory). Warnings and errors as for :func:`load_scene`.
+    directory). ``background``, warnings and errors as for :func:`load_scene`.
 
     >>> import warnings
     >>> with warnings.catch_warnings(record=True) as caught:
@@ -153,19 +165,23 @@ def load_scene_text(
     first = text.lstrip("\ufeff \t\r\n")[:1]
     if (format == "xml" and first in ("{", "[")) or (format == "json" and first == "<"):
         raise ValueError(f"format={format!r}, but the text starts with {first!r}")
-    scene = _glint.load_scene_text(text, _text_path(format, base_dir, name))
+    scene = _glint.load_scene_text(text, _text_path(format, base_dir, name), _rgb(background))
     _issue_warnings(scene)
     return scene
 
 
 def scene_from_dict(
-    scene: Mapping, base_dir: PathLike | None = None, name: str = "<dict>.json"
+    scene: Mapping,
+    base_dir: PathLike | None = None,
+    name: str = "<dict>.json",
+    background: RGB | None = None,
 ) -> Scene:
     """Loads a scene given as the course's JSON document in Python objects (``{"scene": ...}``).
 
     The dict is written out as indented JSON, so a diagnostic's line and column point into that
     text, and its message shows the offending line. Diagnostics name it ``name`` inside
     ``base_dir``; assets are found relative to ``base_dir`` (default: the current directory).
+    ``background`` as for :func:`load_scene`.
 
     >>> bad = {"scene": {**BALL["scene"], "bgColor": "0.2 0.2"}}
     >>> glint.scene_from_dict(bad)
@@ -175,7 +191,8 @@ def scene_from_dict(
                    ^
     """
     text = json.dumps(scene, indent=2)
-    loaded = _glint.load_scene_text(text, _text_path("json", base_dir, name))
+    path = _text_path("json", base_dir, name)
+    loaded = _glint.load_scene_text(text, path, _rgb(background))
     _issue_warnings(loaded)
     return loaded
 
@@ -224,11 +241,13 @@ def render(
     (``(H, W, 3)``) and ``depth`` (``(H, W)``), the first-hit layers a denoiser takes.
 
     Samples that come out NaN or infinite are left out of their pixels, as in the CLI, with a
-    ``RuntimeWarning`` saying how many and where the first was. The GIL is released while
-    rendering. Ctrl-C raises ``KeyboardInterrupt`` once the tiles
-    being rendered are done. ``progress``, when given, is called on the calling thread with
-    the fraction done (0 to 1, ending with 1.0), at most about ten times a second; an exception
-    it raises stops the render and is raised here.
+    ``RuntimeWarning`` saying how many and where the first was.
+
+    The GIL is released while rendering. Ctrl-C raises ``KeyboardInterrupt`` once the tiles
+    being rendered are done (when called from the main thread: Python delivers signals only
+    there). ``progress``, when given, is called on the calling thread with the fraction done
+    (0 to 1, ending with 1.0), at most about ten times a second; an exception it raises stops
+    the render and is raised here.
 
     >>> scene = glint.scene_from_dict(BALL)
     >>> layers = glint.render(scene, width=8, height=8, integrator="path", features=True)

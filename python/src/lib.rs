@@ -16,8 +16,8 @@ use std::time::Duration;
 
 use glint_io::{Diagnostic, ImageWriteError, LoadedScene};
 use glint_render::{
-    Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings,
-    RenderStats, Vec3,
+    Background, Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderError,
+    RenderSettings, RenderStats, Vec3,
 };
 use numpy::ndarray::{Array2, Array3, ArrayView2, ArrayView3};
 use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
@@ -90,6 +90,8 @@ struct PyScene {
     source: Source,
     /// Made absolute at load time, for loading again in another process.
     reload: Source,
+    /// The background that replaced the scene's, if one did.
+    background: Option<[f32; 3]>,
     warnings: Vec<Diagnostic>,
 }
 
@@ -117,15 +119,20 @@ impl PyScene {
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py>> {
         let restore = py.import("glint._glint")?.getattr("_restore")?;
         let arguments = match &self.reload {
-            Source::File(path) => (path_string(path)?, None),
-            Source::Text { text, path } => (path_string(path)?, Some(text.clone())),
+            Source::File(path) => (path_string(path)?, None, self.background),
+            Source::Text { text, path } => {
+                (path_string(path)?, Some(text.clone()), self.background)
+            }
         };
         Ok((restore, arguments))
     }
 }
 
-/// What `Scene.__reduce__` returns: `_restore` and its arguments (path, text).
-type Reduced<'py> = (Bound<'py, PyAny>, (String, Option<String>));
+/// What `Scene.__reduce__` returns: `_restore` and its arguments (path, text, background).
+type Reduced<'py> = (
+    Bound<'py, PyAny>,
+    (String, Option<String>, Option<[f32; 3]>),
+);
 
 fn path_string(path: &Path) -> PyResult<String> {
     path.to_str().map(str::to_owned).ok_or_else(|| {
@@ -133,12 +140,26 @@ fn path_string(path: &Path) -> PyResult<String> {
     })
 }
 
-/// Loads and builds a scene with the GIL released.
-fn load(py: Python<'_>, source: Source) -> PyResult<PyScene> {
+/// Loads and builds a scene with the GIL released; `background` replaces the scene's (the
+/// CLI's `--background`).
+fn load(py: Python<'_>, source: Source, background: Option<[f32; 3]>) -> PyResult<PyScene> {
+    if let Some(rgb) = background {
+        if rgb.iter().any(|c| !c.is_finite() || *c < 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "background components must be finite and >= 0, not {rgb:?}"
+            )));
+        }
+    }
     let loaded = py
         .detach(|| source.load())
         .map_err(|error| scene_error(py, error))?;
-    let LoadedScene { parts, warnings } = loaded;
+    let LoadedScene {
+        mut parts,
+        warnings,
+    } = loaded;
+    if let Some([r, g, b]) = background {
+        parts.background = Background::Color(Color::new(r, g, b));
+    }
     let scene = py.detach(|| glint_render::Scene::new(parts));
     let reload = match &source {
         Source::File(path) => Source::File(std::path::absolute(path)?),
@@ -151,6 +172,7 @@ fn load(py: Python<'_>, source: Source) -> PyResult<PyScene> {
         scene,
         source,
         reload,
+        background,
         warnings,
     })
 }
@@ -158,23 +180,35 @@ fn load(py: Python<'_>, source: Source) -> PyResult<PyScene> {
 /// Loads the scene file at `path` (XML or JSON). Warnings are returned in `Scene.warnings`
 /// for the caller to issue.
 #[pyfunction]
-fn load_scene(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
-    load(py, Source::File(path))
+#[pyo3(signature = (path, background=None))]
+fn load_scene(py: Python<'_>, path: PathBuf, background: Option<[f32; 3]>) -> PyResult<PyScene> {
+    load(py, Source::File(path), background)
 }
 
 /// Loads a scene from its text; `path` names it in diagnostics and locates its assets.
 #[pyfunction]
-fn load_scene_text(py: Python<'_>, text: String, path: PathBuf) -> PyResult<PyScene> {
-    load(py, Source::Text { text, path })
+#[pyo3(signature = (text, path, background=None))]
+fn load_scene_text(
+    py: Python<'_>,
+    text: String,
+    path: PathBuf,
+    background: Option<[f32; 3]>,
+) -> PyResult<PyScene> {
+    load(py, Source::Text { text, path }, background)
 }
 
 /// Unpickles a `Scene`: loads it again from where it came from.
 #[pyfunction]
-#[pyo3(signature = (path, text=None))]
-fn _restore(py: Python<'_>, path: PathBuf, text: Option<String>) -> PyResult<PyScene> {
+#[pyo3(signature = (path, text=None, background=None))]
+fn _restore(
+    py: Python<'_>,
+    path: PathBuf,
+    text: Option<String>,
+    background: Option<[f32; 3]>,
+) -> PyResult<PyScene> {
     match text {
-        None => load(py, Source::File(path)),
-        Some(text) => load(py, Source::Text { text, path }),
+        None => load(py, Source::File(path), background),
+        Some(text) => load(py, Source::Text { text, path }, background),
     }
 }
 

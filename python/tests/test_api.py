@@ -193,6 +193,21 @@ def test_a_scene_pickles_as_its_source_and_renders_the_same(tmp_path, spheres):
     assert repr(spheres) == f'<glint.Scene "{THREE_SPHERES}">'
 
 
+def test_background_replaces_the_scenes_and_survives_pickling():
+    grey = glint.scene_from_dict(glint.BALL, background=(0.5, 0.25, 0))
+    corner = glint.render(grey, width=8, height=8)[0, 0]
+    assert corner.tolist() == [0.5, 0.25, 0.0]
+    again = pickle.loads(pickle.dumps(grey))
+    assert glint.render(again, width=8, height=8)[0, 0].tolist() == [0.5, 0.25, 0.0]
+    plain = glint.render(glint.scene_from_dict(glint.BALL), width=8, height=8)[0, 0]
+    assert np.allclose(plain, 0.2)  # the scene's own bgColor
+    for bad in [(-1, 0, 0), (float("nan"), 0, 0)]:
+        with pytest.raises(ValueError, match="background"):
+            glint.scene_from_dict(glint.BALL, background=bad)
+    with pytest.raises(ValueError):
+        glint.load_scene(THREE_SPHERES, background=(1, 2))
+
+
 def test_to_srgb8_known_values():
     linear = np.array([[[0.0, 0.18, 1.0], [-1.0, np.nan, 1e9], [0.0031308, 0.5, 0.2158605]]])
     assert glint.to_srgb8(linear).tolist() == [[[0, 118, 255], [0, 0, 255], [10, 188, 128]]]

@@ -20,6 +20,7 @@ def bits(array: np.ndarray) -> np.ndarray:
     "integrator, spp, seed, extra",
     [
         ("course", 9, 0, {}),
+        ("course", 4, 0, {"background": (0.2, 0.2, 0.2)}),
         ("course", 4, 7, {"max_depth": 2}),
         ("path", 8, 3, {}),
         ("path", 5, 12, {"aspect": 1.25, "max_depth": 3}),
@@ -36,11 +37,15 @@ def test_render_returns_the_cli_exr_pixels(cli, tmp_path, integrator, spp, seed,
         command += ["-k", str(extra["max_depth"])]
     if "aspect" in extra:
         command += ["-a", str(extra["aspect"])]
+    background = extra.pop("background", None)
+    if background is not None:
+        command += ["--background", ",".join(str(c) for c in background)]
     subprocess.run(command, check=True, capture_output=True)
     written = read_exr(output)
 
+    scene = glint.load_scene(THREE_SPHERES, background=background)
     layers = glint.render(
-        glint.load_scene(THREE_SPHERES),
+        scene,
         width=width,
         height=height,
         spp=spp,
@@ -55,7 +60,7 @@ def test_render_returns_the_cli_exr_pixels(cli, tmp_path, integrator, spp, seed,
     assert np.array_equal(bits(layers["depth"]), bits(written["depth.Y"]))
     # And the beauty alone is the same without the feature layers.
     beauty = glint.render(
-        glint.load_scene(THREE_SPHERES),
+        scene,
         width=width,
         height=height,
         spp=spp,
