@@ -22,18 +22,18 @@ LONG = dict(width=512, height=512, spp=256, integrator="path", threads=2)
 def test_progress_rises_to_one_and_is_throttled():
     scene = glint.load_scene(THREE_SPHERES)
     seen: list[tuple[float, float]] = []
+    threads = set()
+
+    def progress(fraction: float) -> None:
+        threads.add(threading.get_ident())
+        seen.append((time.perf_counter(), fraction))
+
     start = time.perf_counter()
-    glint.render(
-        scene,
-        width=160,
-        height=160,
-        spp=16,
-        integrator="path",
-        progress=lambda f: seen.append((time.perf_counter(), f)),
-    )
+    glint.render(scene, width=160, height=160, spp=16, integrator="path", progress=progress)
     elapsed = time.perf_counter() - start
     fractions = [f for _, f in seen]
     assert fractions[-1] == 1.0
+    assert threads == {threading.get_ident()}, "called on the caller's thread only"
     assert fractions == sorted(fractions)
     assert all(0.0 <= f <= 1.0 for f in fractions)
     assert len(set(fractions)) == len(fractions), "each report says something new"
