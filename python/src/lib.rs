@@ -56,7 +56,7 @@ const MAX_DEPTH: u32 = 100;
 const MAX_THREADS: usize = 1024;
 
 /// Where a scene came from, so that it can be loaded again when unpickled (on a Dask worker).
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 enum Source {
     File(PathBuf),
     Text { text: String, path: PathBuf },
@@ -75,6 +75,13 @@ impl Source {
             Source::File(path) | Source::Text { path, .. } => path,
         }
     }
+
+    fn text(&self) -> Option<&str> {
+        match self {
+            Source::File(_) => None,
+            Source::Text { text, .. } => Some(text),
+        }
+    }
 }
 
 /// A loaded scene with its acceleration structure built, ready to render. Make one with
@@ -88,8 +95,8 @@ struct PyScene {
     scene: glint_render::Scene,
     /// As given: names the scene in diagnostics and `repr`.
     source: Source,
-    /// Made absolute at load time, for loading again in another process.
-    reload: Source,
+    /// The source's path made absolute at load time, for loading again in another process.
+    absolute_path: PathBuf,
     /// The background that replaced the scene's, if one did.
     background: Option<[f32; 3]>,
     warnings: Vec<Diagnostic>,
@@ -118,13 +125,9 @@ impl PyScene {
 
     fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py>> {
         let restore = py.import("glint._glint")?.getattr("_restore")?;
-        let arguments = match &self.reload {
-            Source::File(path) => (path_string(path)?, None, self.background),
-            Source::Text { text, path } => {
-                (path_string(path)?, Some(text.clone()), self.background)
-            }
-        };
-        Ok((restore, arguments))
+        let path = path_string(&self.absolute_path)?;
+        let text = self.source.text().map(str::to_owned);
+        Ok((restore, (path, text, self.background)))
     }
 }
 
@@ -161,17 +164,11 @@ fn load(py: Python<'_>, source: Source, background: Option<[f32; 3]>) -> PyResul
         parts.background = Background::Color(Color::new(r, g, b));
     }
     let scene = py.detach(|| glint_render::Scene::new(parts));
-    let reload = match &source {
-        Source::File(path) => Source::File(std::path::absolute(path)?),
-        Source::Text { text, path } => Source::Text {
-            text: text.clone(),
-            path: std::path::absolute(path)?,
-        },
-    };
+    let absolute_path = std::path::absolute(source.name())?;
     Ok(PyScene {
         scene,
         source,
-        reload,
+        absolute_path,
         background,
         warnings,
     })
