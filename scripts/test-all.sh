@@ -12,7 +12,7 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 
 # Front-end suites, each a script with `install` and `test` subcommands.
-SUITES=()
+SUITES=(python)
 
 install=1
 if [ "${1:-}" = "--no-install" ]; then
