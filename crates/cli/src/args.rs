@@ -20,7 +20,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
-use glint_render::{Color, IntegratorKind, RenderSettings};
+use glint_render::{Color, IntegratorKind, RenderSettings, SplitMethod};
 
 /// Largest accepted image side. Pixel indices are computed in `u32` in places, and a bigger
 /// image would not fit in memory anyway.
@@ -145,9 +145,16 @@ pub struct Options {
     #[arg(short = 'd', long, value_name = "DIST", help_heading = COURSE_NO_EFFECT)]
     pub depth: Option<f32>,
 
-    /// BVH split method (glint always builds a binned-SAH BVH).
-    #[arg(short = 's', long, value_name = "METHOD", help_heading = COURSE_NO_EFFECT)]
-    pub split: Option<String>,
+    /// How the BVH splits: objectMedian or spatialMedian (the course's lecture), or sah
+    /// (surface area heuristic, fastest to trace). The image is the same with any method.
+    #[arg(short = 's', long, value_name = "METHOD", default_value = "sah",
+          value_parser = parse_split)]
+    pub split: SplitMethod,
+
+    /// After the render, print the BVH's build time, nodes, depth, SAH cost and the nodes a
+    /// camera ray visits (a separate counting pass).
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub stats: bool,
 
     /// Preview window width (glint has no preview window).
     #[arg(short = 'x', long, value_name = "PIXELS", help_heading = COURSE_NO_EFFECT)]
@@ -223,6 +230,17 @@ pub fn parse_rgb(text: &str) -> Result<Rgb, String> {
     Ok(Rgb(rgb))
 }
 
+/// Parses `--split`: a method's name (any letter case).
+pub fn parse_split(text: &str) -> Result<SplitMethod, String> {
+    SplitMethod::ALL
+        .into_iter()
+        .find(|m| m.name().eq_ignore_ascii_case(text.trim()))
+        .ok_or_else(|| {
+            let names: Vec<&str> = SplitMethod::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown split method; the methods are {}", names.join(", "))
+        })
+}
+
 /// Parses `--aspect`: a finite number > 0.
 pub fn parse_aspect(text: &str) -> Result<f32, String> {
     let value: f32 = text
@@ -258,6 +276,10 @@ pub struct Job {
     pub threads: usize,
     pub background: Option<Color>,
     pub verbose: bool,
+    /// How the scene's BVHs split (`-s`).
+    pub split: SplitMethod,
+    /// Print the BVH statistics after the render (`--stats`).
+    pub stats: bool,
     /// Notes about accepted options that have no effect, printed before rendering.
     pub notes: Vec<String>,
 }
@@ -301,11 +323,6 @@ impl Options {
                 "--depth {depth} has no effect: glint has no depth of field yet"
             ));
         }
-        if let Some(split) = &self.split {
-            notes.push(format!(
-                "--split {split} has no effect: glint always builds a binned-SAH BVH"
-            ));
-        }
         if self.winwidth.is_some() || self.winheight.is_some() {
             notes.push("--winwidth/--winheight have no effect: glint has no preview window".into());
         }
@@ -339,6 +356,8 @@ impl Options {
                 .map_or(available_threads.max(1), |n| n as usize),
             background: self.background.map(Rgb::to_color),
             verbose: self.verbose,
+            split: self.split,
+            stats: self.stats,
             notes,
         })
     }
@@ -484,28 +503,28 @@ mod tests {
 
     #[test]
     fn course_options_without_effect_leave_notes() {
-        let job = job(&[
-            "-i",
-            "s.xml",
-            "-d",
-            "3",
-            "-s",
-            "spatialMedian",
-            "-x",
-            "300",
-            "-r",
-            "8",
-        ])
-        .unwrap();
-        assert_eq!(job.notes.len(), 4, "{:?}", job.notes);
+        let job = job(&["-i", "s.xml", "-d", "3", "-x", "300", "-r", "8"]).unwrap();
+        assert_eq!(job.notes.len(), 3, "{:?}", job.notes);
         assert!(job.notes[0].starts_with("--depth 3 "), "{:?}", job.notes);
+        assert!(job.notes[1].starts_with("--winwidth"), "{:?}", job.notes);
+        assert!(job.notes[2].contains("2x2"), "{:?}", job.notes);
+    }
+
+    #[test]
+    fn split_methods_by_name_sah_by_default() {
+        assert_eq!(job(&["-i", "s.xml"]).unwrap().split, SplitMethod::Sah);
+        for (name, method) in [
+            ("objectMedian", SplitMethod::ObjectMedian),
+            ("spatialmedian", SplitMethod::SpatialMedian),
+            ("SAH", SplitMethod::Sah),
+        ] {
+            assert_eq!(job(&["-i", "s.xml", "-s", name]).unwrap().split, method);
+        }
+        let error = job(&["-i", "s.xml", "--split", "octree"]).unwrap_err();
         assert!(
-            job.notes[1].starts_with("--split spatialMedian "),
-            "{:?}",
-            job.notes
+            error.contains("objectMedian, spatialMedian, sah"),
+            "{error}"
         );
-        assert!(job.notes[2].starts_with("--winwidth"), "{:?}", job.notes);
-        assert!(job.notes[3].contains("2x2"), "{:?}", job.notes);
     }
 
     #[test]

@@ -8,7 +8,9 @@ use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::time::{Duration, Instant};
 
 use glint_io::{Diagnostic, ImageWriteError, SceneError};
-use glint_render::{Background, Progress, RenderError, RenderStats, Scene};
+use glint_render::{
+    Background, Progress, RenderError, RenderSettings, RenderStats, Scene, SceneOptions,
+};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::{Job, UsageError};
@@ -194,7 +196,8 @@ pub fn run(
     if let Some(color) = job.background {
         parts.background = Background::Color(color);
     }
-    let scene = pool.install(|| Scene::new(parts));
+    let options = SceneOptions { split: job.split };
+    let scene = pool.install(|| Scene::with_options(parts, options));
     let load_time = load_start.elapsed();
 
     let settings = &job.settings;
@@ -202,10 +205,11 @@ pub fn run(
         let depth = format!("depth {}", settings.max_depth());
         let _ = writeln!(
             err,
-            "loaded {} in {:.2} s\nrendering {}x{}, {} samples per pixel, {depth}, seed {}, {} \
-             integrator, {} -> {}",
+            "loaded {} in {:.2} s ({} BVH)\nrendering {}x{}, {} samples per pixel, {depth}, seed \
+             {}, {} integrator, {} -> {}",
             job.scene.display(),
             load_time.as_secs_f64(),
+            job.split.name(),
             settings.width,
             settings.height,
             settings.samples_per_pixel(),
@@ -261,11 +265,38 @@ pub fn run(
     write.map_err(Failure::Write)?;
 
     let _ = writeln!(err, "{}", closing_line(job, &stats, render_time));
+    if job.stats {
+        let _ = write!(err, "{}", pool.install(|| bvh_stats(&scene, settings)));
+    }
     Ok(Summary {
         stats,
         render_time,
         threads: job.threads,
     })
+}
+
+/// `--stats`' BVH figures: how the split method shaped the tree and what it costs the camera
+/// rays (measured in a separate counting pass, so the render itself counted nothing).
+pub fn bvh_stats(scene: &Scene, settings: &RenderSettings) -> String {
+    let bvh = scene.bvh_stats();
+    let walk = glint_render::measure_traversal(scene, settings);
+    format!(
+        "BVH ({}): built in {:.1} ms; {} tree{}, {} nodes, {} leaves, depth {}, SAH cost {:.2}\n\
+         BVH traversal: {:.2} nodes and {:.2} triangle blocks per camera ray ({} rays through \
+         pixel centres, {:.0}% hit)\n",
+        bvh.split.name(),
+        bvh.build_time.as_secs_f64() * 1e3,
+        bvh.trees,
+        plural(bvh.trees as u64),
+        bvh.nodes,
+        bvh.leaves,
+        bvh.depth,
+        bvh.sah_cost,
+        walk.nodes_per_ray(),
+        walk.blocks_per_ray(),
+        walk.rays,
+        100.0 * walk.hits as f64 / walk.rays.max(1) as f64,
+    )
 }
 
 fn new_progress_bar(width: u32, height: u32) -> ProgressBar {
@@ -372,6 +403,8 @@ mod tests {
             threads: 2,
             background: None,
             verbose: false,
+            split: glint_render::SplitMethod::Sah,
+            stats: false,
             notes: Vec::new(),
         };
         let stats = RenderStats {

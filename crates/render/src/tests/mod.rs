@@ -10,3 +10,4 @@ mod path_known_answers;
 mod path_no_allocation;
 mod path_preliminary_hits;
 mod pipeline;
+mod split_methods;
