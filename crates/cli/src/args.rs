@@ -141,9 +141,14 @@ pub struct Options {
     #[arg(short = '?', long, action = ArgAction::Help)]
     pub help: Option<bool>,
 
-    /// Depth-of-field focus distance (glint has no depth of field yet).
-    #[arg(short = 'd', long, value_name = "DIST", help_heading = COURSE_NO_EFFECT)]
+    /// Depth of field: focus at DIST along the view direction (0: off, the course's pinhole).
+    #[arg(short = 'd', long, value_name = "DIST", value_parser = parse_distance)]
     pub depth: Option<f32>,
+
+    /// Lens radius for -d, in scene units [default: 1/50 of the width the image covers at
+    /// the focus distance].
+    #[arg(long, value_name = "R", value_parser = parse_distance, requires = "depth")]
+    pub aperture: Option<f32>,
 
     /// How the BVH splits: objectMedian or spatialMedian (the course's lecture), or sah
     /// (surface area heuristic, fastest to trace). The image is the same with any method.
@@ -230,6 +235,18 @@ pub fn parse_rgb(text: &str) -> Result<Rgb, String> {
     Ok(Rgb(rgb))
 }
 
+/// Parses `--depth` and `--aperture`: a finite number >= 0.
+pub fn parse_distance(text: &str) -> Result<f32, String> {
+    let value: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if !value.is_finite() || value < 0.0 {
+        return Err(format!("expected a finite number >= 0, got {text}"));
+    }
+    Ok(value)
+}
+
 /// Parses `--split`: a method's name (any letter case).
 pub fn parse_split(text: &str) -> Result<SplitMethod, String> {
     SplitMethod::ALL
@@ -278,6 +295,9 @@ pub struct Job {
     pub verbose: bool,
     /// How the scene's BVHs split (`-s`).
     pub split: SplitMethod,
+    /// Depth of field (`-d`, `--aperture`): the focus distance and the lens radius, `None`
+    /// for the default radius (which depends on the scene's camera).
+    pub depth_of_field: Option<(f32, Option<f32>)>,
     /// Print the BVH statistics after the render (`--stats`).
     pub stats: bool,
     /// Notes about accepted options that have no effect, printed before rendering.
@@ -318,11 +338,6 @@ impl Options {
         check_output_extension(&output)?;
 
         let mut notes = Vec::new();
-        if let Some(depth) = self.depth {
-            notes.push(format!(
-                "--depth {depth} has no effect: glint has no depth of field yet"
-            ));
-        }
         if self.winwidth.is_some() || self.winheight.is_some() {
             notes.push("--winwidth/--winheight have no effect: glint has no preview window".into());
         }
@@ -357,6 +372,10 @@ impl Options {
             background: self.background.map(Rgb::to_color),
             verbose: self.verbose,
             split: self.split,
+            depth_of_field: self
+                .depth
+                .filter(|&distance| distance > 0.0)
+                .map(|distance| (distance, self.aperture)),
             stats: self.stats,
             notes,
         })
@@ -504,10 +523,36 @@ mod tests {
     #[test]
     fn course_options_without_effect_leave_notes() {
         let job = job(&["-i", "s.xml", "-d", "3", "-x", "300", "-r", "8"]).unwrap();
-        assert_eq!(job.notes.len(), 3, "{:?}", job.notes);
-        assert!(job.notes[0].starts_with("--depth 3 "), "{:?}", job.notes);
-        assert!(job.notes[1].starts_with("--winwidth"), "{:?}", job.notes);
-        assert!(job.notes[2].contains("2x2"), "{:?}", job.notes);
+        assert_eq!(job.notes.len(), 2, "{:?}", job.notes);
+        assert!(job.notes[0].starts_with("--winwidth"), "{:?}", job.notes);
+        assert!(job.notes[1].contains("2x2"), "{:?}", job.notes);
+    }
+
+    #[test]
+    fn depth_of_field_and_aperture() {
+        assert_eq!(job(&["-i", "s.xml"]).unwrap().depth_of_field, None);
+        assert_eq!(
+            job(&["-i", "s.xml", "-d", "0"]).unwrap().depth_of_field,
+            None
+        );
+        assert_eq!(
+            job(&["-i", "s.xml", "-d", "3"]).unwrap().depth_of_field,
+            Some((3.0, None))
+        );
+        assert_eq!(
+            job(&["-i", "s.xml", "--depth", "3", "--aperture", "0.25"])
+                .unwrap()
+                .depth_of_field,
+            Some((3.0, Some(0.25)))
+        );
+        for args in [
+            &["-i", "s.xml", "-d", "-1"][..],
+            &["-i", "s.xml", "-d", "inf"],
+            &["-i", "s.xml", "-d", "3", "--aperture", "x"],
+            &["-i", "s.xml", "--aperture", "0.2"],
+        ] {
+            assert!(job(args).is_err(), "{args:?} was accepted");
+        }
     }
 
     #[test]

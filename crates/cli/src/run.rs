@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use glint_io::{Diagnostic, ImageWriteError, SceneError};
 use glint_render::{
-    Background, Progress, RenderError, RenderSettings, RenderStats, Scene, SceneOptions,
+    Background, Progress, RenderError, RenderSettings, RenderStats, Scene, SceneOptions, ThinLens,
 };
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
@@ -196,6 +196,13 @@ pub fn run(
     if let Some(color) = job.background {
         parts.background = Background::Color(color);
     }
+    if let Some((focus_distance, radius)) = job.depth_of_field {
+        let lens = ThinLens::with_default_radius(&parts.camera, focus_distance);
+        parts.camera.lens = Some(ThinLens {
+            radius: radius.unwrap_or(lens.radius),
+            ..lens
+        });
+    }
     let options = SceneOptions { split: job.split };
     let scene = pool.install(|| Scene::with_options(parts, options));
     let load_time = load_start.elapsed();
@@ -206,7 +213,7 @@ pub fn run(
         let _ = writeln!(
             err,
             "loaded {} in {:.2} s ({} BVH)\nrendering {}x{}, {} samples per pixel, {depth}, seed \
-             {}, {} integrator, {} -> {}",
+             {}, {} integrator{}, {} -> {}",
             job.scene.display(),
             load_time.as_secs_f64(),
             job.split.name(),
@@ -215,6 +222,10 @@ pub fn run(
             settings.samples_per_pixel(),
             settings.seed,
             settings.integrator.name(),
+            scene.camera.lens.map_or(String::new(), |lens| format!(
+                ", focused at {} with a lens of radius {}",
+                lens.focus_distance, lens.radius
+            )),
             threads_text(job.threads),
             job.output.display()
         );
@@ -404,6 +415,7 @@ mod tests {
             background: None,
             verbose: false,
             split: glint_render::SplitMethod::Sah,
+            depth_of_field: None,
             stats: false,
             notes: Vec::new(),
         };

@@ -85,7 +85,7 @@ mod tests;
 
 // The scene a loader builds, in plain data.
 pub use accel::build::SplitMethod;
-pub use camera::{Camera, Projection};
+pub use camera::{Camera, Projection, ThinLens};
 pub use geometry::{Aabb, Shape};
 pub use light::Light;
 pub use material::{Material, MaterialId};
