@@ -161,16 +161,21 @@ pub struct Options {
     #[arg(long, action = ArgAction::SetTrue)]
     pub stats: bool,
 
-    /// Preview window width (glint has no preview window).
-    #[arg(short = 'x', long, value_name = "PIXELS", help_heading = COURSE_NO_EFFECT)]
+    /// Preview window width: show the image as it renders [default with -y: by the image's
+    /// aspect ratio].
+    #[arg(short = 'x', long, value_name = "PIXELS",
+          value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub winwidth: Option<u32>,
 
-    /// Preview window height (glint has no preview window).
-    #[arg(short = 'y', long, value_name = "PIXELS", help_heading = COURSE_NO_EFFECT)]
+    /// Preview window height [default with -x: by the image's aspect ratio].
+    #[arg(short = 'y', long, value_name = "PIXELS",
+          value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub winheight: Option<u32>,
-}
 
-const COURSE_NO_EFFECT: &str = "Course options accepted for its scripts, with no effect";
+    /// Close the preview window when the render ends instead of waiting for the user.
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub preview_close: bool,
+}
 
 /// `--integrator` / `--shader` values.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -300,6 +305,10 @@ pub struct Job {
     pub depth_of_field: Option<(f32, Option<f32>)>,
     /// Print the BVH statistics after the render (`--stats`).
     pub stats: bool,
+    /// The preview window's size (`-x`, `-y`), if one was asked for.
+    pub preview: Option<(u32, u32)>,
+    /// Close the preview when the render ends (`--preview-close`).
+    pub preview_close: bool,
     /// Notes about accepted options that have no effect, printed before rendering.
     pub notes: Vec<String>,
 }
@@ -338,9 +347,16 @@ impl Options {
         check_output_extension(&output)?;
 
         let mut notes = Vec::new();
-        if self.winwidth.is_some() || self.winheight.is_some() {
-            notes.push("--winwidth/--winheight have no effect: glint has no preview window".into());
-        }
+        // One side given: the other keeps the image's aspect ratio.
+        let scaled = |side: u32, from: u32, to: u32| {
+            ((side as u64 * to as u64).div_ceil(from as u64)).clamp(1, MAX_SIDE as u64) as u32
+        };
+        let preview = match (self.winwidth, self.winheight) {
+            (Some(w), Some(h)) => Some((w, h)),
+            (Some(w), None) => Some((w, scaled(w, self.width, self.height))),
+            (None, Some(h)) => Some((scaled(h, self.height, self.width), h)),
+            (None, None) => None,
+        };
         let settings = RenderSettings {
             width: self.width,
             height: self.height,
@@ -377,6 +393,8 @@ impl Options {
                 .filter(|&distance| distance > 0.0)
                 .map(|distance| (distance, self.aperture)),
             stats: self.stats,
+            preview,
+            preview_close: self.preview_close,
             notes,
         })
     }
@@ -521,11 +539,35 @@ mod tests {
     }
 
     #[test]
-    fn course_options_without_effect_leave_notes() {
-        let job = job(&["-i", "s.xml", "-d", "3", "-x", "300", "-r", "8"]).unwrap();
-        assert_eq!(job.notes.len(), 2, "{:?}", job.notes);
-        assert!(job.notes[0].starts_with("--winwidth"), "{:?}", job.notes);
-        assert!(job.notes[1].contains("2x2"), "{:?}", job.notes);
+    fn a_grid_that_is_not_square_leaves_a_note() {
+        let job = job(&["-i", "s.xml", "-r", "8"]).unwrap();
+        assert_eq!(job.notes.len(), 1, "{:?}", job.notes);
+        assert!(job.notes[0].contains("2x2"), "{:?}", job.notes);
+    }
+
+    #[test]
+    fn preview_window_size() {
+        let size = |args: &[&str]| job(args).unwrap().preview;
+        assert_eq!(size(&["-i", "s.xml"]), None);
+        assert_eq!(
+            size(&["-i", "s.xml", "-x", "300", "-y", "200"]),
+            Some((300, 200))
+        );
+        assert_eq!(
+            size(&["-i", "s.xml", "-w", "200", "-h", "100", "-x", "401"]),
+            Some((401, 201))
+        );
+        assert_eq!(
+            size(&["-i", "s.xml", "-w", "200", "-h", "100", "--winheight", "50"]),
+            Some((100, 50))
+        );
+        assert!(!job(&["-i", "s.xml", "-x", "9"]).unwrap().preview_close);
+        assert!(
+            job(&["-i", "s.xml", "-x", "9", "--preview-close"])
+                .unwrap()
+                .preview_close
+        );
+        assert!(job(&["-i", "s.xml", "-x", "0"]).is_err());
     }
 
     #[test]

@@ -14,6 +14,7 @@ use glint_render::{
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::{Job, UsageError};
+use crate::preview::TileSink;
 
 /// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).
 pub const EXIT_INTERRUPTED: u8 = 130;
@@ -163,13 +164,15 @@ pub struct Summary {
 }
 
 /// Runs `job`, printing notes, warnings, the progress bar (only if `progress_bar`) and the
-/// closing line to `err`. Errors are returned, not printed: `main` prints them and exits.
-/// No image is written unless the whole run succeeds.
+/// closing line to `err`, and handing each finished tile to `preview` if there is one.
+/// Errors are returned, not printed: `main` prints them and exits. No image is written unless
+/// the whole run succeeds.
 pub fn run(
     job: &Job,
     interrupt: &Interrupt,
     err: &mut dyn Write,
     progress_bar: bool,
+    preview: Option<&TileSink>,
 ) -> Result<Summary, Failure> {
     // Write errors on stderr are ignored throughout: a closed stderr must not fail a render.
     for note in &job.notes {
@@ -233,6 +236,9 @@ pub fn run(
 
     let bar = progress_bar.then(|| new_progress_bar(settings.width, settings.height));
     let progress = |report: &Progress| {
+        if let Some(preview) = preview {
+            preview.send(report);
+        }
         if let Some(bar) = &bar {
             bar.set_length(report.tiles_total as u64);
             bar.inc(1);
@@ -417,6 +423,8 @@ mod tests {
             split: glint_render::SplitMethod::Sah,
             depth_of_field: None,
             stats: false,
+            preview: None,
+            preview_close: false,
             notes: Vec::new(),
         };
         let stats = RenderStats {
