@@ -42,7 +42,8 @@ pub struct SceneParts {
 /// How `Scene::with_options` builds the acceleration structures.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub struct SceneOptions {
-    /// How the bottom-level BVHs choose their splits (`-s`). Any method gives the same image.
+    /// How the bottom-level BVHs (one per geometry) choose their splits (`-s`); the top level
+    /// over instances stays binned SAH. Any method gives the same image.
     pub split: SplitMethod,
 }
 
