@@ -26,8 +26,8 @@ use crate::accel::wide::{
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
 
-/// Below this depth the SAH chooses splits; deeper, median splits by count finish the job in
-/// at most log₂(2²⁷) more levels.
+/// Below this depth the SAH (or the spatial median) chooses splits; deeper, median splits by
+/// count finish the job in at most log₂(2²⁷) more levels.
 const SAH_DEPTH: usize = 20;
 const BINS: usize = 32;
 /// Subtrees with more primitives than this are built as parallel tasks.
@@ -42,7 +42,8 @@ pub enum SplitMethod {
     ObjectMedian,
     /// The course's spatial median: the range split about the middle of its box along axis
     /// x, y, z in turn, by centroid; where that leaves one side empty, the next axis, and where
-    /// all three do, the object median. Leaves as for `ObjectMedian`.
+    /// all three do, the object median (and below wide depth 20, as for the SAH, the object
+    /// median always, which bounds the depth). Leaves as for `ObjectMedian`.
     SpatialMedian,
     /// Binned surface area heuristic with a block-aware leaf cost (the default: fastest to
     /// trace).
@@ -348,6 +349,11 @@ fn split_record(
     let mut sides = None;
     let mid = match (method, record.split) {
         (SplitMethod::ObjectMedian, _) => object_median(prims, record, record.level as usize % 3),
+        // Halving space need not halve the count (one far primitive beside a cluster): past
+        // the SAH depth the object median bounds the depth, as for the SAH.
+        (SplitMethod::SpatialMedian, _) if depth >= SAH_DEPTH => {
+            object_median(prims, record, record.level as usize % 3)
+        }
         (SplitMethod::SpatialMedian, _) => spatial_median(prims, record),
         (SplitMethod::Sah, Some(split)) => {
             // Partition, measuring both sides on the way.

@@ -156,3 +156,28 @@ fn methods_build_the_trees_they_describe() {
         );
     }
 }
+
+#[test]
+fn spatial_median_depth_stays_bounded_on_geometric_clusters() {
+    // Point-sized boxes at 2.1^-k on the x, y and z axes in turn: each spatial split, on the
+    // axis of its level, peels off exactly one of them (the next on that axis lies below the
+    // middle), so without a bound the wide tree would be some 60 levels deep, past what the
+    // traversal stack holds (`MAX_DEPTH`).
+    let shapes: Vec<Shape> = (0..420)
+        .map(|i| {
+            let mut p = [0.0f32; 3];
+            p[i % 3] = 2.1f32.powi(-((i / 3) as i32));
+            let p = Vec3::from_array(p);
+            Shape::Box { min: p, max: p }
+        })
+        .collect();
+    for method in SplitMethod::ALL {
+        let bvh = build_with(&shapes, method);
+        let stats = bvh.tree_stats();
+        assert!(
+            stats.depth <= crate::accel::wide::MAX_DEPTH,
+            "{}: {stats:?}",
+            method.name()
+        );
+    }
+}
