@@ -21,7 +21,7 @@ import numpy as np
 HERE = os.path.dirname(os.path.abspath(__file__))
 SHARED_BENCH = os.path.normpath(os.path.join(HERE, '..', '..', '..', 'shared', 'bench'))
 sys.path.insert(0, SHARED_BENCH)
-import make_cornell_ref as cornell  # noqa: E402  (the Cornell box's triangles and materials)
+import make_cornell_ref as cornell  # the Cornell box's triangles and materials
 
 # Must match crates/io/tests/path_thinlens.rs.
 FOCUS_DISTANCE = 3.3
@@ -50,11 +50,8 @@ def main():
         # from arrays), flat shaded like the course's triangles.
         path = os.path.join(tmp, name + '.obj')
         with open(path, 'w') as f:
-            for t in tris:
-                for p in t:
-                    f.write('v %.9g %.9g %.9g\n' % tuple(p))
-            for i in range(len(tris)):
-                f.write('f %d %d %d\n' % (3 * i + 1, 3 * i + 2, 3 * i + 3))
+            f.writelines(f'v {p[0]:.9g} {p[1]:.9g} {p[2]:.9g}\n' for t in tris for p in t)
+            f.writelines(f'f {3 * i + 1} {3 * i + 2} {3 * i + 3}\n' for i in range(len(tris)))
         shape = {'type': 'obj', 'filename': path, 'face_normals': True, 'bsdf': bsdf}
         if emitter is not None:
             shape['emitter'] = emitter
