@@ -347,6 +347,12 @@ impl Options {
         check_output_extension(&output)?;
 
         let mut notes = Vec::new();
+        if self.aperture.is_some() && self.depth == Some(0.0) {
+            return Err(UsageError(
+                "--aperture needs depth of field: give a focus distance -d greater than 0"
+                    .to_string(),
+            ));
+        }
         // One side given: the other keeps the image's aspect ratio.
         let scaled = |side: u32, from: u32, to: u32| {
             ((side as u64 * to as u64).div_ceil(from as u64)).clamp(1, MAX_SIDE as u64) as u32
@@ -592,6 +598,7 @@ mod tests {
             &["-i", "s.xml", "-d", "inf"],
             &["-i", "s.xml", "-d", "3", "--aperture", "x"],
             &["-i", "s.xml", "--aperture", "0.2"],
+            &["-i", "s.xml", "-d", "0", "--aperture", "0.2"],
         ] {
             assert!(job(args).is_err(), "{args:?} was accepted");
         }
