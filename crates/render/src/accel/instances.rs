@@ -324,7 +324,7 @@ pub struct PreliminaryHit {
 
 /// The bottom-level trees of a scene together (`Instances::tree_stats`).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct TreesStats {
+pub struct BottomLevelStats {
     /// Geometries with a wide BVH.
     pub trees: usize,
     /// Inner nodes and leaves over all of them.
@@ -413,8 +413,8 @@ impl Instances {
     }
 
     /// The bottom-level trees' shape, together.
-    pub fn tree_stats(&self) -> TreesStats {
-        let mut out = TreesStats::default();
+    pub fn tree_stats(&self) -> BottomLevelStats {
+        let mut out = BottomLevelStats::default();
         let mut weighted = 0.0f64;
         let mut weights = 0usize;
         for g in &self.geometries {
