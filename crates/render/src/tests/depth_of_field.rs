@@ -138,6 +138,7 @@ fn the_plane_in_focus_stays_sharp_and_a_nearer_one_blurs() {
     // over a disk of diameter 1, mixing black and white.
     let defocused = image(&checkerboard(10.0, Some(lens(5.0))));
     let blurred = mean_difference(&pinhole, &defocused);
+    println!("checkerboard: mean difference to the pinhole in focus {sharp:.2e}, out of focus {blurred:.3}");
     assert!(sharp < 2e-3, "in focus: mean difference {sharp}");
     assert!(blurred > 0.1, "out of focus: mean difference {blurred}");
 }
