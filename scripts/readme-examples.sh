@@ -40,7 +40,7 @@ mapfile -t commands < <(awk '/^```sh$/ {inside = 1; next} /^```$/ {inside = 0} i
 # Not run, with the reason; the first word of the command must still exist.
 not_run_reason() {
   case "$1" in
-    "cargo test --workspace"*) echo "the test suite itself (CI runs it)" ;;
+    "cargo test --workspace"* | scripts/test-all.sh*) echo "the test suite itself (CI runs it)" ;;
     *"-- bench table"*) echo "a benchmark of several minutes" ;;
     bench/embree_compare.sh*) echo "needs Embree 4 (see bench/README.md)" ;;
     bench/cornell_vs_mitsuba.py*) echo "needs Mitsuba 3 (see bench/README.md)" ;;

@@ -7,13 +7,13 @@
 # Suites: the Rust workspace (`cargo test --workspace`: unit, reference-image, corpus, Mitsuba,
 # software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh), every
 # README command in a fresh clone (scripts/readme-examples.sh), and each
-# front end's own script (`FOLDER/ci.sh install|test`, listed in SUITES below).
+# front end's own script (`ci.sh install|test`, listed in SUITES below).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$(pwd)
 
-# Front-end suites, each a script with `install` and `test` subcommands.
-SUITES=(python)
+# Suites beyond cargo, each a script with `install` and `test` subcommands.
+SUITES=(python/ci.sh crates/cli/preview-ci.sh)
 
 install=1
 if [ "${1:-}" = "--no-install" ]; then
@@ -35,8 +35,8 @@ fi
 
 if [ "$install" = 1 ]; then
   for suite in "${SUITES[@]}"; do
-    echo "== $suite: install"
-    "$suite/ci.sh" install
+    echo "== $suite install"
+    "$suite" install
   done
 fi
 
@@ -69,9 +69,9 @@ result[readme]=$(tail -n 1 "$logs/readme.log")
 [ "$status" = 0 ] || failed=1
 
 for suite in "${SUITES[@]}"; do
-  echo "== $suite: test"
+  echo "== $suite test"
   status=0
-  "$root/$suite/ci.sh" test 2>&1 | tee "$logs/suite.log" || status=$?
+  "$root/$suite" test 2>&1 | tee "$logs/suite.log" || status=$?
   result[$suite]="$(tail -n 1 "$logs/suite.log")$([ "$status" = 0 ] || echo " (exit $status)")"
   [ "$status" = 0 ] || failed=1
 done
@@ -79,7 +79,7 @@ done
 echo
 echo "== summary"
 for name in cargo same-images readme "${SUITES[@]}"; do
-  printf '%-12s %s\n' "$name" "${result[$name]}"
+  printf '%-26s %s\n' "$name" "${result[$name]}"
 done
 if [ "$failed" != 0 ]; then
   echo "FAILED" >&2

@@ -163,11 +163,11 @@ fn course_long_options_are_accepted() {
 }
 
 #[test]
-fn course_options_without_effect_are_accepted_with_a_note() {
+fn course_options_depth_split_and_window_take_effect() {
     let dir = scene_dir();
-    let output = glint_in(
-        dir.path(),
-        &[
+    // No display: the preview window cannot open, which must not stop the render.
+    let output = Command::new(GLINT)
+        .args([
             "-i",
             "scene.xml",
             "-o",
@@ -184,19 +184,30 @@ fn course_options_without_effect_are_accepted_with_a_note() {
             "640",
             "-y",
             "480",
-        ],
-    );
+        ])
+        .current_dir(dir.path())
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("cannot run glint");
     assert_exit(&output, 0);
     let text = stderr(&output);
-    assert!(text.contains("note: --depth 2.5 has no effect"), "{text}");
-    assert!(
-        text.contains("note: --split objectMedian has no effect"),
-        "{text}"
+    assert!(!text.contains("has no effect"), "{text}");
+    assert!(text.contains("warning: no preview window"), "{text}");
+    assert_eq!(read_png(&dir.path().join("o.png")).dimensions(), (4, 4));
+}
+
+#[test]
+fn an_unknown_split_method_is_a_usage_error_naming_the_methods() {
+    let dir = scene_dir();
+    let output = glint_in(
+        dir.path(),
+        &["-i", "scene.xml", "-o", "o.png", "-s", "kdtree"],
     );
-    assert!(
-        text.contains("note: --winwidth/--winheight have no effect"),
-        "{text}"
-    );
+    assert_exit(&output, 2);
+    let text = stderr(&output);
+    assert!(text.contains("objectMedian, spatialMedian, sah"), "{text}");
+    assert!(!dir.path().join("o.png").exists());
 }
 
 // ---------------------------------------------------------------------------------------------
