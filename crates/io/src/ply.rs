@@ -125,7 +125,8 @@ pub fn parse(bytes: &[u8]) -> Result<PlyMesh, PlyError> {
                 let (Some(x), Some(y), Some(z)) = (axis("x"), axis("y"), axis("z")) else {
                     return error("the vertex element has no x, y and z properties");
                 };
-                positions.reserve(element.count);
+                // A header may declare any count; reserve no more than the body could hold.
+                positions.reserve(element.count.min(body.len()));
                 let mut values = vec![0.0f64; element.properties.len()];
                 for index in 0..element.count {
                     for (slot, property) in values.iter_mut().zip(&element.properties) {
@@ -157,7 +158,7 @@ pub fn parse(bytes: &[u8]) -> Result<PlyMesh, PlyError> {
                     return error(format!("the {} element has no index list", element.name));
                 };
                 if !strips {
-                    triangles.reserve(element.count);
+                    triangles.reserve(element.count.min(body.len()));
                 }
                 for _ in 0..element.count {
                     for (k, property) in element.properties.iter().enumerate() {
