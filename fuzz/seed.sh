@@ -8,7 +8,12 @@ for target in xml json obj ply texture scene; do mkdir -p "$here/corpus/$target"
 find "$course" -name '*.xml' -size -200k -exec cp {} "$here/corpus/xml/" \;
 find "$course" -name '*.json' -size -200k -exec cp {} "$here/corpus/json/" \;
 find "$course" -name '*.xml' -size -200k -exec cp {} "$here/corpus/scene/" \;
-find "$course" -name '*.obj' -size -100k -exec cp {} "$here/corpus/obj/" \;
+find "$course" -name '*.obj' -size -200k -exec cp {} "$here/corpus/obj/" \;
+# The first 2,000 lines of the bigger course meshes (libFuzzer's inputs are small).
+for mesh in $(find "$course" -name '*.obj' -size +200k | head -3); do
+    head -n 2000 "$mesh" > "$here/corpus/obj/head-$(basename "$mesh")"
+done
+printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1/1/1 2/2/2 3/3/3\n' > "$here/corpus/obj/quad.obj"
 find "$course" -name '*.png' -size -64k -exec cp {} "$here/corpus/texture/" \;
 # PLY: the shared models when present, and two small hand-written ones.
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' > "$here/corpus/ply/ascii.ply"
