@@ -346,6 +346,22 @@ mod tests {
     }
 
     #[test]
+    fn repeated_warnings_are_kept_once() {
+        let text = "one\ntwo\n";
+        let mut diagnostics = Diagnostics::new(Path::new("s.xml"), text);
+        let at = Span { line: 2, column: 1 };
+        for _ in 0..3 {
+            diagnostics.warn(at, "same");
+        }
+        diagnostics.warn(at, "other");
+        diagnostics.warn(Span { line: 1, column: 1 }, "same");
+        let warnings = diagnostics.into_warnings();
+        assert_eq!(warnings.len(), 3);
+        assert_eq!(warnings[0].source_line(), Some("two"));
+        assert_eq!(warnings[2].source_line(), Some("one"));
+    }
+
+    #[test]
     fn suggestions_need_a_close_candidate() {
         assert_eq!(
             did_you_mean("Mirrored", ["Lambertian", "Mirror"]),
