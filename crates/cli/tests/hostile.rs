@@ -219,7 +219,7 @@ fn textured_scene(count: usize) -> String {
 // ---------------------------------------------------------------------------------------------
 // The nine failures of issue 9
 
-/// 1. Thousands of warnings on one long line: a capped, quick report, not gigabytes.
+/// Issue case 1: Thousands of warnings on one long line: a capped, quick report, not gigabytes.
 #[test]
 fn issue_1_thousands_of_warnings_on_one_line_are_capped() {
     let unused: String = (0..8000)
@@ -260,7 +260,7 @@ fn issue_1_thousands_of_warnings_on_one_line_are_capped() {
     assert!(text.len() < 8000 * 400, "{} bytes", text.len());
 }
 
-/// 2. A scene or a mesh that never ends (/dev/zero) is cut off at the size limit.
+/// Issue case 2: A scene or a mesh that never ends (/dev/zero) is cut off at the size limit.
 #[cfg(unix)]
 #[test]
 fn issue_2_endless_files_are_refused_at_the_size_limit() {
@@ -288,7 +288,7 @@ fn issue_2_endless_files_are_refused_at_the_size_limit() {
     assert!(text.contains("--max-file-size"), "{text}");
 }
 
-/// 3. An image too big for memory is refused before anything is loaded.
+/// Issue case 3: An image too big for memory is refused before anything is loaded.
 #[test]
 fn issue_3_a_huge_image_is_refused_up_front() {
     let case = Case::new().file("scene.xml", BASE_XML);
@@ -325,7 +325,7 @@ fn issue_3_a_huge_image_is_refused_up_front() {
     case.assert_nothing_written();
 }
 
-/// 4. A small PNG declaring 12000 x 12000 is refused from its header; entries naming the
+/// Issue case 4: A small PNG declaring 12000 x 12000 is refused from its header; entries naming the
 /// same file share it.
 #[test]
 fn issue_4_textures_declaring_huge_sizes_are_refused_from_their_header() {
@@ -344,7 +344,7 @@ fn issue_4_textures_declaring_huge_sizes_are_refused_from_their_header() {
     assert!(text.contains("--max-memory"), "{text}");
 }
 
-/// 5. Colours that overflow and sizes too large for f32 are located errors; negative colours
+/// Issue case 5: Colours that overflow and sizes too large for f32 are located errors; negative colours
 /// are located warnings; no pixel is ever NaN.
 #[test]
 fn issue_5_overflowing_numbers_are_refused_and_negative_colours_warned() {
@@ -386,7 +386,7 @@ fn issue_5_overflowing_numbers_are_refused_and_negative_colours_warned() {
     case.assert_refused_at("neg.xml", &["--strict"], "<diffuse>");
 }
 
-/// 6. JSON: comments and trailing commas are accepted; unquoted keys and single quotes not.
+/// Issue case 6: JSON: comments and trailing commas are accepted; unquoted keys and single quotes not.
 #[test]
 fn issue_6_json_extensions_beyond_comments_and_trailing_commas_are_refused() {
     let lenient = json_with("\"scene\": {", "// a comment\n  \"scene\": { /* here */")
@@ -404,7 +404,7 @@ fn issue_6_json_extensions_beyond_comments_and_trailing_commas_are_refused() {
     assert!(text.contains("double quotes"), "{text}");
 }
 
-/// 7. Temporary files of runs killed before their rename are removed by the next run; SIGTERM
+/// Issue case 7: Temporary files of runs killed before their rename are removed by the next run; SIGTERM
 /// is handled like Ctrl-C.
 #[cfg(target_os = "linux")]
 #[test]
@@ -473,7 +473,7 @@ fn issue_7_stale_temporary_files_are_removed_and_sigterm_cancels() {
     case.assert_nothing_written();
 }
 
-/// 8. A missing output folder, or an unknown extension, is refused before rendering.
+/// Issue case 8: A missing output folder, or an unknown extension, is refused before rendering.
 #[test]
 fn issue_8_the_output_is_checked_before_rendering() {
     let case = Case::new().file("scene.xml", BASE_XML);
@@ -502,7 +502,7 @@ fn issue_8_the_output_is_checked_before_rendering() {
     case.assert_nothing_written();
 }
 
-/// 9. --strict makes warnings fatal; a misspelled only camera keeps its hint; `glint check`.
+/// Issue case 9: --strict makes warnings fatal; a misspelled only camera keeps its hint; `glint check`.
 #[test]
 fn issue_9_strict_mode_check_and_the_misspelled_camera() {
     let misspelled = xml_with("<camera name", "<camra name").replace("</camera>", "</camra>");
@@ -573,7 +573,7 @@ fn bad_inputs() -> Vec<(&'static str, Vec<u8>, &'static str, Vec<&'static str>)>
         ("deep.xml", deep_xml.into(), "", vec![]),
         ("deep.json", deep_json.into(), "", vec![]),
         ("bomb.xml", entity_bomb.as_bytes().to_vec(), "", vec![]),
-        ("truncated.xml", BASE_XML[..BASE_XML.find("<radius>").unwrap()].as_bytes().to_vec(), "", vec![]),
+        ("truncated.xml", BASE_XML.as_bytes()[..BASE_XML.find("<radius>").unwrap()].to_vec(), "", vec![]),
         ("duplicate.xml", xml_with("<shape name=\"sphere1\"", "<shape name=\"a\" name=\"b\"").into(), "name=\"a\" name=\"b\"", vec![]),
         ("view.xml", xml_with("<viewDir>0 0 -1</viewDir>", "<viewDir>0 0 0</viewDir>").into(), "<viewDir>", vec![]),
         ("plane.xml", xml_with("<imagePlaneWidth>0.5<", "<imagePlaneWidth>0<").into(), "<imagePlaneWidth>", vec![]),
