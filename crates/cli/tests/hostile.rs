@@ -582,6 +582,8 @@ fn bad_inputs() -> Vec<(&'static str, Vec<u8>, &'static str, Vec<&'static str>)>
         ("nan.xml", xml_with("<center>0 0 -5</center>", "<center>nan 0 -5</center>").into(), "<center>", vec![]),
         ("vertex.xml", xml_with("</scene>", "  <shape type=\"triangle\">\n    <v0>0 0 -5</v0>\n    <v1>1 0 -5</v1>\n    <v2>0 inf -5</v2>\n  </shape>\n</scene>").into(), "<v2>", vec![]),
         ("huge.xml", xml_with("<radius>1</radius>", "<radius>1e40</radius>").into(), "<radius>", vec![]),
+        ("far.xml", xml_with("<center>0 0 -5</center>", "<center>0 0 -5e8</center>").into(), "<center>", vec![]),
+        ("focal-huge.xml", xml_with("<focalLength>1.0<", "<focalLength>1e30<").into(), "<focalLength>", vec![]),
         ("radius.xml", xml_with("<radius>1</radius>", "<radius>-1</radius>").into(), "<radius>", vec![]),
         ("scale.xml", xml_with("</scene>", "  <instance name=\"i\" type=\"sphere\">\n    <shader ref=\"blue\"/>\n  </instance>\n  <shape type=\"instance\" id=\"i\">\n    <transform>\n      <scale>0 1 1</scale>\n    </transform>\n  </shape>\n</scene>").into(), "<scale>", vec![]),
         ("index.xml", xml_with("<shader name=\"blue\" type=\"Lambertian\">", "<shader name=\"blue\" type=\"Dielectric\">\n    <refractiveIndex>0</refractiveIndex>").into(), "<refractiveIndex>", vec![]),
@@ -630,7 +632,7 @@ fn bad_inputs_are_refused_at_their_place_without_writing() {
         }
         checked += 1;
     }
-    assert!(checked >= 30, "{checked}");
+    assert!(checked >= 33, "{checked}");
 }
 
 #[test]

@@ -349,11 +349,6 @@ fn located_color(node: &Node, diagnostics: &mut Diagnostics) -> Result<Located<V
     })
 }
 
-/// Largest size (radius, area light extent) accepted. The renderer squares sizes in 32-bit
-/// floats; a sphere of radius 1e20 overflows and its normals become NaN. The course's largest
-/// size is 1000.
-const MAX_SIZE: f64 = 1e7;
-
 /// A positive size (radius, area light extent), with its default when missing.
 fn positive_number(
     fields: &mut Fields,
@@ -369,15 +364,6 @@ fn positive_number(
         return Err(diagnostics.error(
             node.span,
             format!("`{}` must be positive, found {value}", node.raw_key),
-        ));
-    }
-    if value > MAX_SIZE {
-        return Err(diagnostics.error(
-            node.span,
-            format!(
-                "`{}` is {value:e}, too large to render in 32-bit arithmetic (at most {MAX_SIZE:e})",
-                node.raw_key
-            ),
         ));
     }
     Ok(value as f32)

@@ -175,12 +175,38 @@ pub(crate) fn number(node: &Node, diagnostics: &Diagnostics) -> Result<f64, Scen
             ))
         }
     };
-    parse_finite(text).ok_or_else(|| {
+    let value = parse_finite(text).ok_or_else(|| {
         diagnostics.error(
             node.span,
             format!("expected a number for `{}`, found `{text}`", node.raw_key),
         )
-    })
+    })?;
+    check_magnitude(node, &[value], diagnostics)?;
+    Ok(value)
+}
+
+/// Largest magnitude of any number in a scene. The renderer works in 32-bit floats and
+/// squares lengths (a sphere of radius 1e20 has NaN normals); the course's largest number is
+/// 1000.
+pub(crate) const MAX_MAGNITUDE: f64 = 1e7;
+
+/// A located error when one of `values` is beyond ±`MAX_MAGNITUDE`.
+fn check_magnitude(
+    node: &Node,
+    values: &[f64],
+    diagnostics: &Diagnostics,
+) -> Result<(), SceneError> {
+    match values.iter().find(|value| value.abs() > MAX_MAGNITUDE) {
+        Some(value) => Err(diagnostics.error(
+            node.span,
+            format!(
+                "`{}` holds {value:e}, too large to render in 32-bit arithmetic (numbers must \
+                 lie within ±{MAX_MAGNITUDE:e})",
+                node.raw_key
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 pub(crate) fn located_number(
@@ -247,6 +273,7 @@ pub(crate) fn vector(node: &Node, diagnostics: &mut Diagnostics) -> Result<Vec3,
             ),
         ));
     }
+    check_magnitude(node, &numbers[..3], diagnostics)?;
     let vector = Vec3::new(numbers[0] as f32, numbers[1] as f32, numbers[2] as f32);
     if irregular {
         let text = match &node.value {
