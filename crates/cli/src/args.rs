@@ -109,7 +109,7 @@ pub struct LimitOptions {
     #[arg(long, value_name = "SIZE", value_parser = parse_size)]
     pub max_memory: Option<u64>,
 
-    /// Largest scene, mesh or texture file read (bytes; K, M, G suffixes).
+    /// Largest scene, mesh or texture file read (bytes; K, M, G suffixes) [default: 256M].
     #[arg(long, value_name = "SIZE", value_parser = parse_size,
           default_value_t = glint_io::Limits::default().max_file_bytes,
           hide_default_value = true)]
