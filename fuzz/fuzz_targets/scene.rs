@@ -26,7 +26,10 @@ libfuzzer_sys::fuzz_target!(|bytes: &[u8]| {
     for name in ["scene.xml", "scene.json"] {
         if let Some(loaded) = common::load(text, name, &asset) {
             let parts = loaded.parts;
-            assert!(parts.geometries.iter().all(|g| g.shapes.len() == g.materials.len()));
+            assert!(parts
+                .geometries
+                .iter()
+                .all(|g| g.shapes.len() == g.materials.len()));
         }
     }
 });
