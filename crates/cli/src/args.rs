@@ -86,6 +86,104 @@ pub enum Command {
     /// Compare image B with reference A (PNG, EXR): MAE, RMSE, PSNR, pixels off by more than
     /// N levels, NVIDIA's FLIP and its heat map; exit 1 past a --threshold.
     Diff(crate::diff::DiffArgs),
+    /// Load and validate scenes without rendering: print every warning and error, exit 0 when
+    /// all load (with --strict: without warnings), 2 otherwise.
+    #[command(disable_help_flag = true)]
+    Check {
+        /// Scene files, XML or JSON.
+        #[arg(value_name = "SCENE", required = true)]
+        scenes: Vec<PathBuf>,
+
+        #[command(flatten)]
+        limits: LimitOptions,
+
+        /// Print help.
+        #[arg(short = '?', long, action = ArgAction::Help)]
+        help: Option<bool>,
+    },
+}
+
+/// How strict a load is and what it may take: shared by rendering and `glint check`.
+#[derive(Args, Debug, Clone)]
+pub struct LimitOptions {
+    /// Treat every warning about the scene as an error (exit 2, nothing rendered).
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub strict: bool,
+
+    /// Memory a render may plan for: film, textures and acceleration structures, estimated
+    /// before anything is allocated (bytes; K, M, G suffixes) [default: half the machine's
+    /// memory].
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub max_memory: Option<u64>,
+
+    /// Largest scene, mesh or texture file read (bytes; K, M, G suffixes) [default: 256M].
+    #[arg(long, value_name = "SIZE", value_parser = parse_size,
+          default_value_t = glint_io::Limits::default().max_file_bytes,
+          hide_default_value = true)]
+    pub max_file_size: u64,
+
+    /// Largest texture side in pixels [default: 8192].
+    #[arg(long, value_name = "PIXELS", default_value_t = glint_io::Limits::default().max_texture_side,
+          hide_default_value = true, value_parser = clap::value_parser!(u32).range(1..))]
+    pub max_texture_size: u32,
+
+    /// Most triangles one mesh file may make [default: 20000000].
+    #[arg(long, value_name = "N", default_value_t = glint_io::Limits::default().max_triangles,
+          hide_default_value = true)]
+    pub max_triangles: u64,
+}
+
+impl LimitOptions {
+    /// The loader's limits and the memory budget (the textures get no more than it).
+    pub fn resolve(&self) -> (glint_io::Limits, u64) {
+        let max_memory = self.max_memory.unwrap_or_else(default_max_memory);
+        let limits = glint_io::Limits {
+            max_file_bytes: self.max_file_size,
+            max_triangles: self.max_triangles,
+            max_texture_side: self.max_texture_size,
+            max_texture_bytes: max_memory,
+        };
+        (limits, max_memory)
+    }
+}
+
+/// Half the machine's physical memory (Linux: /proc/meminfo), or 4 GiB where it is unknown.
+pub fn default_max_memory() -> u64 {
+    let total = std::fs::read_to_string("/proc/meminfo")
+        .ok()
+        .and_then(|text| {
+            let line = text.lines().find(|line| line.starts_with("MemTotal:"))?;
+            let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+            kib.checked_mul(1024)
+        });
+    total.map_or(4 << 30, |bytes| bytes / 2)
+}
+
+/// Parses a byte count: `1048576`, `512K`, `64M`, `4G`, `1T` (binary units; a trailing `B`
+/// or `iB` is allowed).
+pub fn parse_size(text: &str) -> Result<u64, String> {
+    let trimmed = text.trim();
+    let upper = trimmed.to_ascii_uppercase();
+    let without_b = upper
+        .strip_suffix("IB")
+        .or_else(|| upper.strip_suffix('B'))
+        .unwrap_or(&upper);
+    let (number, shift) = match without_b.chars().last() {
+        Some('K') => (&without_b[..without_b.len() - 1], 10),
+        Some('M') => (&without_b[..without_b.len() - 1], 20),
+        Some('G') => (&without_b[..without_b.len() - 1], 30),
+        Some('T') => (&without_b[..without_b.len() - 1], 40),
+        _ => (without_b, 0),
+    };
+    let value: f64 = number
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a size (e.g. 4G, 512M, 1048576)"))?;
+    let bytes = value * (1u64 << shift) as f64;
+    if !(bytes.is_finite() && bytes >= 1.0 && bytes < u64::MAX as f64) {
+        return Err(format!("'{text}' is not a usable size"));
+    }
+    Ok(bytes as u64)
 }
 
 /// Options shared by both forms.
@@ -154,6 +252,9 @@ pub struct Options {
     /// PNG only: transfer function, `srgb` (IEC 61966-2-1) or `linear` [default: srgb].
     #[arg(long, value_name = "FUNCTION", value_enum, help_heading = PNG_HEADING)]
     pub transfer: Option<TransferArg>,
+
+    #[command(flatten)]
+    pub limits: LimitOptions,
 
     /// Also print the settings and the loading time.
     #[arg(short = 'v', long, action = ArgAction::SetTrue)]
@@ -369,6 +470,12 @@ pub struct Job {
     pub preview_close: bool,
     /// Notes about accepted options that have no effect, printed before rendering.
     pub notes: Vec<String>,
+    /// Every scene warning is an error.
+    pub strict: bool,
+    /// What the loader may read.
+    pub limits: glint_io::Limits,
+    /// The memory estimate's budget, in bytes.
+    pub max_memory: u64,
 }
 
 impl Cli {
@@ -377,8 +484,10 @@ impl Cli {
         let (scene, options) =
             match self.command {
                 Some(Command::Render { scene, options }) => (scene, options),
-                Some(Command::Bench(_)) => {
-                    return Err(UsageError("`glint bench` is not a render".to_string()))
+                Some(Command::Bench(_)) | Some(Command::Check { .. }) => {
+                    return Err(UsageError(
+                        "`glint bench` and `glint check` do not render".into(),
+                    ))
                 }
                 Some(Command::Diff(_)) => {
                     return Err(UsageError("`glint diff` is not a render".to_string()))
@@ -453,7 +562,11 @@ impl Options {
                 self.rpp,
             ));
         }
+        let (limits, max_memory) = self.limits.resolve();
         Ok(Job {
+            strict: self.limits.strict,
+            limits,
+            max_memory,
             scene,
             output,
             settings,
@@ -719,6 +832,51 @@ mod tests {
             error.contains("objectMedian, spatialMedian, sah"),
             "{error}"
         );
+    }
+
+    #[test]
+    fn sizes_take_binary_suffixes() {
+        assert_eq!(parse_size("1048576"), Ok(1 << 20));
+        assert_eq!(parse_size("512K"), Ok(512 << 10));
+        assert_eq!(parse_size("64MiB"), Ok(64 << 20));
+        assert_eq!(parse_size("1.5G"), Ok(3 << 29));
+        assert_eq!(parse_size("2gb"), Ok(2 << 30));
+        for bad in ["", "G", "-1G", "0", "lots", "1e30T"] {
+            assert!(parse_size(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn limits_and_strictness_reach_the_job() {
+        let strict = job(&[
+            "render",
+            "s.xml",
+            "--strict",
+            "--max-memory",
+            "1G",
+            "--max-file-size",
+            "10M",
+            "--max-texture-size",
+            "100",
+            "--max-triangles",
+            "7",
+        ])
+        .unwrap();
+        assert!(strict.strict);
+        assert_eq!(strict.max_memory, 1 << 30);
+        assert_eq!(
+            strict.limits,
+            glint_io::Limits {
+                max_file_bytes: 10 << 20,
+                max_triangles: 7,
+                max_texture_side: 100,
+                max_texture_bytes: 1 << 30,
+            }
+        );
+        let defaults = job(&["-i", "s.xml"]).unwrap();
+        assert!(!defaults.strict);
+        assert_eq!(defaults.max_memory, default_max_memory());
+        assert!(defaults.max_memory >= 1 << 30);
     }
 
     #[test]

@@ -40,6 +40,11 @@ fn main() -> ExitCode {
         let status = diff::run(args, &mut std::io::stdout(), &mut std::io::stderr());
         return ExitCode::from(status);
     }
+    if let Some(crate::args::Command::Check { scenes, limits, .. }) = &cli.command {
+        let (resolved, _) = limits.resolve();
+        let status = run::check(scenes, &resolved, limits.strict, &mut std::io::stderr());
+        return ExitCode::from(status);
+    }
     let available = std::thread::available_parallelism().map_or(1, |n| n.get());
     let job = match cli.into_job(available) {
         Ok(job) => job,
@@ -48,6 +53,7 @@ fn main() -> ExitCode {
 
     // Without a handler Ctrl-C would still kill the process without writing anything (the
     // image is written atomically), only less politely; so a failure here is only a note.
+    // With ctrlc's `termination` feature SIGTERM (and SIGHUP) take the same path as Ctrl-C.
     if let Err(error) = ctrlc::set_handler(|| match INTERRUPT.on_signal() {
         SignalAction::ExitNow => {
             eprintln!("\nerror: {}", Failure::Interrupted);

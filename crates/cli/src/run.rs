@@ -4,6 +4,7 @@
 
 use std::fmt;
 use std::io::Write;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::time::{Duration, Instant};
 
@@ -30,14 +31,20 @@ pub enum Failure {
     Write(ImageWriteError),
     /// The render threads could not be started (exit 1).
     ThreadPool(rayon::ThreadPoolBuildError),
-    /// Ctrl-C (exit 130). Nothing was written.
+    /// Ctrl-C or SIGTERM (exit 130). Nothing was written.
     Interrupted,
+    /// `--strict` and the scene has warnings (exit 2); they were printed as errors.
+    Strict { scene: PathBuf, warnings: usize },
+    /// The render would need more memory than `--max-memory` allows (exit 2).
+    Memory(String),
 }
 
 impl Failure {
     pub fn exit_code(&self) -> u8 {
         match self {
-            Failure::Usage(_) | Failure::Scene(_) => 2,
+            Failure::Usage(_) | Failure::Scene(_) | Failure::Strict { .. } | Failure::Memory(_) => {
+                2
+            }
             Failure::Write(_) | Failure::ThreadPool(_) => 1,
             Failure::Interrupted => EXIT_INTERRUPTED,
         }
@@ -49,11 +56,24 @@ impl fmt::Display for Failure {
         match self {
             Failure::Usage(error) => write!(f, "{error}"),
             Failure::Scene(SceneError::Invalid(diagnostic)) => f.write_str(&located(diagnostic)),
-            Failure::Scene(error) => write!(f, "{error}"),
+            Failure::Scene(error @ SceneError::Io { source, .. }) => {
+                write!(f, "{error}")?;
+                if glint_io::TooLarge::of(source).is_some() {
+                    f.write_str(" (--max-file-size raises it)")?;
+                }
+                Ok(())
+            }
             // It names the file: "cannot write out.png: ...".
             Failure::Write(error) => write!(f, "{error}"),
             Failure::ThreadPool(error) => write!(f, "cannot start the render threads: {error}"),
             Failure::Interrupted => f.write_str("interrupted: no image was written"),
+            Failure::Strict { scene, warnings } => write!(
+                f,
+                "{}: {warnings} warning{} with --strict; nothing was rendered",
+                scene.display(),
+                plural(*warnings as u64)
+            ),
+            Failure::Memory(why) => f.write_str(why),
         }
     }
 }
@@ -185,16 +205,36 @@ pub fn run(
         .map_err(Failure::ThreadPool)?;
 
     interrupt.set_phase(Phase::Loading);
-    let load_start = Instant::now();
-    let loaded = glint_io::load_scene(&job.scene).map_err(Failure::Scene)?;
-    let mut shown: Vec<String> = Vec::new();
-    for warning in &loaded.warnings {
-        let text = located(warning);
-        if !shown.contains(&text) {
-            let _ = writeln!(err, "warning: {text}");
-            shown.push(text);
-        }
+    // Everything that can be known before the render is checked before it: the output can
+    // be written, and the film fits in the memory budget.
+    check_output(&job.output)?;
+    let removed = glint_io::remove_stale_partials(output_directory(&job.output));
+    if removed > 0 {
+        let _ = writeln!(
+            err,
+            "note: removed {removed} temporary file{} left by an earlier run that was killed",
+            plural(removed as u64)
+        );
     }
+    let film_bytes = film_bytes(&job.settings);
+    check_memory(film_bytes, 0, 0, job.max_memory)?;
+    let load_start = Instant::now();
+    // Textures get what the film leaves of the budget.
+    let mut limits = job.limits;
+    limits.max_texture_bytes = limits
+        .max_texture_bytes
+        .min(job.max_memory.saturating_sub(film_bytes));
+    let loaded = glint_io::load_scene_limited(&job.scene, &limits).map_err(Failure::Scene)?;
+    if job.strict && !loaded.warnings.is_empty() {
+        for warning in &loaded.warnings {
+            let _ = writeln!(err, "error: {}", located(warning));
+        }
+        return Err(Failure::Strict {
+            scene: job.scene.clone(),
+            warnings: loaded.warnings.len(),
+        });
+    }
+    print_warnings(&loaded.warnings, MAX_SHOWN_WARNINGS, err);
     let mut parts = loaded.parts;
     if let Some(color) = job.background {
         parts.background = Background::Color(color);
@@ -206,6 +246,12 @@ pub fn run(
             ..lens
         });
     }
+    check_memory(
+        film_bytes,
+        texture_bytes(&parts),
+        shape_count(&parts),
+        job.max_memory,
+    )?;
     let options = SceneOptions { split: job.split };
     let scene = pool.install(|| Scene::with_options(parts, options));
     let load_time = load_start.elapsed();
@@ -267,7 +313,8 @@ pub fn run(
             .unwrap_or_default();
         let _ = writeln!(
             err,
-            "warning: {} sample{} returned NaN or infinity and {} left out of the image{first}",
+            "warning: {} sample{} returned NaN or infinity (or overflowed) and {} left out of \
+             the image{first}",
             stats.nonfinite_samples,
             plural(stats.nonfinite_samples),
             if stats.nonfinite_samples == 1 {
@@ -315,6 +362,187 @@ pub fn bvh_stats(scene: &Scene, settings: &RenderSettings) -> String {
         walk.rays,
         100.0 * walk.hits as f64 / walk.rays.max(1) as f64,
     )
+}
+
+/// `glint check`: loads every scene under `limits`, prints every diagnostic (warnings as
+/// errors with `strict`) and a line per scene, and returns the exit status: 0 when every scene
+/// loads (with `strict`: without warnings), 2 otherwise.
+pub fn check(
+    scenes: &[PathBuf],
+    limits: &glint_io::Limits,
+    strict: bool,
+    err: &mut dyn Write,
+) -> u8 {
+    let mut failed = 0usize;
+    for scene in scenes {
+        match glint_io::load_scene_limited(scene, limits) {
+            Ok(loaded) => {
+                let label = if strict { "error" } else { "warning" };
+                for warning in &loaded.warnings {
+                    let _ = writeln!(err, "{label}: {}", located(warning));
+                }
+                let count = loaded.warnings.len();
+                let verdict = if strict && count > 0 {
+                    failed += 1;
+                    "fails under --strict"
+                } else {
+                    "ok"
+                };
+                let _ = writeln!(
+                    err,
+                    "{}: {verdict} ({count} warning{})",
+                    scene.display(),
+                    plural(count as u64)
+                );
+            }
+            Err(error) => {
+                failed += 1;
+                let _ = writeln!(err, "error: {}", Failure::Scene(error));
+                let _ = writeln!(err, "{}: cannot be loaded", scene.display());
+            }
+        }
+    }
+    if failed > 0 {
+        let _ = writeln!(
+            err,
+            "{failed} of {} scene{} failed",
+            scenes.len(),
+            plural(scenes.len() as u64)
+        );
+        2
+    } else {
+        0
+    }
+}
+
+/// How many warnings a render prints; `glint check` prints them all.
+pub const MAX_SHOWN_WARNINGS: usize = 20;
+
+/// Prints the first `limit` warnings and then how many more there were.
+pub fn print_warnings(warnings: &[Diagnostic], limit: usize, err: &mut dyn Write) {
+    for warning in warnings.iter().take(limit) {
+        let _ = writeln!(err, "warning: {}", located(warning));
+    }
+    if warnings.len() > limit {
+        let rest = warnings.len() - limit;
+        let _ = writeln!(
+            err,
+            "warning: {rest} more warning{} not shown (`glint check SCENE` lists them all)",
+            plural(rest as u64)
+        );
+    }
+}
+
+/// The folder the output goes into.
+fn output_directory(output: &Path) -> &Path {
+    match output.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    }
+}
+
+/// The output's extension is known, its folder exists, and a file can be created in it (an
+/// unnamed one, on Linux: nothing appears in the folder, even if the process dies here).
+fn check_output(output: &Path) -> Result<(), Failure> {
+    glint_io::output_format(output)
+        .map_err(|error| Failure::Usage(UsageError(error.to_string())))?;
+    let directory = output_directory(output);
+    let refuse = |why: String| {
+        Failure::Usage(UsageError(format!(
+            "cannot write {}: {why}; nothing was rendered",
+            output.display()
+        )))
+    };
+    match std::fs::metadata(directory) {
+        Ok(metadata) if metadata.is_dir() => {}
+        Ok(_) => return Err(refuse(format!("{} is not a folder", directory.display()))),
+        Err(error) if error.kind() == std::io::ErrorKind::NotFound => {
+            return Err(refuse(format!(
+                "the folder {} does not exist",
+                directory.display()
+            )))
+        }
+        Err(error) => {
+            return Err(refuse(format!(
+                "the folder {} cannot be used ({error})",
+                directory.display()
+            )))
+        }
+    }
+    if output.is_dir() {
+        return Err(refuse("it is a folder".to_owned()));
+    }
+    tempfile::tempfile_in(directory).map_err(|error| {
+        refuse(format!(
+            "the folder {} is not writable ({error})",
+            directory.display()
+        ))
+    })?;
+    Ok(())
+}
+
+/// Bytes per pixel of a render: the pipeline's per-pixel values (40), the film (12), the
+/// 8-bit copy and its encoding (6), and with feature layers their film copies (28).
+fn film_bytes(settings: &glint_render::RenderSettings) -> u64 {
+    let per_pixel = if settings.features { 86 } else { 58 };
+    u64::from(settings.width) * u64::from(settings.height) * per_pixel
+}
+
+/// Bytes per shape of the scene and its acceleration structures: the shape (up to 40 bytes),
+/// its material, its triangle copy in the ray engine and its share of BVH nodes, with room.
+const BYTES_PER_SHAPE: u64 = 160;
+
+fn texture_bytes(parts: &glint_render::SceneParts) -> u64 {
+    let mut texels: u64 = parts
+        .textures
+        .iter()
+        .map(|texture| texture.texels.len() as u64)
+        .sum();
+    if let Background::CubeMap(map) = &parts.background {
+        texels += map
+            .faces
+            .iter()
+            .map(|face| face.texels.len() as u64)
+            .sum::<u64>();
+    }
+    texels * 12
+}
+
+fn shape_count(parts: &glint_render::SceneParts) -> u64 {
+    let shapes: u64 = parts
+        .geometries
+        .iter()
+        .map(|geometry| geometry.shapes.len() as u64)
+        .sum();
+    let light_triangles: u64 = parts
+        .lights
+        .iter()
+        .map(|light| match light {
+            glint_render::Light::Triangles { triangles, .. } => triangles.len() as u64,
+            _ => 1,
+        })
+        .sum();
+    shapes + light_triangles + parts.instances.len() as u64
+}
+
+/// Refuses a render whose estimated memory is over the budget.
+fn check_memory(film: u64, textures: u64, shapes: u64, budget: u64) -> Result<(), Failure> {
+    let structures = shapes.saturating_mul(BYTES_PER_SHAPE);
+    let total = film.saturating_add(textures).saturating_add(structures);
+    if total <= budget {
+        return Ok(());
+    }
+    let bytes = glint_io::format_bytes;
+    Err(Failure::Memory(format!(
+        "the render would need about {} (image {}, textures {}, shapes and their acceleration \
+         structures {}), more than the limit of {}; render a smaller image, or raise the limit \
+         with --max-memory",
+        bytes(total),
+        bytes(film),
+        bytes(textures),
+        bytes(structures),
+        bytes(budget)
+    )))
 }
 
 fn new_progress_bar(width: u32, height: u32) -> ProgressBar {
@@ -428,6 +656,9 @@ mod tests {
             preview: None,
             preview_close: false,
             notes: Vec::new(),
+            strict: false,
+            limits: glint_io::Limits::default(),
+            max_memory: 1 << 30,
         };
         let stats = RenderStats {
             rays: 4_500_000,
@@ -447,12 +678,49 @@ mod tests {
             line: 3,
             column: 5,
             message: "radius must be > 0".into(),
-            source_line: Some("\tab cd".into()),
+            source: Some(glint_io::SourceLine::new("\tab cd")),
         };
         assert_eq!(
             located(&diagnostic),
             "scene.xml:3:5: radius must be > 0\n\tab cd\n\t   ^"
         );
+    }
+
+    #[test]
+    fn memory_estimates_refuse_what_does_not_fit() {
+        let huge = glint_render::RenderSettings {
+            width: 65_535,
+            height: 65_535,
+            ..glint_render::RenderSettings::default()
+        };
+        let film = film_bytes(&huge);
+        assert!(film > 200 << 30, "{film}");
+        let refused = check_memory(film, 0, 0, 8 << 30).unwrap_err();
+        assert_eq!(refused.exit_code(), 2);
+        assert!(refused.to_string().contains("--max-memory"), "{refused}");
+        assert!(check_memory(1 << 20, 1 << 20, 1000, 8 << 30).is_ok());
+        assert!(check_memory(0, 0, u64::MAX, 8 << 30).is_err());
+    }
+
+    #[test]
+    fn warnings_beyond_the_cap_are_counted() {
+        let warnings: Vec<Diagnostic> = (1..=25)
+            .map(|line| Diagnostic {
+                severity: glint_io::Severity::Warning,
+                path: "s.xml".into(),
+                line,
+                column: 1,
+                message: format!("w{line}"),
+                source: None,
+            })
+            .collect();
+        let mut out = Vec::new();
+        print_warnings(&warnings, 20, &mut out);
+        let text = String::from_utf8(out).unwrap();
+        assert_eq!(text.lines().count(), 21, "{text}");
+        assert!(text.contains("s.xml:20:1: w20"), "{text}");
+        assert!(!text.contains("w21"), "{text}");
+        assert!(text.ends_with("5 more warnings not shown (`glint check SCENE` lists them all)\n"));
     }
 
     #[test]

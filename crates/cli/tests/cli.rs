@@ -658,7 +658,7 @@ fn bad_arguments_exit_2_without_output() {
 }
 
 #[test]
-fn unwritable_output_exits_1() {
+fn a_missing_output_folder_is_refused_before_rendering() {
     let dir = scene_dir();
     let output = glint_in(
         dir.path(),
@@ -673,8 +673,11 @@ fn unwritable_output_exits_1() {
             "4",
         ],
     );
-    assert_exit(&output, 1);
-    assert!(stderr(&output).contains("out.png"), "{}", stderr(&output));
+    assert_exit(&output, 2);
+    let text = stderr(&output);
+    assert!(text.contains("out.png"), "{text}");
+    assert!(text.contains("does not exist"), "{text}");
+    assert!(!text.contains("rendered 4x4"), "{text}");
 }
 
 /// Ctrl-C during the render cancels it: status 130 and no image.

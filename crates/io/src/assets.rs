@@ -3,8 +3,11 @@
 //! `Assets` for every mesh, texture and environment map, so both see the same scenes.
 
 use std::collections::HashMap;
-use std::io;
+use std::fmt;
+use std::io::{self, Read};
 use std::path::{Component, Path, PathBuf};
+
+use crate::limits::format_bytes;
 
 /// A source of the files a scene names, by path (already joined to the scene file's folder).
 pub trait Assets {
@@ -13,6 +16,66 @@ pub trait Assets {
 
     /// Whether a file exists at `path` (to pick among alternative names).
     fn exists(&self, path: &Path) -> bool;
+    /// The bytes of the file at `path`, or a [`TooLarge`] error (kind `InvalidData`) when it
+    /// holds more than `limit` bytes. The loader reads every file through this. The default
+    /// reads the whole file first; sources that can tell the size before reading override it.
+    fn read_at_most(&self, path: &Path, limit: u64) -> io::Result<Vec<u8>> {
+        let bytes = self.read(path)?;
+        if bytes.len() as u64 > limit {
+            return Err(TooLarge { limit }.into());
+        }
+        Ok(bytes)
+    }
+}
+
+/// A file over the size limit; `TooLarge::of(&error)` finds it in an `io::Error`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TooLarge {
+    pub limit: u64,
+}
+
+impl TooLarge {
+    /// The limit `error` reports, when it is a `TooLarge`.
+    pub fn of(error: &io::Error) -> Option<TooLarge> {
+        error.get_ref()?.downcast_ref::<TooLarge>().copied()
+    }
+}
+
+impl fmt::Display for TooLarge {
+    fn fmt(&self, formatter: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            formatter,
+            "the file is larger than the limit of {}",
+            format_bytes(self.limit)
+        )
+    }
+}
+
+impl std::error::Error for TooLarge {}
+
+impl From<TooLarge> for io::Error {
+    fn from(too_large: TooLarge) -> io::Error {
+        io::Error::new(io::ErrorKind::InvalidData, too_large)
+    }
+}
+
+/// Why a mesh, texture or environment map was not loaded.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) enum AssetError {
+    /// Over a limit (file size, dimensions, texture memory): the scene is refused.
+    Refused(String),
+    /// Missing or unreadable: the scene goes on without it.
+    Failed(String),
+}
+
+impl std::fmt::Display for AssetError {
+    fn fmt(&self, formatter: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            AssetError::Refused(message) | AssetError::Failed(message) => {
+                formatter.write_str(message)
+            }
+        }
+    }
 }
 
 /// The file system.
@@ -27,6 +90,38 @@ impl Assets for FileSystem {
     fn exists(&self, path: &Path) -> bool {
         path.is_file()
     }
+    /// Refuses a regular file by its size before reading it; reads anything else (a pipe, a
+    /// device such as /dev/zero) only up to one byte past the limit.
+    fn read_at_most(&self, path: &Path, limit: u64) -> io::Result<Vec<u8>> {
+        read_file_at_most(path, limit)
+    }
+}
+
+/// The file at `path`, refused with [`TooLarge`] when over `limit` bytes, without ever holding
+/// more than `limit + 1` bytes.
+pub fn read_file_at_most(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
+    let file = std::fs::File::open(path)?;
+    let metadata = file.metadata()?;
+    if metadata.is_dir() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "it is a directory",
+        ));
+    }
+    if metadata.is_file() && metadata.len() > limit {
+        return Err(TooLarge { limit }.into());
+    }
+    let expected = if metadata.is_file() {
+        metadata.len()
+    } else {
+        0
+    };
+    let mut bytes = Vec::with_capacity(usize::try_from(expected).unwrap_or(0));
+    file.take(limit.saturating_add(1)).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(TooLarge { limit }.into());
+    }
+    Ok(bytes)
 }
 
 /// Files held in memory, by path. Paths are compared after lexical normalisation (`a/./b` and
@@ -54,12 +149,21 @@ impl MemoryAssets {
 
 impl Assets for MemoryAssets {
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
-        self.files.get(&normalise(path)).cloned().ok_or_else(|| {
+        self.read_at_most(path, u64::MAX)
+    }
+
+    /// Checks the size before copying.
+    fn read_at_most(&self, path: &Path, limit: u64) -> io::Result<Vec<u8>> {
+        let bytes = self.files.get(&normalise(path)).ok_or_else(|| {
             io::Error::new(
                 io::ErrorKind::NotFound,
                 "no such file among the files given",
             )
-        })
+        })?;
+        if bytes.len() as u64 > limit {
+            return Err(TooLarge { limit }.into());
+        }
+        Ok(bytes.clone())
     }
 
     fn exists(&self, path: &Path) -> bool {
@@ -109,5 +213,28 @@ mod tests {
             normalise(Path::new("../a/./b/../c")),
             PathBuf::from("../a/c")
         );
+        let too_large = assets
+            .read_at_most(Path::new("scenes/data/bunny.obj"), 3)
+            .unwrap_err();
+        assert_eq!(TooLarge::of(&too_large), Some(TooLarge { limit: 3 }));
+    }
+
+    #[test]
+    fn file_system_reads_stop_past_the_limit() {
+        let directory = tempfile::tempdir().unwrap();
+        let path = directory.path().join("ten.bin");
+        std::fs::write(&path, [7u8; 10]).unwrap();
+        assert_eq!(FileSystem.read_at_most(&path, 10).unwrap().len(), 10);
+        let error = FileSystem.read_at_most(&path, 9).unwrap_err();
+        assert_eq!(TooLarge::of(&error), Some(TooLarge { limit: 9 }));
+        assert!(error.to_string().contains("limit of 9 bytes"), "{error}");
+        // A device that never ends is cut off one byte past the limit.
+        if Path::new("/dev/zero").exists() {
+            let error = FileSystem
+                .read_at_most(Path::new("/dev/zero"), 1 << 20)
+                .unwrap_err();
+            assert_eq!(TooLarge::of(&error), Some(TooLarge { limit: 1 << 20 }));
+        }
+        assert!(FileSystem.read_at_most(directory.path(), 100).is_err());
     }
 }

@@ -21,24 +21,26 @@ use glint_render::{
     Material, MaterialId, Matrix4, SceneParts, Shape, TextureId, Transform, Vec3,
 };
 
-use crate::assets::Assets;
+use crate::assets::{AssetError, Assets};
 use crate::desc::{
     ColorDesc, LightKindDesc, Located, SceneDesc, ShaderKindDesc, ShapeDesc, ShapeKindDesc, Span,
     TextureDesc, TransformOperation, TransformStep,
 };
 use crate::diagnostic::{did_you_mean, Diagnostics, SceneError};
-use crate::image_io::{cut_vertical_cross, load_cube_map, load_image};
+use crate::image_io::{cut_vertical_cross, load_cube_map, load_image, TextureBudget};
+use crate::limits::Limits;
 use crate::obj::load_triangles;
 
 pub(crate) fn build(
     desc: &SceneDesc,
     base_directory: &Path,
     assets: &dyn Assets,
+    limits: &Limits,
     diagnostics: &mut Diagnostics,
 ) -> Result<SceneParts, SceneError> {
-    let mut builder = Builder::new(desc, base_directory, assets, diagnostics);
+    let mut builder = Builder::new(desc, base_directory, assets, limits, diagnostics);
     builder.declare_textures();
-    builder.create_materials();
+    builder.create_materials()?;
     builder.declare_definitions();
     for shape in &desc.shapes {
         builder.add_shape(shape)?;
@@ -47,7 +49,7 @@ pub(crate) fn build(
         builder.add_light(&light.kind)?;
     }
     let camera = builder.camera();
-    let background = builder.background();
+    let background = builder.background()?;
     Ok(builder.finish(camera, background))
 }
 
@@ -66,7 +68,12 @@ struct Builder<'desc, 'diagnostics, 'text> {
     texture_by_name: HashMap<&'desc str, &'desc TextureDesc>,
     /// Loaded textures by name; `None` when loading failed (reported once).
     loaded_textures: HashMap<&'desc str, Option<TextureId>>,
+    /// Loaded textures by file: texture entries naming the same image share one copy.
+    textures_by_path: HashMap<PathBuf, Option<TextureId>>,
     textures: Vec<Image>,
+    limits: Limits,
+    /// Texture memory taken so far, checked against the limits before each decode.
+    texture_budget: TextureBudget,
     definition_by_name: HashMap<&'desc str, usize>,
     /// Definitions whose own shader is needed: some instance shape places them without a
     /// shader of its own.
@@ -86,6 +93,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         desc: &'desc SceneDesc,
         base_directory: &'desc Path,
         assets: &'desc dyn Assets,
+        limits: &Limits,
         diagnostics: &'diagnostics mut Diagnostics<'text>,
     ) -> Self {
         Builder {
@@ -98,7 +106,10 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             fallback_material: None,
             texture_by_name: HashMap::new(),
             loaded_textures: HashMap::new(),
+            textures_by_path: HashMap::new(),
             textures: Vec::new(),
+            limits: *limits,
+            texture_budget: TextureBudget::new(*limits),
             definition_by_name: HashMap::new(),
             definition_needs_shader: vec![false; desc.instance_definitions.len()],
             definition_geometry: HashMap::new(),
@@ -152,12 +163,12 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         }
     }
 
-    fn create_materials(&mut self) {
+    fn create_materials(&mut self) -> Result<(), SceneError> {
         for shader in &self.desc.shaders {
             let Some(name) = &shader.name else { continue };
             let material = match &shader.kind {
                 ShaderKindDesc::Unknown { .. } => None,
-                kind => Some(self.material(kind)),
+                kind => Some(self.material(kind)?),
             };
             let id = match material {
                 Some(material) => self.push_material(material),
@@ -177,6 +188,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 );
             }
         }
+        Ok(())
     }
 
     fn push_material(&mut self, material: Material) -> MaterialId {
@@ -195,10 +207,10 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         id
     }
 
-    fn material(&mut self, kind: &'desc ShaderKindDesc) -> Material {
-        match kind {
+    fn material(&mut self, kind: &'desc ShaderKindDesc) -> Result<Material, SceneError> {
+        Ok(match kind {
             ShaderKindDesc::Lambertian { diffuse } => Material::Lambertian {
-                diffuse: self.color(diffuse),
+                diffuse: self.color(diffuse)?,
             },
             ShaderKindDesc::BlinnPhong {
                 diffuse,
@@ -206,8 +218,8 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 phong_exp,
                 mirror_coef,
             } => Material::BlinnPhong {
-                diffuse: self.color(diffuse),
-                specular: self.color(specular),
+                diffuse: self.color(diffuse)?,
+                specular: self.color(specular)?,
                 phong_exponent: *phong_exp,
                 mirror_coef: *mirror_coef,
             },
@@ -216,8 +228,8 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 specular,
                 phong_exp,
             } => Material::Phong {
-                diffuse: self.color(diffuse),
-                specular: self.color(specular),
+                diffuse: self.color(diffuse)?,
+                specular: self.color(specular)?,
                 phong_exponent: *phong_exp,
             },
             ShaderKindDesc::Mirror { roughness } => Material::Mirror {
@@ -227,7 +239,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 diffuse,
                 mirror_coef,
             } => Material::Glaze {
-                diffuse: self.color(diffuse),
+                diffuse: self.color(diffuse)?,
                 mirror_coef: *mirror_coef,
             },
             ShaderKindDesc::BlinnPhongMirrored {
@@ -237,8 +249,8 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 mirror_coef,
                 roughness,
             } => Material::BlinnPhongMirrored {
-                diffuse: self.color(diffuse),
-                specular: self.color(specular),
+                diffuse: self.color(diffuse)?,
+                specular: self.color(specular)?,
                 phong_exponent: *phong_exp,
                 mirror_coef: *mirror_coef,
                 roughness: *roughness,
@@ -251,29 +263,29 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 attenuation: *attenuation_coef,
             },
             ShaderKindDesc::CoolToWarm { diffuse } => Material::CoolToWarm {
-                diffuse: self.color(diffuse),
+                diffuse: self.color(diffuse)?,
             },
             ShaderKindDesc::Diffuse { diffuse } => Material::Diffuse {
-                diffuse: self.color(diffuse),
+                diffuse: self.color(diffuse)?,
             },
             ShaderKindDesc::Unknown { .. } => Material::fallback(),
-        }
+        })
     }
 
     /// A colour parameter with its texture loaded. FORMAT.md A17: a texture that is not
     /// defined or cannot be read leaves the plain colour.
-    fn color(&mut self, color: &'desc ColorDesc) -> ColorSource {
+    fn color(&mut self, color: &'desc ColorDesc) -> Result<ColorSource, SceneError> {
         let Some(texture_name) = &color.texture else {
-            return ColorSource::constant(color.color);
+            return Ok(ColorSource::constant(color.color));
         };
-        let texture = self.texture(texture_name);
-        ColorSource {
+        let texture = self.texture(texture_name)?;
+        Ok(ColorSource {
             color: color.color,
             texture,
-        }
+        })
     }
 
-    fn texture(&mut self, name: &'desc Located<String>) -> Option<TextureId> {
+    fn texture(&mut self, name: &'desc Located<String>) -> Result<Option<TextureId>, SceneError> {
         let Some(declaration) = self.texture_by_name.get(name.value.as_str()).copied() else {
             let suggestion = did_you_mean(&name.value, self.texture_by_name.keys().copied());
             self.diagnostics.warn(
@@ -283,20 +295,34 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                     name.value
                 ),
             );
-            return None;
+            return Ok(None);
         };
         let key = declaration.name.value.as_str();
         if let Some(loaded) = self.loaded_textures.get(key) {
-            return *loaded;
+            return Ok(*loaded);
         }
         let source = &declaration.source_file;
         let path = self.resolve_path(&source.value);
-        let loaded = match load_image(&path, self.assets) {
+        if let Some(&shared) = self.textures_by_path.get(&path) {
+            self.loaded_textures.insert(key, shared);
+            return Ok(shared);
+        }
+        let loaded = match load_image(&path, self.assets, &mut self.texture_budget) {
             Ok(image) => {
                 self.textures.push(image);
                 Some((self.textures.len() - 1) as TextureId)
             }
-            Err(error) => {
+            Err(AssetError::Refused(why)) => {
+                return Err(self.diagnostics.error(
+                    source.span,
+                    format!(
+                        "texture image `{}` ({}) is refused: {why}",
+                        source.value,
+                        path.display()
+                    ),
+                ))
+            }
+            Err(AssetError::Failed(error)) => {
                 self.diagnostics.warn(
                     source.span,
                     format!(
@@ -310,7 +336,8 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             }
         };
         self.loaded_textures.insert(key, loaded);
-        loaded
+        self.textures_by_path.insert(path, loaded);
+        Ok(loaded)
     }
 
     /// The material of a shader reference. A missing reference on a plain shape, or one that
@@ -387,7 +414,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             }
             ShapeKindDesc::Mesh { file } => {
                 let material = self.shader(shape.shader.as_ref(), shape.span);
-                if let Some(geometry) = self.direct_mesh(file, material) {
+                if let Some(geometry) = self.direct_mesh(file, material)? {
                     self.instances.push(Instance {
                         geometry,
                         transform: None,
@@ -397,7 +424,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 }
             }
             ShapeKindDesc::Instance { id, transform } => {
-                let Some((geometry, _)) = self.placed_definition(id) else {
+                let Some((geometry, _)) = self.placed_definition(id)? else {
                     return Ok(());
                 };
                 // FORMAT.md A15: without a shader of its own the instance keeps its
@@ -427,12 +454,12 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
     }
 
     /// The OBJ triangles of `file`, read once per path.
-    fn mesh(&mut self, file: &Located<String>) -> Option<Rc<Vec<[Vec3; 3]>>> {
+    fn mesh(&mut self, file: &Located<String>) -> Result<Option<Rc<Vec<[Vec3; 3]>>>, SceneError> {
         let path = self.resolve_path(&file.value);
         if let Some(cached) = self.meshes.get(&path) {
-            return cached.clone();
+            return Ok(cached.clone());
         }
-        let loaded = match load_triangles(&path, self.assets) {
+        let loaded = match load_triangles(&path, self.assets, &self.limits) {
             Ok(triangles) if triangles.is_empty() => {
                 self.diagnostics.warn(
                     file.span,
@@ -445,7 +472,17 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 None
             }
             Ok(triangles) => Some(Rc::new(triangles)),
-            Err(error) => {
+            Err(AssetError::Refused(why)) => {
+                return Err(self.diagnostics.error(
+                    file.span,
+                    format!(
+                        "OBJ file `{}` ({}) is refused: {why}",
+                        file.value,
+                        path.display()
+                    ),
+                ))
+            }
+            Err(AssetError::Failed(error)) => {
                 // FORMAT.md A17: instructor files name meshes that exist nowhere; warn and go on.
                 self.diagnostics.warn(
                     file.span,
@@ -459,7 +496,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             }
         };
         self.meshes.insert(path, loaded.clone());
-        loaded
+        Ok(loaded)
     }
 
     fn push_geometry(&mut self, geometry: GeometryDesc) -> u32 {
@@ -467,31 +504,44 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         (self.geometries.len() - 1) as u32
     }
 
-    fn mesh_geometry(&mut self, file: &Located<String>, material: MaterialId) -> Option<u32> {
-        let triangles = self.mesh(file)?;
+    fn mesh_geometry(
+        &mut self,
+        file: &Located<String>,
+        material: MaterialId,
+    ) -> Result<Option<u32>, SceneError> {
+        let Some(triangles) = self.mesh(file)? else {
+            return Ok(None);
+        };
         let shapes: Vec<Shape> = triangles
             .iter()
             .map(|&vertices| Shape::Triangle { vertices })
             .collect();
         let materials = vec![material; shapes.len()];
-        Some(self.push_geometry(GeometryDesc { shapes, materials }))
+        Ok(Some(self.push_geometry(GeometryDesc { shapes, materials })))
     }
 
     /// The geometry of a mesh used directly as a shape, shared by every shape naming the same
     /// file (each placement carries its own material).
-    fn direct_mesh(&mut self, file: &Located<String>, material: MaterialId) -> Option<u32> {
+    fn direct_mesh(
+        &mut self,
+        file: &Located<String>,
+        material: MaterialId,
+    ) -> Result<Option<u32>, SceneError> {
         let path = self.resolve_path(&file.value);
         if let Some(&geometry) = self.direct_mesh_geometry.get(&path) {
-            return geometry;
+            return Ok(geometry);
         }
-        let geometry = self.mesh_geometry(file, material);
+        let geometry = self.mesh_geometry(file, material)?;
         self.direct_mesh_geometry.insert(path, geometry);
-        geometry
+        Ok(geometry)
     }
 
     /// The geometry of the definition an instance shape names, built on first use, and the
     /// definition itself.
-    fn placed_definition(&mut self, id: &Located<String>) -> Option<(u32, &'desc ShapeDesc)> {
+    fn placed_definition(
+        &mut self,
+        id: &Located<String>,
+    ) -> Result<Option<(u32, &'desc ShapeDesc)>, SceneError> {
         let Some(&index) = self.definition_by_name.get(id.value.as_str()) else {
             let suggestion = did_you_mean(&id.value, self.definition_by_name.keys().copied());
             self.diagnostics.warn(
@@ -501,16 +551,16 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                     id.value
                 ),
             );
-            return None;
+            return Ok(None);
         };
         let definitions = &self.desc.instance_definitions;
         let definition = &definitions[index];
         if let Some(&geometry) = self.definition_geometry.get(&index) {
-            return geometry.map(|geometry| (geometry, definition));
+            return Ok(geometry.map(|geometry| (geometry, definition)));
         }
         let material = self.definition_material(index);
         let geometry = match &definition.kind {
-            ShapeKindDesc::Mesh { file } => self.mesh_geometry(file, material),
+            ShapeKindDesc::Mesh { file } => self.mesh_geometry(file, material)?,
             kind => primitive(kind).map(|primitive| {
                 self.push_geometry(GeometryDesc {
                     shapes: vec![primitive],
@@ -519,7 +569,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             }),
         };
         self.definition_geometry.insert(index, geometry);
-        geometry.map(|geometry| (geometry, definition))
+        Ok(geometry.map(|geometry| (geometry, definition)))
     }
 
     /// A definition's own shader. FORMAT.md A16: instructor files give definitions shaders
@@ -663,7 +713,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 self.add_plain(shape, material);
             }
             ShapeKindDesc::Mesh { file } => {
-                let Some(triangles) = self.mesh(file) else {
+                let Some(triangles) = self.mesh(file)? else {
                     return Ok(());
                 };
                 let light = self.push_light(Light::Triangles {
@@ -671,7 +721,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                     intensity,
                 });
                 let material = self.emissive(intensity, surface, Some(light));
-                if let Some(geometry) = self.direct_mesh(file, material) {
+                if let Some(geometry) = self.direct_mesh(file, material)? {
                     self.instances.push(Instance {
                         geometry,
                         transform: None,
@@ -681,22 +731,22 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 }
             }
             ShapeKindDesc::Instance { id, transform } => {
-                let Some((geometry, definition)) = self.placed_definition(id) else {
+                let Some((geometry, definition)) = self.placed_definition(id)? else {
                     return Ok(());
                 };
                 let transform = self.transform(transform)?;
-                let light = match self.world_light(definition, transform.map(|(_, m)| m), intensity)
-                {
-                    Some(light) => Some(self.push_light(light)),
-                    None => {
-                        self.diagnostics.warn(
+                let light =
+                    match self.world_light(definition, transform.map(|(_, m)| m), intensity)? {
+                        Some(light) => Some(self.push_light(light)),
+                        None => {
+                            self.diagnostics.warn(
                             shape.span,
                             "this emitter is a sphere scaled unevenly, which cannot be sampled as \
                              a light: it is drawn glowing but lights nothing directly",
                         );
-                        None
-                    }
-                };
+                            None
+                        }
+                    };
                 let material = self.emissive(intensity, surface, light);
                 self.instances.push(Instance {
                     geometry,
@@ -734,19 +784,18 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         definition: &'desc ShapeDesc,
         matrix: Option<Matrix4>,
         intensity: Color,
-    ) -> Option<Light> {
+    ) -> Result<Option<Light>, SceneError> {
         let matrix = matrix.unwrap_or(Matrix4::IDENTITY);
-        match &definition.kind {
+        Ok(match &definition.kind {
             ShapeKindDesc::Sphere { center, radius } => {
-                let scale = uniform_scale(&matrix)?;
-                Some(Light::Sphere {
+                uniform_scale(&matrix).map(|scale| Light::Sphere {
                     center: matrix.transform_point(*center),
                     radius: radius * scale,
                     intensity,
                 })
             }
             ShapeKindDesc::Mesh { file } => {
-                let triangles = self.mesh(file).map_or_else(Vec::new, |mesh| mesh.to_vec());
+                let triangles = self.mesh(file)?.map_or_else(Vec::new, |mesh| mesh.to_vec());
                 Some(Light::Triangles {
                     triangles: transform_triangles(&triangles, &matrix),
                     intensity,
@@ -759,12 +808,12 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                     intensity,
                 })
             }
-        }
+        })
     }
 
     // ---- background and result -----------------------------------------------------------
 
-    fn background(&mut self) -> Background {
+    fn background(&mut self) -> Result<Background, SceneError> {
         let background = &self.desc.background;
         // FORMAT.md A4: sceneParameters.bgColor outranks the scene's bgColor/_bgColor; black
         // when neither is given.
@@ -774,10 +823,21 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             .or(background.scene_bg_color.as_ref())
             .map_or(Vec3::ZERO, |color| color.value);
         if let Some(prefix) = &background.env_map_prefix {
-            match load_cube_map(self.base_directory, &prefix.value, self.assets) {
-                Ok(map) => return Background::CubeMap(Box::new(map)),
+            match load_cube_map(
+                self.base_directory,
+                &prefix.value,
+                self.assets,
+                &mut self.texture_budget,
+            ) {
+                Ok(map) => return Ok(Background::CubeMap(Box::new(map))),
+                Err(AssetError::Refused(why)) => {
+                    return Err(self.diagnostics.error(
+                        prefix.span,
+                        format!("environment map `{}` is refused: {why}", prefix.value),
+                    ))
+                }
                 // FORMAT.md 2.1, A17: `data/reef_` never existed; a missing map means no map.
-                Err(error) => self.diagnostics.warn(
+                Err(AssetError::Failed(error)) => self.diagnostics.warn(
                     prefix.span,
                     format!(
                         "environment map `{}`: {error}; the background colour is used instead",
@@ -788,11 +848,24 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         }
         if let Some(cross) = &background.env_map_vertical_cross {
             let path = self.resolve_path(&cross.value);
-            let faces = load_image(&path, self.assets)
-                .map_err(|error| format!("cannot read ({}): {error}", path.display()))
-                .and_then(|image| cut_vertical_cross(&image));
+            let faces = match load_image(&path, self.assets, &mut self.texture_budget) {
+                Err(AssetError::Refused(why)) => {
+                    return Err(self.diagnostics.error(
+                        cross.span,
+                        format!(
+                            "environment map `{}` ({}) is refused: {why}",
+                            cross.value,
+                            path.display()
+                        ),
+                    ))
+                }
+                Err(AssetError::Failed(error)) => {
+                    Err(format!("cannot read ({}): {error}", path.display()))
+                }
+                Ok(image) => cut_vertical_cross(&image),
+            };
             match faces {
-                Ok(faces) => return Background::CubeMap(Box::new(CubeMap { faces })),
+                Ok(faces) => return Ok(Background::CubeMap(Box::new(CubeMap { faces }))),
                 Err(error) => self.diagnostics.warn(
                     cross.span,
                     format!(
@@ -802,7 +875,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 ),
             }
         }
-        Background::Color(color)
+        Ok(Background::Color(color))
     }
 
     fn finish(mut self, camera: Camera, background: Background) -> SceneParts {

@@ -2,8 +2,12 @@
 //! the way compilers report. Errors stop the load (`SceneError`); warnings are collected and
 //! handed back with the scene so the application decides how to show them.
 
+use std::cell::OnceCell;
+use std::collections::HashSet;
 use std::fmt;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use crate::desc::Span;
 
@@ -27,9 +31,31 @@ pub struct Diagnostic {
     /// 1-based column, counted in characters.
     pub column: u32,
     pub message: String,
-    /// The text of the offending line (without its line break), for display. `Display` shows
-    /// an excerpt around the column when the line is very long.
-    pub source_line: Option<String>,
+    /// The offending line, for display: a span into the scene's text, shared by every
+    /// diagnostic of the file, so that thousands of warnings on one long line cost no copies.
+    pub source: Option<SourceLine>,
+}
+
+/// One line of a scene file's text: the whole text (shared) and the line's byte range in it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SourceLine {
+    text: Arc<str>,
+    range: Range<usize>,
+}
+
+impl SourceLine {
+    /// A line on its own (for diagnostics made outside the loader, and tests).
+    pub fn new(line: &str) -> SourceLine {
+        SourceLine {
+            text: Arc::from(line),
+            range: 0..line.len(),
+        }
+    }
+
+    /// The line's text, without its line break.
+    pub fn as_str(&self) -> &str {
+        &self.text[self.range.clone()]
+    }
 }
 
 impl fmt::Display for Diagnostic {
@@ -54,11 +80,17 @@ impl fmt::Display for Diagnostic {
 }
 
 impl Diagnostic {
+    /// The text of the offending line (without its line break), when known. `Display` shows
+    /// an excerpt around the column when the line is very long.
+    pub fn source_line(&self) -> Option<&str> {
+        self.source.as_ref().map(SourceLine::as_str)
+    }
+
     /// The offending line and, below it, a caret under the column: two lines for display, or
     /// `None` when the source line is unknown. A long line is cut to an excerpt around the
     /// column.
     pub fn source_excerpt(&self) -> Option<String> {
-        let source_line = self.source_line.as_ref()?;
+        let source_line = self.source_line()?;
         let (shown, caret_offset) =
             excerpt_around(source_line, self.column.saturating_sub(1) as usize);
         // Reuse the line's own tabs in front of the caret so it lines up however wide the
@@ -78,13 +110,13 @@ const SHOWN_LINE_LIMIT: usize = 120;
 
 /// The part of `line` to display and the caret's character offset in it.
 fn excerpt_around(line: &str, column_index: usize) -> (String, usize) {
-    let characters: Vec<char> = line.chars().collect();
-    if characters.len() <= SHOWN_LINE_LIMIT {
+    let length = line.chars().count();
+    if length <= SHOWN_LINE_LIMIT {
         return (line.to_owned(), column_index);
     }
     let start = column_index
         .saturating_sub(SHOWN_LINE_LIMIT / 2)
-        .min(characters.len() - SHOWN_LINE_LIMIT);
+        .min(length - SHOWN_LINE_LIMIT);
     let end = start + SHOWN_LINE_LIMIT;
     let mut shown = String::new();
     let mut caret_offset = column_index - start;
@@ -92,8 +124,8 @@ fn excerpt_around(line: &str, column_index: usize) -> (String, usize) {
         shown.push_str("...");
         caret_offset += 3;
     }
-    shown.extend(&characters[start..end]);
-    if end < characters.len() {
+    shown.extend(line.chars().skip(start).take(SHOWN_LINE_LIMIT));
+    if end < length {
         shown.push_str("...");
     }
     (shown, caret_offset)
@@ -159,14 +191,23 @@ impl<'text> LineIndex<'text> {
     }
 
     /// The text of 1-based `line`, without its line break.
+    #[cfg(test)]
     pub fn line_text(&self, line: u32) -> Option<&'text str> {
+        self.line_range(line).map(|range| &self.text[range])
+    }
+
+    /// The byte range of 1-based `line`, without its line break.
+    pub fn line_range(&self, line: u32) -> Option<Range<usize>> {
         let index = (line as usize).checked_sub(1)?;
         let start = *self.line_starts.get(index)?;
-        let end = self
+        let mut end = self
             .line_starts
             .get(index + 1)
             .map_or(self.text.len(), |&next| next - 1);
-        Some(self.text[start..end].trim_end_matches('\r'))
+        if end > start && self.text.as_bytes()[end - 1] == b'\r' {
+            end -= 1;
+        }
+        Some(start..end)
     }
 }
 
@@ -175,7 +216,11 @@ impl<'text> LineIndex<'text> {
 pub(crate) struct Diagnostics<'text> {
     path: PathBuf,
     lines: LineIndex<'text>,
+    /// The text, copied once when the first diagnostic needs it, shared by all of them.
+    shared_text: OnceCell<Arc<str>>,
     warnings: Vec<Diagnostic>,
+    /// (line, column, message) of every warning kept: a repeated warning is dropped in O(1).
+    seen: HashSet<(u32, u32, String)>,
 }
 
 impl<'text> Diagnostics<'text> {
@@ -183,7 +228,9 @@ impl<'text> Diagnostics<'text> {
         Diagnostics {
             path: path.to_path_buf(),
             lines: LineIndex::new(text),
+            shared_text: OnceCell::new(),
             warnings: Vec::new(),
+            seen: HashSet::new(),
         }
     }
 
@@ -192,18 +239,29 @@ impl<'text> Diagnostics<'text> {
     }
 
     fn diagnostic(&self, severity: Severity, span: Span, message: String) -> Diagnostic {
+        let source = self.lines.line_range(span.line).map(|range| SourceLine {
+            text: self
+                .shared_text
+                .get_or_init(|| Arc::from(self.lines.text))
+                .clone(),
+            range,
+        });
         Diagnostic {
             severity,
             path: self.path.clone(),
             line: span.line,
             column: span.column,
             message,
-            source_line: self.lines.line_text(span.line).map(str::to_owned),
+            source,
         }
     }
 
     pub fn warn(&mut self, span: Span, message: impl Into<String>) {
-        let diagnostic = self.diagnostic(Severity::Warning, span, message.into());
+        let message = message.into();
+        if !self.seen.insert((span.line, span.column, message.clone())) {
+            return;
+        }
+        let diagnostic = self.diagnostic(Severity::Warning, span, message);
         self.warnings.push(diagnostic);
     }
 
@@ -288,6 +346,22 @@ mod tests {
     }
 
     #[test]
+    fn repeated_warnings_are_kept_once() {
+        let text = "one\ntwo\n";
+        let mut diagnostics = Diagnostics::new(Path::new("s.xml"), text);
+        let at = Span { line: 2, column: 1 };
+        for _ in 0..3 {
+            diagnostics.warn(at, "same");
+        }
+        diagnostics.warn(at, "other");
+        diagnostics.warn(Span { line: 1, column: 1 }, "same");
+        let warnings = diagnostics.into_warnings();
+        assert_eq!(warnings.len(), 3);
+        assert_eq!(warnings[0].source_line(), Some("two"));
+        assert_eq!(warnings[2].source_line(), Some("one"));
+    }
+
+    #[test]
     fn suggestions_need_a_close_candidate() {
         assert_eq!(
             did_you_mean("Mirrored", ["Lambertian", "Mirror"]),
@@ -313,7 +387,7 @@ mod tests {
             line: 3,
             column: 5,
             message: "something".into(),
-            source_line: Some("\tab cd".into()),
+            source: Some(SourceLine::new("\tab cd")),
         };
         assert_eq!(
             diagnostic.to_string(),
@@ -330,7 +404,7 @@ mod tests {
             line: 1,
             column: 501,
             message: "here".into(),
-            source_line: Some(line),
+            source: Some(SourceLine::new(&line)),
         };
         let shown = diagnostic.to_string();
         let lines: Vec<&str> = shown.lines().collect();

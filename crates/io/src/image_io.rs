@@ -7,8 +7,22 @@ use std::path::{Path, PathBuf};
 
 use glint_render::{Color, CubeMap, Film, Image, Vec3};
 
-use crate::assets::Assets;
+use crate::assets::{AssetError, Assets, TooLarge};
 use crate::display::{PngEncoding, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD};
+use crate::limits::{format_bytes, Limits, BYTES_PER_TEXEL};
+
+/// The texture memory a load may still take, charged image by image before each decode.
+#[derive(Debug)]
+pub(crate) struct TextureBudget {
+    pub limits: Limits,
+    pub used: u64,
+}
+
+impl TextureBudget {
+    pub fn new(limits: Limits) -> TextureBudget {
+        TextureBudget { limits, used: 0 }
+    }
+}
 
 /// Reads a texture or environment-map image as linear RGB; alpha is dropped.
 ///
@@ -18,24 +32,65 @@ use crate::display::{PngEncoding, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD}
 ///
 /// Every other image is 8-bit or converted to 8 bits, and the course applies no gamma anywhere
 /// (FORMAT.md 1.3), so a texel is its 8-bit value / 255.
-pub(crate) fn load_image(path: &Path, assets: &dyn Assets) -> Result<Image, String> {
-    let bytes = assets.read(path).map_err(|error| error.to_string())?;
-    decode_image(&bytes)
+pub(crate) fn load_image(
+    path: &Path,
+    assets: &dyn Assets,
+    budget: &mut TextureBudget,
+) -> Result<Image, AssetError> {
+    let bytes = assets
+        .read_at_most(path, budget.limits.max_file_bytes)
+        .map_err(|error| match TooLarge::of(&error) {
+            Some(too_large) => {
+                AssetError::Refused(format!("{too_large} (--max-file-size raises it)"))
+            }
+            None => AssetError::Failed(error.to_string()),
+        })?;
+    decode_image(&bytes, budget)
 }
 
-/// Decodes an image held in memory, its format told by its content.
-pub(crate) fn decode_image(bytes: &[u8]) -> Result<Image, String> {
-    let reader = image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|error| error.to_string())?;
-    let decoded = reader.decode().map_err(|error| error.to_string())?;
+/// Decodes an image held in memory, its format told by its content, after checking the
+/// dimensions its header declares against the limits and charging its memory to `budget`.
+pub(crate) fn decode_image(bytes: &[u8], budget: &mut TextureBudget) -> Result<Image, AssetError> {
+    let failed = |error: image::ImageError| AssetError::Failed(error.to_string());
+    let reader = || {
+        image::ImageReader::new(std::io::Cursor::new(bytes))
+            .with_guessed_format()
+            .map_err(|error| AssetError::Failed(error.to_string()))
+    };
+    let (width, height) = reader()?.into_dimensions().map_err(failed)?;
+    let side = budget.limits.max_texture_side;
+    if width > side || height > side {
+        return Err(AssetError::Refused(format!(
+            "the image is {width} x {height} pixels, larger than the limit of {side} pixels a \
+             side (--max-texture-size raises it)"
+        )));
+    }
+    let cost = u64::from(width) * u64::from(height) * BYTES_PER_TEXEL;
+    let remaining = budget.limits.max_texture_bytes.saturating_sub(budget.used);
+    if cost > remaining {
+        return Err(AssetError::Refused(format!(
+            "the image is {width} x {height} pixels and would take {} with the textures \
+             before it, more than the limit of {} (--max-memory raises it)",
+            format_bytes(budget.used + cost),
+            format_bytes(budget.limits.max_texture_bytes)
+        )));
+    }
+    let mut decode_limits = image::Limits::default();
+    decode_limits.max_image_width = Some(side);
+    decode_limits.max_image_height = Some(side);
+    decode_limits.max_alloc = Some(remaining);
+    let mut reader = reader()?;
+    reader.limits(decode_limits);
+    let decoded = reader.decode().map_err(failed)?;
+    budget.used += cost;
     if matches!(
         decoded,
         image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
     ) {
-        return float_image(decoded.to_rgb32f());
+        return float_image(decoded.to_rgb32f()).map_err(AssetError::Failed);
     }
     let rgb = decoded.to_rgb8();
+    drop(decoded);
     let (width, height) = rgb.dimensions();
     let texels = rgb
         .pixels()
@@ -149,18 +204,24 @@ pub(crate) fn load_cube_map(
     directory: &Path,
     prefix: &str,
     assets: &dyn Assets,
-) -> Result<CubeMap, String> {
+    budget: &mut TextureBudget,
+) -> Result<CubeMap, AssetError> {
     let mut faces = Vec::with_capacity(6);
     let extension = cube_face_extension(directory, prefix, assets);
     for name in cube_face_paths(prefix, extension) {
         let path = directory.join(&name);
-        let face = load_image(&path, assets)
-            .map_err(|error| format!("cannot read face `{name}` ({}): {error}", path.display()))?;
+        let in_face = |error: String| format!("face `{name}` ({}): {error}", path.display());
+        let face = load_image(&path, assets, budget).map_err(|error| match error {
+            AssetError::Refused(message) => AssetError::Refused(in_face(message)),
+            AssetError::Failed(message) => {
+                AssetError::Failed(format!("cannot read {}", in_face(message)))
+            }
+        })?;
         faces.push(face);
     }
     let faces: [Image; 6] = faces
         .try_into()
-        .map_err(|_| "a cube map needs six faces".to_owned())?;
+        .map_err(|_| AssetError::Failed("a cube map needs six faces".to_owned()))?;
     Ok(CubeMap { faces })
 }
 
@@ -277,23 +338,30 @@ pub fn write_image_with(
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
+    // Encoded in memory first, so the temporary file exists only for the write and rename:
+    // a process killed while encoding leaves nothing behind.
+    let mut encoded = std::io::Cursor::new(Vec::new());
+    match format {
+        OutputFormat::Png => encode_png(film, &options.png, &mut encoded),
+        OutputFormat::Exr => encode_exr(film, &mut encoded),
+    }
+    .map_err(|source| ImageWriteError::Encode {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    // The process id in the name tells a later run whether the writer is gone for good
+    // (`remove_stale_partials`).
     let mut temporary = tempfile::Builder::new()
-        .prefix(".glint-")
-        .suffix(".partial")
+        .prefix(&format!("{PARTIAL_PREFIX}{}-", std::process::id()))
+        .suffix(PARTIAL_SUFFIX)
         .tempfile_in(directory)
         .map_err(io_error)?;
     {
         let mut writer = BufWriter::new(temporary.as_file_mut());
-        match format {
-            OutputFormat::Png => encode_png(film, &options.png, &mut writer),
-            OutputFormat::Exr => encode_exr(film, &mut writer),
-        }
-        .map_err(|source| ImageWriteError::Encode {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        writer.write_all(encoded.get_ref()).map_err(io_error)?;
         writer.flush().map_err(io_error)?;
     }
+    drop(encoded);
     temporary.as_file().sync_all().map_err(io_error)?;
     set_readable_permissions(temporary.as_file(), path).map_err(io_error)?;
     // The temporary file is removed when `temporary` drops on any error above.
@@ -303,10 +371,79 @@ pub fn write_image_with(
     Ok(())
 }
 
+/// Temporary files are `.glint-PID-RANDOM.partial`, beside the output.
+const PARTIAL_PREFIX: &str = ".glint-";
+const PARTIAL_SUFFIX: &str = ".partial";
+
+/// Removes the temporary files (`.glint-PID-RANDOM.partial`) that runs killed between creating
+/// and renaming them left in `directory`, and returns how many. A file counts as stale only
+/// when it is surely abandoned: the process named in it is gone and the file is older than
+/// this process (so a live writer is never robbed, even one whose PID is reused). Where
+/// whether a process lives cannot be told (outside Linux), nothing is removed.
+pub fn remove_stale_partials(directory: &Path) -> usize {
+    let Some(started) = process_start() else {
+        return 0;
+    };
+    let Ok(entries) = std::fs::read_dir(directory) else {
+        return 0;
+    };
+    let own = std::process::id();
+    let mut removed = 0;
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let Some(pid) = name.to_str().and_then(partial_pid) else {
+            continue;
+        };
+        let Ok(metadata) = entry.metadata() else {
+            continue;
+        };
+        let older = metadata.modified().is_ok_and(|modified| modified < started);
+        if pid != own
+            && metadata.is_file()
+            && older
+            && !process_alive(pid)
+            && std::fs::remove_file(entry.path()).is_ok()
+        {
+            removed += 1;
+        }
+    }
+    removed
+}
+
+/// The process id in a temporary file's name, when it is one of ours.
+fn partial_pid(name: &str) -> Option<u32> {
+    let rest = name
+        .strip_prefix(PARTIAL_PREFIX)?
+        .strip_suffix(PARTIAL_SUFFIX)?;
+    let (pid, random) = rest.split_once('-')?;
+    (!random.is_empty()).then_some(())?;
+    pid.parse().ok()
+}
+
+#[cfg(target_os = "linux")]
+fn process_start() -> Option<std::time::SystemTime> {
+    std::fs::metadata("/proc/self").ok()?.modified().ok()
+}
+
+#[cfg(not(target_os = "linux"))]
+fn process_start() -> Option<std::time::SystemTime> {
+    None
+}
+
+#[cfg(target_os = "linux")]
+fn process_alive(pid: u32) -> bool {
+    Path::new("/proc").join(pid.to_string()).exists()
+}
+
+#[cfg(not(target_os = "linux"))]
+fn process_alive(_pid: u32) -> bool {
+    true
+}
+
 fn encode_png(
     film: &Film,
     encoding: &PngEncoding,
-    writer: &mut BufWriter<&mut File>,
+    writer: &mut std::io::Cursor<Vec<u8>>,
 ) -> Result<(), EncodeError> {
     let mut encoder = png::Encoder::new(writer, film.width, film.height);
     encoder.set_color(png::ColorType::Rgb);
@@ -339,7 +476,7 @@ pub const DEPTH_CHANNEL: &str = "Depth.Z";
 
 /// One EXR part with f32 channels R, G, B (the beauty) and the feature layers' channels, rows
 /// from the top, as the `exr` crate stores them.
-fn encode_exr(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), EncodeError> {
+fn encode_exr(film: &Film, writer: &mut std::io::Cursor<Vec<u8>>) -> Result<(), EncodeError> {
     use exr::prelude::{
         AnyChannel, AnyChannels, Encoding, FlatSamples, Image as ExrImage, Layer, LayerAttributes,
         WritableImage,
@@ -473,6 +610,41 @@ mod tests {
     }
 
     #[test]
+    fn only_abandoned_temporary_files_are_removed() {
+        assert_eq!(partial_pid(".glint-123-abc.partial"), Some(123));
+        assert_eq!(partial_pid(".glint-abc.partial"), None);
+        assert_eq!(partial_pid(".glint-123-.partial"), None);
+        assert_eq!(partial_pid("glint-123-abc.partial"), None);
+        if process_start().is_none() {
+            return;
+        }
+        let directory = tempfile::tempdir().unwrap();
+        // A process id that cannot be alive (above Linux's pid_max of 2^22).
+        let dead = directory.path().join(".glint-4999999-x1.partial");
+        let ours = directory
+            .path()
+            .join(format!(".glint-{}-x2.partial", std::process::id()));
+        let other = directory.path().join(".glint-4999999-x3.png");
+        for path in [&dead, &ours, &other] {
+            std::fs::write(path, b"partial").unwrap();
+        }
+        // Made after this process started: not surely stale yet.
+        assert_eq!(remove_stale_partials(directory.path()), 0);
+        let old = std::time::SystemTime::UNIX_EPOCH + std::time::Duration::from_secs(1_000_000);
+        for path in [&dead, &ours, &other] {
+            File::options()
+                .write(true)
+                .open(path)
+                .unwrap()
+                .set_modified(old)
+                .unwrap();
+        }
+        assert_eq!(remove_stale_partials(directory.path()), 1);
+        assert!(!dead.exists());
+        assert!(ours.exists() && other.exists());
+    }
+
+    #[test]
     fn cube_map_files_are_named_in_face_order() {
         assert_eq!(
             cube_face_paths("images/reef_", "png"),
@@ -503,7 +675,9 @@ mod tests {
                 .save(directory.path().join(name))
                 .unwrap();
         }
-        let map = load_cube_map(directory.path(), "sky_", &crate::FileSystem).unwrap();
+        let mut budget = TextureBudget::new(Limits::default());
+        let map = load_cube_map(directory.path(), "sky_", &crate::FileSystem, &mut budget).unwrap();
+        assert_eq!(budget.used, 6 * 4 * BYTES_PER_TEXEL);
         let directions = [Vec3::X, -Vec3::X, Vec3::Y, -Vec3::Y, Vec3::Z, -Vec3::Z];
         for (direction, color) in directions.into_iter().zip(colors) {
             let expected = Vec3::new(
@@ -522,8 +696,53 @@ mod tests {
     #[test]
     fn missing_cube_map_face_names_the_file() {
         let directory = tempfile::tempdir().unwrap();
-        let error = load_cube_map(directory.path(), "data/reef_", &crate::FileSystem).unwrap_err();
-        assert!(error.contains("data/reef_posX.png"), "{error}");
+        let mut budget = TextureBudget::new(Limits::default());
+        let error = load_cube_map(
+            directory.path(),
+            "data/reef_",
+            &crate::FileSystem,
+            &mut budget,
+        )
+        .unwrap_err();
+        assert!(matches!(error, AssetError::Failed(_)));
+        assert!(error.to_string().contains("data/reef_posX.png"), "{error}");
+    }
+
+    fn png(width: u32, height: u32) -> Vec<u8> {
+        let mut bytes = Vec::new();
+        image::RgbImage::new(width, height)
+            .write_to(
+                &mut std::io::Cursor::new(&mut bytes),
+                image::ImageFormat::Png,
+            )
+            .unwrap();
+        bytes
+    }
+
+    #[test]
+    fn images_over_the_limits_are_refused_before_decoding() {
+        let limits = Limits {
+            max_texture_side: 64,
+            max_texture_bytes: 3 * 32 * 32 * BYTES_PER_TEXEL,
+            ..Limits::default()
+        };
+        let mut budget = TextureBudget::new(limits);
+        let error = decode_image(&png(65, 1), &mut budget).unwrap_err();
+        assert!(
+            matches!(&error, AssetError::Refused(m) if m.contains("65 x 1")),
+            "{error}"
+        );
+        assert_eq!(budget.used, 0);
+        for _ in 0..3 {
+            decode_image(&png(32, 32), &mut budget).unwrap();
+        }
+        let error = decode_image(&png(1, 1), &mut budget).unwrap_err();
+        assert!(
+            matches!(&error, AssetError::Refused(m) if m.contains("--max-memory")),
+            "{error}"
+        );
+        let garbage = decode_image(b"not an image", &mut budget).unwrap_err();
+        assert!(matches!(garbage, AssetError::Failed(_)));
     }
 
     fn float_rgb(values: &[[f32; 3]], width: u32) -> image::Rgb32FImage {
@@ -538,7 +757,12 @@ mod tests {
         for extension in ["exr", "hdr"] {
             let path = directory.path().join(format!("sky.{extension}"));
             float_rgb(&texels, 2).save(&path).unwrap();
-            let image = load_image(&path, &crate::FileSystem).unwrap();
+            let image = load_image(
+                &path,
+                &crate::FileSystem,
+                &mut TextureBudget::new(Limits::default()),
+            )
+            .unwrap();
             assert_eq!((image.width, image.height), (2, 1));
             for (loaded, expected) in image.texels.iter().zip(texels) {
                 // EXR stores f32 exactly; Radiance HDR's shared exponent keeps ~1 % .
@@ -561,7 +785,12 @@ mod tests {
             .unwrap()
             .save(&path)
             .unwrap();
-        let image = load_image(&path, &crate::FileSystem).unwrap();
+        let image = load_image(
+            &path,
+            &crate::FileSystem,
+            &mut TextureBudget::new(Limits::default()),
+        )
+        .unwrap();
         let expected: Vec<f32> = [0u8, 1, 127, 128, 254, 255]
             .into_iter()
             .map(|v| f32::from(v) / 255.0)
@@ -578,8 +807,16 @@ mod tests {
             float_rgb(&[[1.0, 1.0, 1.0], [0.5, bad, 0.5]], 2)
                 .save(&path)
                 .unwrap();
-            let error = load_image(&path, &crate::FileSystem).unwrap_err();
-            assert!(error.contains("texel (1, 0)"), "{what}: {error}");
+            let error = load_image(
+                &path,
+                &crate::FileSystem,
+                &mut TextureBudget::new(Limits::default()),
+            )
+            .unwrap_err();
+            assert!(
+                error.to_string().contains("texel (1, 0)"),
+                "{what}: {error}"
+            );
         }
     }
 
@@ -592,7 +829,13 @@ mod tests {
                 .save(directory.path().join(name))
                 .unwrap();
         }
-        let map = load_cube_map(directory.path(), "sky_", &crate::FileSystem).unwrap();
+        let map = load_cube_map(
+            directory.path(),
+            "sky_",
+            &crate::FileSystem,
+            &mut TextureBudget::new(Limits::default()),
+        )
+        .unwrap();
         assert_eq!(map.lookup(Vec3::X), Vec3::splat(2.0));
         assert_eq!(map.lookup(-Vec3::Z), Vec3::splat(7.0));
     }

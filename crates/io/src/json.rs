@@ -1,6 +1,10 @@
 //! Course JSON (FORMAT.md 3) into the located tree, with jsonc-parser: its AST keeps the byte
-//! range of every value, which serde-style parsers throw away. Comments and trailing commas are
-//! accepted, as hand-edited files sometimes have them.
+//! range of every value, which serde-style parsers throw away.
+//!
+//! The JSON accepted is RFC 8259 plus two extensions hand-edited files sometimes have: comments
+//! (`// ...` and `/* ... */`) and trailing commas. Everything else jsonc-parser could be lenient
+//! about is refused with a located error: unquoted or numeric keys (`{camera: ...}`) and
+//! single-quoted strings (`'red'`).
 
 use jsonc_parser::ast;
 use jsonc_parser::common::Ranged;
@@ -11,17 +15,19 @@ use crate::tree::{Node, Value};
 /// Parses `text` and returns the top-level value as a node with an empty key.
 pub(crate) fn parse(text: &str, diagnostics: &Diagnostics) -> Result<Node, SceneError> {
     check_nesting(text, diagnostics)?;
-    let result = jsonc_parser::parse_to_ast(
-        text,
-        &jsonc_parser::CollectOptions::default(),
-        &jsonc_parser::ParseOptions::default(),
-    )
-    .map_err(|error| {
-        diagnostics.error(
-            diagnostics.span_at(error.range().start),
-            format!("malformed JSON: {}", error.kind()),
-        )
-    })?;
+    let options = jsonc_parser::ParseOptions {
+        allow_comments: true,
+        allow_trailing_commas: true,
+        allow_loose_object_property_names: false,
+    };
+    let result =
+        jsonc_parser::parse_to_ast(text, &jsonc_parser::CollectOptions::default(), &options)
+            .map_err(|error| {
+                diagnostics.error(
+                    diagnostics.span_at(error.range().start),
+                    format!("malformed JSON: {}", error.kind()),
+                )
+            })?;
     let Some(value) = result.value else {
         return Err(diagnostics.error(
             diagnostics.span_at(text.len()),
@@ -37,14 +43,21 @@ pub(crate) fn parse(text: &str, diagnostics: &Diagnostics) -> Result<Node, Scene
 /// anything; such files are refused up front.
 pub(crate) const MAX_NESTING: usize = 100;
 
-/// Counts brackets outside strings and comments, and fails where the nesting gets too deep.
+/// Counts brackets outside strings and comments, and fails where the nesting gets too deep or
+/// where a string is single-quoted (which jsonc-parser would accept).
 fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError> {
     let bytes = text.as_bytes();
     let mut depth = 0usize;
     let mut index = 0;
     while index < bytes.len() {
         match bytes[index] {
-            quote @ (b'"' | b'\'') => {
+            b'\'' => {
+                return Err(diagnostics.error(
+                    diagnostics.span_at(index),
+                    "malformed JSON: strings must be in double quotes (\"...\"), not single quotes",
+                ))
+            }
+            quote @ b'"' => {
                 index += 1;
                 while index < bytes.len() && bytes[index] != quote {
                     index += if bytes[index] == b'\\' { 2 } else { 1 };

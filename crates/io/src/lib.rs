@@ -49,6 +49,7 @@ mod diagnostic;
 mod display;
 mod image_io;
 mod json;
+mod limits;
 mod mesh;
 mod obj;
 mod ply;
@@ -60,16 +61,17 @@ mod xml;
 
 use std::path::Path;
 
-pub use assets::{Assets, FileSystem, MemoryAssets};
-pub use diagnostic::{Diagnostic, SceneError, Severity};
+pub use assets::{read_file_at_most, Assets, FileSystem, MemoryAssets, TooLarge};
+pub use diagnostic::{Diagnostic, SceneError, Severity, SourceLine};
 pub use display::{
     DisplayTransform, PngEncoding, ToneMap, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD,
 };
 pub use image_io::{
-    output_format, write_image, write_image_with, EncodeError, ImageWriteError, OutputFormat,
-    WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
+    output_format, remove_stale_partials, write_image, write_image_with, EncodeError,
+    ImageWriteError, OutputFormat, WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
 };
-pub use mesh::{load_mesh, Mesh, MeshError};
+pub use limits::{format_bytes, Limits, BYTES_PER_TEXEL};
+pub use mesh::{load_mesh, load_mesh_from, Mesh, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
 
 use diagnostic::Diagnostics;
@@ -85,12 +87,19 @@ pub struct LoadedScene {
 /// Loads a course scene file, XML or JSON (told apart by content, then by extension). Assets
 /// (OBJ meshes, textures, environment maps) are found relative to the file's directory.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
-    let bytes = std::fs::read(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    load_scene_limited(path, &Limits::default())
+}
+
+/// [`load_scene`] under `limits`: the scene file and every asset are refused, with an error,
+/// when over them.
+pub fn load_scene_limited(path: &Path, limits: &Limits) -> Result<LoadedScene, SceneError> {
+    let bytes =
+        read_file_at_most(path, limits.max_file_bytes).map_err(|source| SceneError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
     match String::from_utf8(bytes) {
-        Ok(text) => load_scene_from_text(&text, path),
+        Ok(text) => load_scene_with_assets_limited(&text, path, &FileSystem, limits),
         Err(error) => {
             let valid_up_to = error.utf8_error().valid_up_to();
             let valid = String::from_utf8_lossy(&error.as_bytes()[..valid_up_to]).into_owned();
@@ -136,6 +145,16 @@ pub fn load_scene_with_assets(
     path: &Path,
     assets: &dyn Assets,
 ) -> Result<LoadedScene, SceneError> {
+    load_scene_with_assets_limited(text, path, assets, &Limits::default())
+}
+
+/// [`load_scene_with_assets`] under `limits` (the text's own size is the caller's to check).
+pub fn load_scene_with_assets_limited(
+    text: &str,
+    path: &Path,
+    assets: &dyn Assets,
+    limits: &Limits,
+) -> Result<LoadedScene, SceneError> {
     // A byte-order mark is not part of line 1's columns.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut diagnostics = Diagnostics::new(path, text);
@@ -146,7 +165,7 @@ pub fn load_scene_with_assets(
     };
     let desc = read::read_document(&root, format, &mut diagnostics)?;
     let base_directory = path.parent().unwrap_or(Path::new(""));
-    let parts = build::build(&desc, base_directory, assets, &mut diagnostics)?;
+    let parts = build::build(&desc, base_directory, assets, limits, &mut diagnostics)?;
     Ok(LoadedScene {
         parts,
         warnings: diagnostics.into_warnings(),

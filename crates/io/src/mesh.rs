@@ -2,12 +2,11 @@
 //! any scene file: what `glint bench`
 //! traces and what the acceleration tests and benches load from `../shared/models`.
 
-use std::fs::File;
-use std::io::BufReader;
 use std::path::{Path, PathBuf};
 
 use glint_render::{GeometryDesc, Shape, Vec3};
 
+use crate::assets::{Assets, FileSystem};
 use crate::ply;
 
 /// An indexed triangle mesh: positions and corner indices into them.
@@ -59,6 +58,11 @@ pub enum MeshError {
 /// Loads an OBJ (by tobj, polygons fan-triangulated) or PLY (`ply.rs`) mesh, told apart by
 /// the extension.
 pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
+    load_mesh_from(path, &FileSystem)
+}
+
+/// [`load_mesh`] reading from `assets` (files held in memory, as the fuzz targets do).
+pub fn load_mesh_from(path: &Path, assets: &dyn Assets) -> Result<Mesh, MeshError> {
     let extension = path
         .extension()
         .map(|extension| extension.to_string_lossy().to_lowercase());
@@ -66,28 +70,23 @@ pub fn load_mesh(path: &Path) -> Result<Mesh, MeshError> {
         path: path.to_path_buf(),
         message,
     };
-    match extension.as_deref() {
-        Some("ply") => {
-            let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
-            let (positions, triangles) = ply::parse(&bytes).map_err(|e| format_error(e.0))?;
-            Ok(Mesh {
-                positions: positions.into_iter().map(Vec3::from_array).collect(),
-                triangles,
-            })
-        }
-        Some("obj") => {
-            let file = File::open(path).map_err(|source| MeshError::Io {
-                path: path.to_path_buf(),
-                source,
-            })?;
-            crate::obj::read_obj(&mut BufReader::new(file)).map_err(format_error)
-        }
-        _ => Err(MeshError::UnknownFormat {
+    if !matches!(extension.as_deref(), Some("ply" | "obj")) {
+        return Err(MeshError::UnknownFormat {
             path: path.to_path_buf(),
-        }),
+        });
+    }
+    let bytes = assets.read(path).map_err(|source| MeshError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    if extension.as_deref() == Some("ply") {
+        let (positions, triangles) = ply::parse(&bytes).map_err(|e| format_error(e.0))?;
+        Ok(Mesh {
+            positions: positions.into_iter().map(Vec3::from_array).collect(),
+            triangles,
+        })
+    } else {
+        crate::obj::read_obj(&mut bytes.as_slice()).map_err(format_error)
     }
 }
 

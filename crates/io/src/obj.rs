@@ -7,17 +7,59 @@ use std::path::Path;
 
 use glint_render::Vec3;
 
-use crate::assets::Assets;
+use crate::assets::{AssetError, Assets, TooLarge};
+use crate::limits::Limits;
 use crate::mesh::Mesh;
 
 /// The triangles of an OBJ file, polygons fan-triangulated (`al.obj` has faces of 3 to 23
 /// vertices). Errors are messages for a warning.
-pub(crate) fn load_triangles(path: &Path, assets: &dyn Assets) -> Result<Vec<[Vec3; 3]>, String> {
-    let bytes = assets.read(path).map_err(|error| error.to_string())?;
-    let mesh = read_obj(&mut bytes.as_slice())?;
+/// The file is refused (not only skipped) when it is over the limits: more than
+/// `limits.max_file_bytes`, or faces that would make more than `limits.max_triangles`.
+pub(crate) fn load_triangles(
+    path: &Path,
+    assets: &dyn Assets,
+    limits: &Limits,
+) -> Result<Vec<[Vec3; 3]>, AssetError> {
+    let bytes =
+        assets
+            .read_at_most(path, limits.max_file_bytes)
+            .map_err(|error| match TooLarge::of(&error) {
+                Some(too_large) => {
+                    AssetError::Refused(format!("{too_large} (--max-file-size raises it)"))
+                }
+                None => AssetError::Failed(error.to_string()),
+            })?;
+    let triangles = count_triangles(&bytes);
+    if triangles > limits.max_triangles {
+        return Err(AssetError::Refused(format!(
+            "its faces make {triangles} triangles, more than the limit of {} \
+             (--max-triangles raises it)",
+            limits.max_triangles
+        )));
+    }
+    let mesh = read_obj(&mut bytes.as_slice()).map_err(AssetError::Failed)?;
     Ok((0..mesh.triangles.len())
         .map(|index| mesh.triangle(index))
         .collect())
+}
+
+/// How many triangles the `f` records of an OBJ file make when fan-triangulated, counted
+/// before parsing so that a face of millions of corners is refused before it is expanded.
+pub(crate) fn count_triangles(bytes: &[u8]) -> u64 {
+    bytes
+        .split(|&byte| byte == b'\n')
+        .filter_map(|line| {
+            let line = line.strip_prefix(b"f")?;
+            if !line.first().is_some_and(u8::is_ascii_whitespace) {
+                return None;
+            }
+            let corners = line
+                .split(u8::is_ascii_whitespace)
+                .filter(|token| !token.is_empty())
+                .count() as u64;
+            Some(corners.saturating_sub(2))
+        })
+        .sum()
 }
 
 /// The one OBJ reader: scene meshes (`load_triangles`) and stand-alone meshes
@@ -77,7 +119,7 @@ mod tests {
             "mtllib missing.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 2 0\nusemtl x\nf 1 2 3 4 5\n",
         )
         .unwrap();
-        let triangles = load_triangles(&path, &crate::FileSystem).unwrap();
+        let triangles = load_triangles(&path, &crate::FileSystem, &Limits::default()).unwrap();
         assert_eq!(triangles.len(), 3);
         assert_eq!(
             triangles[0],
@@ -89,9 +131,13 @@ mod tests {
 
     #[test]
     fn missing_file_is_an_error_message() {
-        let error =
-            load_triangles(Path::new("/nonexistent/file.obj"), &crate::FileSystem).unwrap_err();
-        assert!(error.contains("No such file"), "{error}");
+        let error = load_triangles(
+            Path::new("/nonexistent/file.obj"),
+            &crate::FileSystem,
+            &Limits::default(),
+        )
+        .unwrap_err();
+        assert!(matches!(&error, AssetError::Failed(m) if m.contains("No such file")));
     }
 
     #[test]
@@ -110,11 +156,41 @@ mod tests {
         for (index, contents) in cases.iter().enumerate() {
             let path = directory.path().join(format!("case{index}.obj"));
             std::fs::write(&path, contents).unwrap();
-            let _ = load_triangles(&path, &crate::FileSystem);
+            let _ = load_triangles(&path, &crate::FileSystem, &Limits::default());
         }
         let path = directory.path().join("case7.obj");
-        assert!(load_triangles(&path, &crate::FileSystem)
-            .unwrap_err()
-            .contains("not finite"));
+        let error = load_triangles(&path, &crate::FileSystem, &Limits::default()).unwrap_err();
+        assert!(error.to_string().contains("not finite"), "{error}");
+    }
+
+    #[test]
+    fn meshes_over_the_limits_are_refused() {
+        assert_eq!(
+            count_triangles(b"v 0 0 0\nf 1 2 3\nf 1 2 3 4 5\nfoo 1 2 3\n"),
+            4
+        );
+        let mut assets = crate::MemoryAssets::new();
+        assets.insert(
+            "huge.obj",
+            b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 1 2 3 1 2 3\n".to_vec(),
+        );
+        let limits = Limits {
+            max_triangles: 6,
+            ..Limits::default()
+        };
+        let error = load_triangles(Path::new("huge.obj"), &assets, &limits).unwrap_err();
+        assert!(
+            matches!(&error, AssetError::Refused(m) if m.contains("7 triangles")),
+            "{error}"
+        );
+        let limits = Limits {
+            max_file_bytes: 10,
+            ..Limits::default()
+        };
+        let error = load_triangles(Path::new("huge.obj"), &assets, &limits).unwrap_err();
+        assert!(
+            matches!(&error, AssetError::Refused(m) if m.contains("10 bytes")),
+            "{error}"
+        );
     }
 }

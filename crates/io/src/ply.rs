@@ -125,7 +125,8 @@ pub fn parse(bytes: &[u8]) -> Result<PlyMesh, PlyError> {
                 let (Some(x), Some(y), Some(z)) = (axis("x"), axis("y"), axis("z")) else {
                     return error("the vertex element has no x, y and z properties");
                 };
-                positions.reserve(element.count);
+                // A header may declare any count; reserve no more than the body could hold.
+                positions.reserve(element.count.min(body.len()));
                 let mut values = vec![0.0f64; element.properties.len()];
                 for index in 0..element.count {
                     for (slot, property) in values.iter_mut().zip(&element.properties) {
@@ -157,7 +158,7 @@ pub fn parse(bytes: &[u8]) -> Result<PlyMesh, PlyError> {
                     return error(format!("the {} element has no index list", element.name));
                 };
                 if !strips {
-                    triangles.reserve(element.count);
+                    triangles.reserve(element.count.min(body.len()));
                 }
                 for _ in 0..element.count {
                     for (k, property) in element.properties.iter().enumerate() {
@@ -515,6 +516,15 @@ mod tests {
             ASCII_QUAD.replace("4 0 1 2 3", "-4 0 1 2 3").into_bytes(),
             truncated,
             vec![0xff; 64],
+            // A header may declare any count: reserving it aborted the process (found in
+            // review for issue 9); now the body runs out first.
+            b"ply\nformat binary_little_endian 1.0\nelement vertex 1000000000000000\n\
+              property float x\nproperty float y\nproperty float z\nend_header\n"
+                .to_vec(),
+            b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\n\
+              property float z\nelement face 1000000000000000\n\
+              property list uchar int vertex_indices\nend_header\n3 0 0 0\n"
+                .to_vec(),
         ];
         for (index, bytes) in cases.iter().enumerate() {
             assert!(parse(bytes).is_err(), "case {index} was accepted");

@@ -12,7 +12,9 @@ use crate::desc::{
 };
 use crate::diagnostic::{did_you_mean, Diagnostics, SceneError};
 use crate::tree::{Node, Value, TEXT_KEY};
-use crate::values::{color, flag, located_number, located_vector, number, string, vector, Fields};
+use crate::values::{
+    color, flag, located_number, located_vector, number, plain_color, string, vector, Fields,
+};
 
 /// Which file format the tree came from; only the top level differs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -97,7 +99,7 @@ fn read_scene(node: &Node, diagnostics: &mut Diagnostics) -> Result<SceneDesc, S
         .find(|entry| entry.raw_key == "_bgColor")
         .or(bg_colors.first());
     if let Some(&chosen) = chosen {
-        background.scene_bg_color = Some(located_vector(chosen, diagnostics)?);
+        background.scene_bg_color = Some(located_color(chosen, diagnostics)?);
         for other in bg_colors
             .iter()
             .filter(|entry| !std::ptr::eq(**entry, chosen))
@@ -154,6 +156,24 @@ fn read_scene(node: &Node, diagnostics: &mut Diagnostics) -> Result<SceneDesc, S
     fields.finish(diagnostics);
 
     if cameras.is_empty() {
+        // A misspelled camera was reported as an unused key, but that warning would be lost
+        // behind this error: say it here, where the misspelling is.
+        let entries = match &node.value {
+            Value::Object(entries) => entries.as_slice(),
+            _ => &[],
+        };
+        if let Some((entry, suggestion)) = entries.iter().find_map(|entry| {
+            let suggestion = did_you_mean(&entry.key, ["camera"]);
+            (!suggestion.is_empty()).then_some((entry, suggestion))
+        }) {
+            return Err(diagnostics.error(
+                entry.key_span,
+                format!(
+                    "the scene has no camera: `{}` is not a scene element{suggestion}",
+                    entry.raw_key
+                ),
+            ));
+        }
         return Err(diagnostics.error(
             node.key_span,
             "the scene has no camera; add a <camera> element (XML) or a \"camera\" entry (JSON)",
@@ -185,7 +205,7 @@ fn read_scene_parameters(
 ) -> Result<(), SceneError> {
     let mut fields = Fields::of(node, "`sceneParameters`", diagnostics)?;
     if let Some(bg_color) = fields.take("bgColor", diagnostics) {
-        background.parameters_bg_color = Some(located_vector(bg_color, diagnostics)?);
+        background.parameters_bg_color = Some(located_color(bg_color, diagnostics)?);
     }
     if let Some(prefix) = fields.take_any(&["envMapPrefix", "envmapPrefix"], diagnostics) {
         background.env_map_prefix = Some(string(prefix, diagnostics)?);
@@ -310,6 +330,25 @@ fn vector_or(
     }
 }
 
+/// A light's intensity, checked as a colour, with a warning and 1 1 1 when missing.
+fn color_or(
+    fields: &mut Fields,
+    key: &'static str,
+    diagnostics: &mut Diagnostics,
+) -> Result<Vec3, SceneError> {
+    match fields.take(key, diagnostics) {
+        Some(node) => plain_color(node, diagnostics),
+        None => vector_or(fields, key, Vec3::ONE, "1 1 1", diagnostics),
+    }
+}
+
+fn located_color(node: &Node, diagnostics: &mut Diagnostics) -> Result<Located<Vec3>, SceneError> {
+    Ok(Located {
+        value: plain_color(node, diagnostics)?,
+        span: node.span,
+    })
+}
+
 /// A positive size (radius, area light extent), with its default when missing.
 fn positive_number(
     fields: &mut Fields,
@@ -347,7 +386,7 @@ fn read_light(node: &Node, diagnostics: &mut Diagnostics) -> Result<Option<Light
             // not taken, so `finish` reports them as unused.
             fields.set_what("a point light");
             let position = vector_or(&mut fields, "position", Vec3::ZERO, "0 0 0", diagnostics)?;
-            let intensity = vector_or(&mut fields, "intensity", Vec3::ONE, "1 1 1", diagnostics)?;
+            let intensity = color_or(&mut fields, "intensity", diagnostics)?;
             LightKindDesc::Point {
                 position,
                 intensity,
@@ -356,7 +395,7 @@ fn read_light(node: &Node, diagnostics: &mut Diagnostics) -> Result<Option<Light
         "area" => {
             fields.set_what("an area light");
             let position = vector_or(&mut fields, "position", Vec3::ZERO, "0 0 0", diagnostics)?;
-            let intensity = vector_or(&mut fields, "intensity", Vec3::ONE, "1 1 1", diagnostics)?;
+            let intensity = color_or(&mut fields, "intensity", diagnostics)?;
             let normal = match fields.take("normal", diagnostics) {
                 Some(normal_node) => {
                     let normal = vector(normal_node, diagnostics)?;
@@ -393,7 +432,7 @@ fn read_light(node: &Node, diagnostics: &mut Diagnostics) -> Result<Option<Light
         }
         "shape" => {
             fields.set_what("a shape light");
-            let intensity = vector_or(&mut fields, "intensity", Vec3::ONE, "1 1 1", diagnostics)?;
+            let intensity = color_or(&mut fields, "intensity", diagnostics)?;
             let Some(shape_node) = fields.take("shape", diagnostics) else {
                 diagnostics.warn(
                     fields.span(),

@@ -175,12 +175,38 @@ pub(crate) fn number(node: &Node, diagnostics: &Diagnostics) -> Result<f64, Scen
             ))
         }
     };
-    parse_finite(text).ok_or_else(|| {
+    let value = parse_finite(text).ok_or_else(|| {
         diagnostics.error(
             node.span,
             format!("expected a number for `{}`, found `{text}`", node.raw_key),
         )
-    })
+    })?;
+    check_magnitude(node, &[value], diagnostics)?;
+    Ok(value)
+}
+
+/// Largest magnitude of any number in a scene. The renderer works in 32-bit floats and
+/// squares lengths (a sphere of radius 1e20 has NaN normals); the course's largest number is
+/// 1000.
+pub(crate) const MAX_MAGNITUDE: f64 = 1e7;
+
+/// A located error when one of `values` is beyond ±`MAX_MAGNITUDE`.
+fn check_magnitude(
+    node: &Node,
+    values: &[f64],
+    diagnostics: &Diagnostics,
+) -> Result<(), SceneError> {
+    match values.iter().find(|value| value.abs() > MAX_MAGNITUDE) {
+        Some(value) => Err(diagnostics.error(
+            node.span,
+            format!(
+                "`{}` holds {value:e}, too large to render in 32-bit arithmetic (numbers must \
+                 lie within ±{MAX_MAGNITUDE:e})",
+                node.raw_key
+            ),
+        )),
+        None => Ok(()),
+    }
 }
 
 pub(crate) fn located_number(
@@ -247,6 +273,7 @@ pub(crate) fn vector(node: &Node, diagnostics: &mut Diagnostics) -> Result<Vec3,
             ),
         ));
     }
+    check_magnitude(node, &numbers[..3], diagnostics)?;
     let vector = Vec3::new(numbers[0] as f32, numbers[1] as f32, numbers[2] as f32);
     if irregular {
         let text = match &node.value {
@@ -361,6 +388,52 @@ pub(crate) fn flag(node: &Node, diagnostics: &Diagnostics) -> Result<bool, Scene
     })
 }
 
+/// Largest magnitude of a colour, intensity or background component. The renderer multiplies
+/// colours along a path in 32-bit floats (at most 3.4e38); components this far above any real
+/// scene's (the course's largest is 60) cannot be rendered without overflowing to infinity.
+pub(crate) const MAX_COLOR_COMPONENT: f32 = 1e6;
+
+/// Checks a colour, intensity or background read from `node`: a component beyond
+/// ±`MAX_COLOR_COMPONENT` is an error, a negative one a warning (it renders, as a colour that
+/// takes light away, which is not physical).
+pub(crate) fn check_color(
+    node: &Node,
+    color: Vec3,
+    diagnostics: &mut Diagnostics,
+) -> Result<Vec3, SceneError> {
+    let components = color.to_array();
+    if let Some(huge) = components
+        .iter()
+        .find(|component| component.abs() > MAX_COLOR_COMPONENT)
+    {
+        return Err(diagnostics.error(
+            node.span,
+            format!(
+                "`{}` has the component {huge:e}, which cannot be rendered: colours and \
+                 intensities must lie within ±{MAX_COLOR_COMPONENT:e}",
+                node.raw_key
+            ),
+        ));
+    }
+    if let Some(negative) = components.iter().find(|component| **component < 0.0) {
+        diagnostics.warn(
+            node.span,
+            format!(
+                "`{}` has the negative component {negative}; light cannot be negative, so the \
+                 image will not be physical",
+                node.raw_key
+            ),
+        );
+    }
+    Ok(color)
+}
+
+/// A colour that is not textured ("r g b"), checked by `check_color`.
+pub(crate) fn plain_color(node: &Node, diagnostics: &mut Diagnostics) -> Result<Vec3, SceneError> {
+    let color = vector(node, diagnostics)?;
+    check_color(node, color, diagnostics)
+}
+
 /// A colour parameter: "r g b", or an object with a texture name and a colour (FORMAT.md 3.4:
 /// `{"tex": "...", "data": "r g b"}`; XML `<diffuse tex="...">r g b</diffuse>`; the converter's
 /// older `{"_tex": "...", "__text": "r g b"}`). Without a colour a texture is used as is,
@@ -368,7 +441,7 @@ pub(crate) fn flag(node: &Node, diagnostics: &Diagnostics) -> Result<bool, Scene
 /// (colour = data ⊙ texel), which is why both are kept.
 pub(crate) fn color(node: &Node, diagnostics: &mut Diagnostics) -> Result<ColorDesc, SceneError> {
     if !matches!(node.value, Value::Object(_)) {
-        return Ok(ColorDesc::constant(vector(node, diagnostics)?));
+        return Ok(ColorDesc::constant(plain_color(node, diagnostics)?));
     }
     let what = format!("the colour `{}`", node.raw_key);
     let mut fields = Fields::of(node, what, diagnostics)?;
@@ -377,7 +450,7 @@ pub(crate) fn color(node: &Node, diagnostics: &mut Diagnostics) -> Result<ColorD
         None => None,
     };
     let color = match fields.take_any(&["data", "text", TEXT_KEY], diagnostics) {
-        Some(data) => vector(data, diagnostics)?,
+        Some(data) => plain_color(data, diagnostics)?,
         None => Vec3::ONE,
     };
     fields.finish(diagnostics);

@@ -369,7 +369,7 @@ fn missing_assets_are_warnings_at_their_location() {
         .ends_with("willemsen/scenes_B/solarSystem.json"));
     assert_eq!((warning.line, warning.column), (56, 17));
     assert_eq!(
-        warning.source_line.as_deref(),
+        warning.source_line(),
         Some("\t\t\"sourcefile\": \"images/jupiter_map_css_plus_juno_bj.png\",")
     );
     let shown = warning.to_string();

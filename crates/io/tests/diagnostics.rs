@@ -153,10 +153,7 @@ fn a_word_where_a_number_belongs_is_an_error() {
     let error = expect_error(fixture.load("word.xml", &text));
     assert_eq!(at(&error), (8, 13));
     assert_eq!(error.message, "expected a number for `radius`, found `abc`");
-    assert_eq!(
-        error.source_line.as_deref(),
-        Some("    <radius>abc</radius>")
-    );
+    assert_eq!(error.source_line(), Some("    <radius>abc</radius>"));
 }
 
 #[test]

@@ -398,6 +398,7 @@ fn render_with<I: Integrator>(
             let mut sum = Color::ZERO;
             let mut valid = 0u32;
             let mut dropped = 0u32;
+            let mut feature_count = 0u32;
             let mut sink = |sample: Sample| {
                 // The one place a sample becomes part of a pixel.
                 if sample.radiance.is_finite() {
@@ -407,9 +408,19 @@ fn render_with<I: Integrator>(
                     dropped += 1;
                 }
                 if let Some(features) = sample.features {
-                    value.albedo += features.albedo;
-                    value.normal += features.normal;
-                    value.depth += features.depth;
+                    // Feature samples are dropped on their own: a NaN normal (a degenerate
+                    // surface) must not reach the layer, nor cost the beauty its sample.
+                    if features.albedo.is_finite()
+                        && features.normal.is_finite()
+                        && features.depth.is_finite()
+                    {
+                        value.albedo += features.albedo;
+                        value.normal += features.normal;
+                        value.depth += features.depth;
+                        feature_count += 1;
+                    } else if sample.radiance.is_finite() {
+                        dropped += 1;
+                    }
                 }
             };
             integrator.pixel_samples(
@@ -419,16 +430,31 @@ fn render_with<I: Integrator>(
                 &mut counters.rays,
                 &mut sink,
             );
-            counters.dropped_samples(pixel_index, dropped);
             if valid > 0 {
                 value.beauty = sum / valid as f32;
+                // Finite samples can still overflow their sum (two of 3e38): then none of
+                // them is usable, and all are counted as dropped.
+                if !value.beauty.is_finite() {
+                    value.beauty = Color::ZERO;
+                    dropped += valid;
+                }
             }
             if settings.features {
-                let count = samples.len().max(1) as f32;
+                let count = feature_count.max(1) as f32;
                 value.albedo = value.albedo / count;
                 value.normal = value.normal / count;
                 value.depth /= count;
+                if !(value.albedo.is_finite()
+                    && value.normal.is_finite()
+                    && value.depth.is_finite())
+                {
+                    value.albedo = Color::ZERO;
+                    value.normal = Vec3::ZERO;
+                    value.depth = 0.0;
+                    dropped += feature_count;
+                }
             }
+            counters.dropped_samples(pixel_index, dropped);
             value
         },
     )?;

@@ -214,6 +214,30 @@ fn non_finite_samples_are_dropped_and_counted() {
 }
 
 #[test]
+fn finite_samples_whose_sum_overflows_are_dropped_and_counted() {
+    // Each sample is finite (3e38), but 16 of them sum to infinity: the pixel must not be
+    // infinite, and the samples are counted. The feature layers stay finite too.
+    let scene = scene(Material::Emissive {
+        radiance: Color::splat(3e38),
+        surface: None,
+        light: None,
+    });
+    for integrator in [IntegratorKind::Course, IntegratorKind::Path] {
+        let s = RenderSettings {
+            samples_per_pixel: 16,
+            ..settings(integrator)
+        };
+        let (film, stats) = render(&scene, &s, &|_| true).unwrap();
+        assert!(film.pixels.iter().all(|c| c.is_finite()), "{integrator:?}");
+        let features = film.features.as_ref().expect("features were asked for");
+        assert!(features.albedo.iter().all(|c| c.is_finite()));
+        assert!(features.normal.iter().all(|n| n.is_finite()));
+        assert!(stats.nonfinite_samples > 0, "{integrator:?}");
+        assert!(stats.first_nonfinite_pixel.is_some(), "{integrator:?}");
+    }
+}
+
+#[test]
 fn cancelling_stops_the_render() {
     let scene = scene(red());
     let result = render(&scene, &settings(IntegratorKind::Course), &|p| {
