@@ -1,0 +1,355 @@
+//! Glint's GPU back end: the path tracer of `--integrator path` as a wgpu compute shader
+//! (WGSL, `path.wgsl`), on any Vulkan adapter, including Mesa's software one (lavapipe), on
+//! which CI tests it.
+//!
+//! It stands on glint-render's public API only: it takes the loaded `SceneParts`, flattens
+//! them into storage buffers itself (`layout`: its own BVH, materials, lights and textures)
+//! and returns a `Film` like `glint_render::render`. Samples are taken in progressive passes
+//! (a few samples per pixel per dispatch, summed in an accumulation buffer), so no dispatch
+//! runs long enough to meet a driver's watchdog.
+//!
+//! ```no_run
+//! use glint_gpu::GpuRenderer;
+//! use glint_render::{IntegratorKind, RenderSettings};
+//!
+//! let loaded = glint_io::load_scene("scene.json".as_ref()).unwrap();
+//! let settings = RenderSettings {
+//!     width: 64,
+//!     height: 64,
+//!     samples_per_pixel: 16,
+//!     integrator: IntegratorKind::Path,
+//!     ..RenderSettings::default()
+//! };
+//! glint_gpu::check_supported(&loaded.parts, &settings).unwrap();
+//! let gpu = GpuRenderer::new().unwrap();
+//! println!("adapter: {}", gpu.adapter_name());
+//! let film = gpu.render(&loaded.parts, &settings, &|_done, _total| true).unwrap();
+//! ```
+//!
+//! The random numbers differ from the CPU's (independent PCG draws instead of scrambled
+//! Sobol' points), so the two back ends agree in distribution, not pixel for pixel; the
+//! tests in `tests/agreement.rs` check that statistically.
+
+mod layout;
+
+use std::sync::mpsc;
+
+use glint_render::{Color, Film, IntegratorKind, RenderSettings, SceneParts};
+use wgpu::util::DeviceExt;
+
+pub use layout::FlatScene;
+
+/// Why the GPU back end did not render.
+#[derive(Debug, thiserror::Error)]
+pub enum GpuError {
+    /// No GPU adapter (no Vulkan driver, or no device).
+    #[error("no GPU adapter found ({0}); install a Vulkan driver (Mesa's software one is Debian's mesa-vulkan-drivers), or render with --device cpu")]
+    NoAdapter(String),
+    /// The scene or the settings ask for something the GPU path does not do.
+    #[error("the GPU path tracer does not support {0}; render with --device cpu")]
+    Unsupported(String),
+    /// The device failed (out of memory, lost, a shader the driver rejected).
+    #[error("GPU error: {0}")]
+    Device(String),
+    /// The progress callback asked to stop.
+    #[error("cancelled")]
+    Cancelled,
+}
+
+/// Refuses, before any device is opened, what the GPU path does not do: any integrator but
+/// the path tracer, feature layers, crop windows and sample ranges. Every scene feature of
+/// `SceneParts` (triangles, spheres, boxes, instances, every material, every light,
+/// textures, both backgrounds, both projections) is supported.
+pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<(), GpuError> {
+    let _ = parts;
+    if settings.integrator != IntegratorKind::Path {
+        return Err(GpuError::Unsupported(format!(
+            "the {:?} integrator (only --integrator path runs on the GPU)",
+            settings.integrator
+        )));
+    }
+    if settings.features {
+        return Err(GpuError::Unsupported(
+            "feature layers (albedo, normal, depth)".into(),
+        ));
+    }
+    if settings.pixel_bounds.is_some() {
+        return Err(GpuError::Unsupported("crop windows (pixel bounds)".into()));
+    }
+    if settings.sample_range.is_some() {
+        return Err(GpuError::Unsupported("sample ranges".into()));
+    }
+    if settings.width == 0 || settings.height == 0 || settings.samples_per_pixel == 0 {
+        return Err(GpuError::Unsupported(
+            "an empty image or zero samples per pixel".into(),
+        ));
+    }
+    Ok(())
+}
+
+/// How many path samples one dispatch traces at most (over the whole image): small enough
+/// that a dispatch on a real GPU lasts milliseconds, far from any watchdog.
+const SAMPLES_PER_DISPATCH: u64 = 1 << 20;
+
+/// The path tracer's depth cap when `-k` is not given (glint-render's `DEFAULT_MAX_DEPTH`).
+const DEFAULT_MAX_DEPTH: u32 = 1024;
+
+/// An opened GPU device with the path-tracing pipeline compiled.
+pub struct GpuRenderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    max_binding: u64,
+}
+
+impl std::fmt::Debug for GpuRenderer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuRenderer")
+            .field("adapter", &self.info.name)
+            .finish()
+    }
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl GpuRenderer {
+    /// Opens the first adapter wgpu finds (high-performance preference) and compiles the
+    /// kernel. `GpuError::NoAdapter` when there is none.
+    pub fn new() -> Result<GpuRenderer, GpuError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::VULKAN,
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
+        });
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|error| GpuError::NoAdapter(error.to_string()))?;
+        let info = adapter.get_info();
+        let limits = adapter.limits();
+        let required_limits = wgpu::Limits {
+            max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
+            max_buffer_size: limits.max_buffer_size,
+            ..wgpu::Limits::default()
+        };
+        let max_binding = required_limits.max_storage_buffer_binding_size as u64;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("glint"),
+            required_limits,
+            ..Default::default()
+        }))
+        .map_err(|error| GpuError::Device(error.to_string()))?;
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("path.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("path.wgsl").into()),
+        });
+        let mut entries = vec![wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        }];
+        entries.extend((1..=6).map(|binding| storage_entry(binding, true)));
+        entries.push(storage_entry(7, false));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("glint scene"),
+            entries: &entries,
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("glint"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("glint path"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        Ok(GpuRenderer {
+            device,
+            queue,
+            max_binding,
+            info,
+            pipeline,
+            layout,
+        })
+    }
+
+    /// The adapter's name and backend, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)".
+    pub fn adapter_name(&self) -> String {
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
+    }
+
+    /// Renders `parts` with the path tracer. `progress(done, total)` hears after every pass
+    /// (samples per pixel done and asked for) and may cancel by returning false.
+    pub fn render(
+        &self,
+        parts: &SceneParts,
+        settings: &RenderSettings,
+        progress: &dyn Fn(u32, u32) -> bool,
+    ) -> Result<Film, GpuError> {
+        check_supported(parts, settings)?;
+        let flat = FlatScene::new(parts);
+        let (width, height) = (settings.width, settings.height);
+        let pixels = width as u64 * height as u64;
+        let mut params = flat.params;
+        params.width = width;
+        params.height = height;
+        params.seed_lo = settings.seed as u32;
+        params.seed_hi = (settings.seed >> 32) as u32;
+        params.max_depth = settings.max_depth.unwrap_or(DEFAULT_MAX_DEPTH);
+        params.camera_w[3] = settings.aspect.unwrap_or(width as f32 / height as f32);
+
+        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
+            // wgpu refuses empty bindings: an empty table is one zero word.
+            let padded: &[u8] = if bytes.is_empty() { &[0u8; 16] } else { bytes };
+            if padded.len() as u64 > self.max_binding {
+                return Err(GpuError::Unsupported(format!(
+                    "a scene whose {label} take {} bytes (the adapter binds at most {})",
+                    padded.len(),
+                    self.max_binding
+                )));
+            }
+            Ok(self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: padded,
+                    usage: wgpu::BufferUsages::STORAGE | extra,
+                }))
+        };
+        let none = wgpu::BufferUsages::empty();
+        let nodes = storage("BVH nodes", bytemuck::cast_slice(&flat.nodes), none)?;
+        let prims = storage("primitives", bytemuck::cast_slice(&flat.prims), none)?;
+        let materials = storage("materials", bytemuck::cast_slice(&flat.materials), none)?;
+        let lights = storage("lights", bytemuck::cast_slice(&flat.lights), none)?;
+        let tables = storage("tables", bytemuck::cast_slice(&flat.tables), none)?;
+        let texels = storage("texels", bytemuck::cast_slice(&flat.texels), none)?;
+        let accum_bytes = vec![0u8; pixels as usize * 16];
+        let accum = storage("accumulation", &accum_bytes, wgpu::BufferUsages::COPY_SRC)?;
+        let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<layout::Params>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("glint scene"),
+            layout: &self.layout,
+            entries: &[
+                (0, &uniform),
+                (1, &nodes),
+                (2, &prims),
+                (3, &materials),
+                (4, &lights),
+                (5, &tables),
+                (6, &texels),
+                (7, &accum),
+            ]
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }),
+        });
+
+        let total = settings.samples_per_pixel;
+        let per_pass = (SAMPLES_PER_DISPATCH / pixels).clamp(1, total as u64) as u32;
+        let mut done = 0u32;
+        while done < total {
+            let samples = per_pass.min(total - done);
+            params.first_sample = done;
+            params.samples = samples;
+            self.queue
+                .write_buffer(&uniform, 0, bytemuck::bytes_of(&params));
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("path samples"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &bind_group, &[]);
+                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+            }
+            self.queue.submit([encoder.finish()]);
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|error| GpuError::Device(error.to_string()))?;
+            done += samples;
+            if !progress(done, total) {
+                return Err(GpuError::Cancelled);
+            }
+        }
+
+        let sums: Vec<[f32; 4]> = self.read_back(&accum, pixels * 16)?;
+        let mut film = Film::new(width, height);
+        for (pixel, sum) in film.pixels.iter_mut().zip(&sums) {
+            // Non-finite samples were dropped; the valid ones are averaged (as the CPU
+            // pipeline does).
+            *pixel = if sum[3] > 0.0 {
+                Color::new(sum[0], sum[1], sum[2]) / sum[3]
+            } else {
+                Color::ZERO
+            };
+        }
+        Ok(film)
+    }
+
+    fn read_back(&self, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<[f32; 4]>, GpuError> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read back"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        let (sender, receiver) = mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |result| {
+            let _ = sender.send(result);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        receiver
+            .recv()
+            .map_err(|error| GpuError::Device(error.to_string()))?
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        let values = bytemuck::cast_slice::<u8, [f32; 4]>(&data).to_vec();
+        drop(data);
+        staging.unmap();
+        Ok(values)
+    }
+}
