@@ -133,6 +133,11 @@ pub struct Options {
           default_value_t = IntegratorArg::Course)]
     pub integrator: IntegratorArg,
 
+    /// Where the path tracer runs: `cpu`, or `gpu` (wgpu on Vulkan; prints the adapter's
+    /// name; only --integrator path).
+    #[arg(long, value_name = "DEVICE", value_enum, default_value_t = DeviceArg::Cpu)]
+    pub device: DeviceArg,
+
     /// Also print the settings and the loading time.
     #[arg(short = 'v', long, action = ArgAction::SetTrue)]
     pub verbose: bool,
@@ -181,6 +186,13 @@ impl From<IntegratorArg> for IntegratorKind {
             IntegratorArg::Depth => IntegratorKind::Depth,
         }
     }
+}
+
+/// `--device` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DeviceArg {
+    Cpu,
+    Gpu,
 }
 
 /// A colour given on the command line.
@@ -257,6 +269,7 @@ pub struct Job {
     pub settings: RenderSettings,
     pub threads: usize,
     pub background: Option<Color>,
+    pub device: DeviceArg,
     pub verbose: bool,
     /// Notes about accepted options that have no effect, printed before rendering.
     pub notes: Vec<String>,
@@ -338,6 +351,7 @@ impl Options {
                 .threads
                 .map_or(available_threads.max(1), |n| n as usize),
             background: self.background.map(Rgb::to_color),
+            device: self.device,
             verbose: self.verbose,
             notes,
         })
@@ -425,6 +439,22 @@ mod tests {
         assert_eq!(job.settings.integrator, IntegratorKind::Course);
         assert_eq!(job.threads, 8);
         assert_eq!(job.background, None);
+        assert_eq!(job.device, DeviceArg::Cpu);
+    }
+
+    #[test]
+    fn device_gpu() {
+        let job = job(&[
+            "render",
+            "s.json",
+            "--integrator",
+            "path",
+            "--device",
+            "gpu",
+        ])
+        .unwrap();
+        assert_eq!(job.device, DeviceArg::Gpu);
+        assert!(job(&["render", "s.json", "--device", "tpu"]).is_err());
     }
 
     #[test]

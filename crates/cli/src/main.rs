@@ -7,6 +7,7 @@
 
 mod args;
 mod bench;
+mod gpu;
 mod run;
 
 use std::io::IsTerminal;

@@ -11,7 +11,7 @@ use glint_io::{Diagnostic, ImageWriteError, SceneError};
 use glint_render::{Background, Progress, RenderError, RenderStats, Scene};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::args::{Job, UsageError};
+use crate::args::{DeviceArg, Job, UsageError};
 
 /// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).
 pub const EXIT_INTERRUPTED: u8 = 130;
@@ -25,6 +25,11 @@ pub enum Failure {
     Scene(SceneError),
     /// The image could not be written (exit 1).
     Write(ImageWriteError),
+    /// The GPU back end cannot render this scene with these settings (exit 2: like a bad
+    /// argument, the user asked for something this device does not do).
+    GpuUnsupported(glint_gpu::GpuError),
+    /// No GPU adapter, or the device failed (exit 1: the machine, not the input, is at fault).
+    Gpu(glint_gpu::GpuError),
     /// The render threads could not be started (exit 1).
     ThreadPool(rayon::ThreadPoolBuildError),
     /// Ctrl-C (exit 130). Nothing was written.
@@ -34,8 +39,8 @@ pub enum Failure {
 impl Failure {
     pub fn exit_code(&self) -> u8 {
         match self {
-            Failure::Usage(_) | Failure::Scene(_) => 2,
-            Failure::Write(_) | Failure::ThreadPool(_) => 1,
+            Failure::Usage(_) | Failure::Scene(_) | Failure::GpuUnsupported(_) => 2,
+            Failure::Write(_) | Failure::ThreadPool(_) | Failure::Gpu(_) => 1,
             Failure::Interrupted => EXIT_INTERRUPTED,
         }
     }
@@ -49,6 +54,7 @@ impl fmt::Display for Failure {
             Failure::Scene(error) => write!(f, "{error}"),
             // It names the file: "cannot write out.png: ...".
             Failure::Write(error) => write!(f, "{error}"),
+            Failure::GpuUnsupported(error) | Failure::Gpu(error) => write!(f, "{error}"),
             Failure::ThreadPool(error) => write!(f, "cannot start the render threads: {error}"),
             Failure::Interrupted => f.write_str("interrupted: no image was written"),
         }
@@ -194,6 +200,9 @@ pub fn run(
     if let Some(color) = job.background {
         parts.background = Background::Color(color);
     }
+    if job.device == DeviceArg::Gpu {
+        return crate::gpu::run(job, &parts, interrupt, err, progress_bar);
+    }
     let scene = pool.install(|| Scene::new(parts));
     let load_time = load_start.elapsed();
 
@@ -317,7 +326,7 @@ fn threads_text(threads: usize) -> String {
     format!("{threads} thread{}", plural(threads as u64))
 }
 
-fn plural(count: u64) -> &'static str {
+pub(crate) fn plural(count: u64) -> &'static str {
     if count == 1 {
         ""
     } else {
@@ -371,6 +380,7 @@ mod tests {
             },
             threads: 2,
             background: None,
+            device: DeviceArg::Cpu,
             verbose: false,
             notes: Vec::new(),
         };

@@ -23,7 +23,7 @@
 //! glint_gpu::check_supported(&loaded.parts, &settings).unwrap();
 //! let gpu = GpuRenderer::new().unwrap();
 //! println!("adapter: {}", gpu.adapter_name());
-//! let film = gpu.render(&loaded.parts, &settings, &|_done, _total| true).unwrap();
+//! let (film, stats) = gpu.render(&loaded.parts, &settings, &|_done, _total| true).unwrap();
 //! ```
 //!
 //! The random numbers differ from the CPU's (independent PCG draws instead of scrambled
@@ -34,7 +34,7 @@ mod layout;
 
 use std::sync::mpsc;
 
-use glint_render::{Color, Film, IntegratorKind, RenderSettings, SceneParts};
+use glint_render::{Color, Features, Film, IntegratorKind, RenderSettings, SceneParts, Vec3};
 use wgpu::util::DeviceExt;
 
 pub use layout::FlatScene;
@@ -51,48 +51,50 @@ pub enum GpuError {
     /// The device failed (out of memory, lost, a shader the driver rejected).
     #[error("GPU error: {0}")]
     Device(String),
+    /// Settings that no back end can render (`RenderSettings::validate`).
+    #[error("{0}")]
+    Invalid(String),
     /// The progress callback asked to stop.
     #[error("cancelled")]
     Cancelled,
 }
 
 /// Refuses, before any device is opened, what the GPU path does not do: any integrator but
-/// the path tracer, feature layers, crop windows and sample ranges. Every scene feature of
-/// `SceneParts` (triangles, spheres, boxes, instances, every material, every light,
-/// textures, both backgrounds, both projections) is supported.
+/// the path tracer (the course integrator and the debug views run on the CPU only), and
+/// settings `RenderSettings::validate` rejects. Every scene feature of `SceneParts`
+/// (triangles, spheres, boxes, instances, every material, every light, textures, both
+/// backgrounds, both projections) is supported, and so are feature layers, crop windows and
+/// sample ranges.
 pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<(), GpuError> {
     let _ = parts;
     if settings.integrator != IntegratorKind::Path {
         return Err(GpuError::Unsupported(format!(
-            "the {:?} integrator (only --integrator path runs on the GPU)",
-            settings.integrator
+            "the {} integrator (only --integrator path runs on the GPU)",
+            settings.integrator.name()
         )));
     }
-    if settings.features {
-        return Err(GpuError::Unsupported(
-            "feature layers (albedo, normal, depth)".into(),
-        ));
-    }
-    if settings.pixel_bounds.is_some() {
-        return Err(GpuError::Unsupported("crop windows (pixel bounds)".into()));
-    }
-    if settings.sample_range.is_some() {
-        return Err(GpuError::Unsupported("sample ranges".into()));
-    }
-    if settings.width == 0 || settings.height == 0 || settings.samples_per_pixel == 0 {
-        return Err(GpuError::Unsupported(
-            "an empty image or zero samples per pixel".into(),
-        ));
-    }
-    Ok(())
+    settings.validate().map_err(GpuError::Invalid)
 }
 
 /// How many path samples one dispatch traces at most (over the whole image): small enough
 /// that a dispatch on a real GPU lasts milliseconds, far from any watchdog.
 const SAMPLES_PER_DISPATCH: u64 = 1 << 20;
 
-/// The path tracer's depth cap when `-k` is not given (glint-render's `DEFAULT_MAX_DEPTH`).
-const DEFAULT_MAX_DEPTH: u32 = 1024;
+/// What a GPU render did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuStats {
+    /// Path samples traced (pixels times samples per pixel).
+    pub samples: u64,
+    /// Samples whose radiance was NaN or infinite: dropped from the pixel's average.
+    pub nonfinite_samples: u64,
+    /// The first pixel (x, y from the top-left of the whole image) with a non-finite sample.
+    pub first_nonfinite_pixel: Option<(u32, u32)>,
+    /// Samples the driver's loop limit cut short (a render with any fails).
+    cut_samples: u64,
+}
+
+/// The accumulation buffer's bytes per pixel (three vec4: `ACCUM_STRIDE` in `path.wgsl`).
+const ACCUM_BYTES_PER_PIXEL: usize = 48;
 
 /// An opened GPU device with the path-tracing pipeline compiled.
 pub struct GpuRenderer {
@@ -102,6 +104,7 @@ pub struct GpuRenderer {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     max_binding: u64,
+    samples_per_pass: Option<u32>,
 }
 
 impl std::fmt::Debug for GpuRenderer {
@@ -189,10 +192,19 @@ impl GpuRenderer {
             device,
             queue,
             max_binding,
+            samples_per_pass: None,
             info,
             pipeline,
             layout,
         })
+    }
+
+    /// Sets how many samples of each pixel one dispatch takes (`None`: the default, one on a
+    /// CPU adapter such as lavapipe, otherwise as many as keep a dispatch near 2^20 samples).
+    /// More per pass means fewer dispatches; on lavapipe more than a few run into its loop
+    /// limit, which `render` detects and reports as an error.
+    pub fn set_samples_per_pass(&mut self, samples: Option<u32>) {
+        self.samples_per_pass = samples.map(|n| n.max(1));
     }
 
     /// The adapter's name and backend, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)".
@@ -210,17 +222,23 @@ impl GpuRenderer {
         parts: &SceneParts,
         settings: &RenderSettings,
         progress: &dyn Fn(u32, u32) -> bool,
-    ) -> Result<Film, GpuError> {
+    ) -> Result<(Film, GpuStats), GpuError> {
         check_supported(parts, settings)?;
         let flat = FlatScene::new(parts);
         let (width, height) = (settings.width, settings.height);
-        let pixels = width as u64 * height as u64;
+        let bounds = settings.bounds();
+        let (crop_width, crop_height) = (bounds.x1 - bounds.x0, bounds.y1 - bounds.y0);
+        let pixels = crop_width as u64 * crop_height as u64;
         let mut params = flat.params;
         params.width = width;
         params.height = height;
+        params.x0 = bounds.x0;
+        params.y0 = bounds.y0;
+        params.crop_width = crop_width;
+        params.crop_height = crop_height;
         params.seed_lo = settings.seed as u32;
         params.seed_hi = (settings.seed >> 32) as u32;
-        params.max_depth = settings.max_depth.unwrap_or(DEFAULT_MAX_DEPTH);
+        params.max_depth = settings.max_depth();
         params.camera_w[3] = settings.aspect.unwrap_or(width as f32 / height as f32);
 
         let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
@@ -248,7 +266,7 @@ impl GpuRenderer {
         let lights = storage("lights", bytemuck::cast_slice(&flat.lights), none)?;
         let tables = storage("tables", bytemuck::cast_slice(&flat.tables), none)?;
         let texels = storage("texels", bytemuck::cast_slice(&flat.texels), none)?;
-        let accum_bytes = vec![0u8; pixels as usize * 16];
+        let accum_bytes = vec![0u8; pixels as usize * ACCUM_BYTES_PER_PIXEL];
         let accum = storage("accumulation", &accum_bytes, wgpu::BufferUsages::COPY_SRC)?;
         let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("params"),
@@ -275,13 +293,21 @@ impl GpuRenderer {
             }),
         });
 
-        let total = settings.samples_per_pixel;
-        let per_pass = (SAMPLES_PER_DISPATCH / pixels).clamp(1, total as u64) as u32;
+        let samples = settings.samples();
+        let total = samples.len() as u32;
+        // On a CPU adapter (lavapipe) one sample per invocation and pass keeps every
+        // invocation far below llvmpipe's loop limit (`path.wgsl`, `loop_limit_reached`).
+        let per_invocation = match (self.samples_per_pass, self.info.device_type) {
+            (Some(samples), _) => samples as u64,
+            (None, wgpu::DeviceType::Cpu) => 1,
+            (None, _) => SAMPLES_PER_DISPATCH / pixels,
+        };
+        let per_pass = per_invocation.clamp(1, total.max(1) as u64) as u32;
         let mut done = 0u32;
         while done < total {
-            let samples = per_pass.min(total - done);
-            params.first_sample = done;
-            params.samples = samples;
+            let count = per_pass.min(total - done);
+            params.first_sample = samples.start + done;
+            params.samples = count;
             self.queue
                 .write_buffer(&uniform, 0, bytemuck::bytes_of(&params));
             let mut encoder = self
@@ -294,30 +320,69 @@ impl GpuRenderer {
                 });
                 pass.set_pipeline(&self.pipeline);
                 pass.set_bind_group(0, &bind_group, &[]);
-                pass.dispatch_workgroups(width.div_ceil(8), height.div_ceil(8), 1);
+                pass.dispatch_workgroups(crop_width.div_ceil(8), crop_height.div_ceil(8), 1);
             }
             self.queue.submit([encoder.finish()]);
             self.device
                 .poll(wgpu::PollType::wait_indefinitely())
                 .map_err(|error| GpuError::Device(error.to_string()))?;
-            done += samples;
+            done += count;
             if !progress(done, total) {
                 return Err(GpuError::Cancelled);
             }
         }
 
-        let sums: Vec<[f32; 4]> = self.read_back(&accum, pixels * 16)?;
-        let mut film = Film::new(width, height);
-        for (pixel, sum) in film.pixels.iter_mut().zip(&sums) {
-            // Non-finite samples were dropped; the valid ones are averaged (as the CPU
-            // pipeline does).
-            *pixel = if sum[3] > 0.0 {
-                Color::new(sum[0], sum[1], sum[2]) / sum[3]
+        let sums = self.read_back(&accum, pixels * ACCUM_BYTES_PER_PIXEL as u64)?;
+        let mut film = Film::new(crop_width, crop_height);
+        film.origin = (bounds.x0, bounds.y0);
+        film.full_size = (width, height);
+        let mut features = Features {
+            albedo: Vec::with_capacity(pixels as usize),
+            normal: Vec::with_capacity(pixels as usize),
+            depth: Vec::with_capacity(pixels as usize),
+        };
+        let taken = total.max(1) as f32;
+        let mut stats = GpuStats {
+            samples: pixels * total as u64,
+            ..GpuStats::default()
+        };
+        for (index, (pixel, sum)) in film.pixels.iter_mut().zip(sums.chunks_exact(3)).enumerate() {
+            let [beauty, albedo_depth, normal] = [sum[0], sum[1], sum[2]];
+            let cut = normal[3] as u64;
+            stats.cut_samples += cut;
+            let dropped = (total as u64).saturating_sub(beauty[3] as u64 + cut);
+            if dropped > 0 {
+                stats.nonfinite_samples += dropped;
+                let (x, y) = (index as u32 % crop_width, index as u32 / crop_width);
+                stats
+                    .first_nonfinite_pixel
+                    .get_or_insert((bounds.x0 + x, bounds.y0 + y));
+            }
+            // Non-finite samples were dropped; the valid ones are averaged and the feature
+            // layers divided by every sample taken, as the CPU pipeline does.
+            *pixel = if beauty[3] > 0.0 {
+                Color::new(beauty[0], beauty[1], beauty[2]) / beauty[3]
             } else {
                 Color::ZERO
             };
+            features
+                .albedo
+                .push(Color::new(albedo_depth[0], albedo_depth[1], albedo_depth[2]) / taken);
+            features.depth.push(albedo_depth[3] / taken);
+            features
+                .normal
+                .push(Vec3::new(normal[0], normal[1], normal[2]) / taken);
         }
-        Ok(film)
+        if stats.cut_samples > 0 {
+            return Err(GpuError::Device(format!(
+                "the driver stopped {} path sample{} short (llvmpipe ends a shader's loops \
+                 after 65535 iterations): this scene's paths are too long for this adapter",
+                stats.cut_samples,
+                if stats.cut_samples == 1 { "" } else { "s" }
+            )));
+        }
+        film.features = settings.features.then_some(features);
+        Ok((film, stats))
     }
 
     fn read_back(&self, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<[f32; 4]>, GpuError> {

@@ -77,9 +77,15 @@ struct Params {
     transforms: u32,
     // Perspective 0, orthographic 1.
     projection: u32,
+    // The crop window: its top-left pixel and size; the accumulation buffer covers it alone.
+    x0: u32,
+    y0: u32,
+    crop_width: u32,
+    crop_height: u32,
+    // Always 2; read from the uniform so the compiler cannot unroll the canary loop.
+    canary: u32,
     _pad0: u32,
     _pad1: u32,
-    _pad2: u32,
     camera_position: vec4<f32>,
     // xyz: the basis vectors; w of u: focal length, of v: image-plane width, of w: aspect.
     camera_u: vec4<f32>,
@@ -98,29 +104,34 @@ struct Params {
 @group(0) @binding(7) var<storage, read_write> accum: array<vec4<f32>>;
 
 // ---------------------------------------------------------------------------------------
-// Random numbers: PCG (O'Neill) with the state seeded from a hash of seed, pixel and sample.
+// Random numbers: counter-based. Each draw hashes (seed, pixel, sample, draw index) with
+// Jarzynski and Olano's pcg4d ("Hash Functions for GPU Rendering", JCGT 2020), so every
+// number is a pure function of its coordinates and no two samples share a stream.
 
-var<private> rng_state: u32;
+var<private> rng_key: vec4<u32>;
 
-fn pcg_hash(v: u32) -> u32 {
-    let state = v * 747796405u + 2891336453u;
-    let word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
+fn pcg4d(input: vec4<u32>) -> vec4<u32> {
+    var v = input * 1664525u + 1013904223u;
+    v.x += v.y * v.w;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    v.w += v.y * v.z;
+    v = v ^ (v >> vec4<u32>(16u));
+    v.x += v.y * v.w;
+    v.y += v.z * v.x;
+    v.z += v.x * v.y;
+    v.w += v.y * v.z;
+    return v;
 }
 
 fn rng_seed(pixel: u32, sample: u32) {
-    var h = pcg_hash(params.seed_lo ^ 0x9e3779b9u);
-    h = pcg_hash(h ^ params.seed_hi);
-    h = pcg_hash(h ^ pixel);
-    h = pcg_hash(h ^ sample);
-    rng_state = h;
+    // The draw counter lives in w, mixed with the seed's high word.
+    rng_key = vec4<u32>(pixel, sample, params.seed_lo, params.seed_hi << 16u);
 }
 
 fn next_1d() -> f32 {
-    let old = rng_state;
-    rng_state = old * 747796405u + 2891336453u;
-    let word = ((old >> ((old >> 28u) + 4u)) ^ old) * 277803737u;
-    let out = (word >> 22u) ^ word;
+    let out = pcg4d(rng_key).x;
+    rng_key.w += 1u;
     // 24 random bits: uniform in [0, 1).
     return f32(out >> 8u) * (1.0 / 16777216.0);
 }
@@ -1400,7 +1411,15 @@ fn material_index(id: u32) -> u32 {
     return min(id, params.material_count - 1u);
 }
 
+// What the camera ray's first hit gives the feature layers (integrator/mod.rs FirstHit).
+var<private> first_albedo: vec3<f32>;
+var<private> first_normal: vec3<f32>;
+var<private> first_depth: f32;
+
 fn trace(camera: Ray) -> vec3<f32> {
+    first_albedo = vec3<f32>(0.0);
+    first_normal = vec3<f32>(0.0);
+    first_depth = 0.0;
     var ray = camera;
     ray.direction = normalize(camera.direction);
     var radiance = vec3<f32>(0.0);
@@ -1413,6 +1432,9 @@ fn trace(camera: Ray) -> vec3<f32> {
         let hit = traverse(ray, false);
         if (hit.primitive == NONE) {
             let background = background_radiance(ray.direction);
+            if (depth == 0u) {
+                first_albedo = clamp(background, vec3<f32>(0.0), vec3<f32>(1.0));
+            }
             if (any(background != vec3<f32>(0.0))) {
                 var weight = 1.0;
                 if (!specular_bounce) {
@@ -1449,6 +1471,9 @@ fn trace(camera: Ray) -> vec3<f32> {
             } else {
                 behind_emitter = true;
             }
+            if (depth == 0u) {
+                first_albedo = clamp(emitted.xyz * emitted.w, vec3<f32>(0.0), vec3<f32>(1.0));
+            }
         }
 
         // Beer's law inside a dielectric.
@@ -1462,6 +1487,17 @@ fn trace(camera: Ray) -> vec3<f32> {
         var bsdf = bsdf_black();
         if (!behind_emitter) {
             bsdf = build_bsdf(material, si.uv);
+        }
+        if (depth == 0u) {
+            first_normal = select(si.normal, -si.normal, wo.z < 0.0);
+            first_depth = hit.t;
+            if (bsdf.count > 0u) {
+                var albedo = vec3<f32>(0.0);
+                for (var i = 0u; i < bsdf.count; i += 1u) {
+                    albedo += bsdf.lobes[i].weight;
+                }
+                first_albedo = clamp(albedo, vec3<f32>(0.0), vec3<f32>(1.0));
+            }
         }
         if (depth >= params.max_depth || bsdf.count == 0u || wo.z == 0.0) {
             break;
@@ -1527,23 +1563,60 @@ fn trace(camera: Ray) -> vec3<f32> {
     return radiance;
 }
 
+// Mesa's llvmpipe (lavapipe) stops every loop of an invocation once their iterations
+// together reach 65535 (gallivm's loop limiter, a guard against hung shaders): a traversal
+// cut short that way misses geometry and the sample is silently wrong. Whether it happened
+// is visible afterwards, because the limiter never recovers: a loop that must iterate twice
+// then stops after one pass. Real GPUs have no such limit and the check costs two iterations.
+fn loop_limit_reached() -> bool {
+    var n = 0u;
+    loop {
+        n += 1u;
+        if (n >= params.canary) {
+            break;
+        }
+    }
+    return n < params.canary;
+}
+
+// Three vec4 per pixel of the crop window in `accum`: [radiance sum, valid samples],
+// [albedo sum, depth sum], [normal sum, samples cut short by the loop limit].
+const ACCUM_STRIDE: u32 = 3u;
+
 @compute @workgroup_size(8, 8, 1)
 fn main(@builtin(global_invocation_id) id: vec3<u32>) {
-    if (id.x >= params.width || id.y >= params.height) {
+    if (id.x >= params.crop_width || id.y >= params.crop_height) {
         return;
     }
-    let pixel = id.y * params.width + id.x;
+    let x = params.x0 + id.x;
+    let y = params.y0 + id.y;
+    // Random numbers are keyed by the pixel's index in the whole image, so a crop window
+    // renders its pixels exactly as the whole image does.
+    let pixel = y * params.width + x;
     // The lecture's j counts rows from the bottom; film row 0 is the top.
-    let j = params.height - 1u - id.y;
-    var sum = accum[pixel];
+    let j = params.height - 1u - y;
+    let slot = ACCUM_STRIDE * (id.y * params.crop_width + id.x);
+    var sum = accum[slot];
+    var features = accum[slot + 1u];
+    var normal = accum[slot + 2u];
     for (var s = 0u; s < params.samples; s += 1u) {
         rng_seed(pixel, params.first_sample + s);
         let offset = next_2d();
-        let ray = camera_ray(f32(id.x) + offset.x, f32(j) + offset.y);
+        let ray = camera_ray(f32(x) + offset.x, f32(j) + offset.y);
         let radiance = trace(ray);
+        if (loop_limit_reached()) {
+            // This sample and the pass's remaining ones are lost: the host reports it.
+            normal.w += f32(params.samples - s);
+            break;
+        }
+        // Non-finite samples are dropped, as the CPU pipeline drops them.
         if (is_finite3(radiance)) {
             sum += vec4<f32>(radiance, 1.0);
         }
+        features += vec4<f32>(first_albedo, first_depth);
+        normal += vec4<f32>(first_normal, 0.0);
     }
-    accum[pixel] = sum;
+    accum[slot] = sum;
+    accum[slot + 1u] = features;
+    accum[slot + 2u] = normal;
 }

@@ -81,9 +81,15 @@ fn render_cpu(parts: &SceneParts, samples: u32, seed: u64) -> Pixels {
 }
 
 fn render_gpu(gpu: &GpuRenderer, parts: &SceneParts, samples: u32, seed: u64) -> Pixels {
-    let film = gpu
+    let (film, stats) = gpu
         .render(parts, &settings(samples, seed), &|_, _| true)
         .unwrap();
+    assert_eq!(
+        stats.nonfinite_samples, 0,
+        "first at {:?}",
+        stats.first_nonfinite_pixel
+    );
+    assert_eq!(stats.samples, (SIZE * SIZE * samples) as u64);
     to_pixels(&film)
 }
 
@@ -485,5 +491,39 @@ fn feature_scene() -> SceneParts {
         })),
         geometries,
         instances,
+    }
+}
+
+/// llvmpipe (lavapipe) ends an invocation's loops after 65535 iterations in all; 256 Cornell
+/// samples in one invocation pass that, and the render must fail rather than return an image
+/// with paths cut short. On adapters without the limit the render succeeds and is checked
+/// for having every sample.
+#[test]
+fn loop_limit_is_detected_not_rendered() {
+    let Some(mut gpu) = gpu("loop limit") else {
+        return;
+    };
+    let path =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/refs/cornell/cornell.json");
+    let loaded = glint_io::load_scene(&path).unwrap_or_else(|error| panic!("{error}"));
+    gpu.set_samples_per_pass(Some(256));
+    let settings = RenderSettings {
+        width: 16,
+        height: 16,
+        ..settings(256, 1)
+    };
+    match gpu.render(&loaded.parts, &settings, &|_, _| true) {
+        Err(GpuError::Device(message)) => {
+            println!("loop limit: {message}");
+            assert!(message.contains("65535"), "{message}");
+        }
+        Ok((_, stats)) => {
+            assert!(
+                !gpu.adapter_name().contains("llvmpipe"),
+                "llvmpipe rendered 256 samples per invocation without hitting its loop limit"
+            );
+            assert_eq!(stats.nonfinite_samples, 0);
+        }
+        Err(error) => panic!("{error}"),
     }
 }
