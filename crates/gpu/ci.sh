@@ -38,8 +38,9 @@ run_tests() {
     local log
     log="$(mktemp)"
     local status=0
-    cargo test -p glint-gpu -p glint --test gpu_device -- --nocapture 2>&1 | tee "$log" \
-        || status=$?
+    # glint-gpu's own tests (unit, agreement, pipeline) and the CLI's --device tests.
+    cargo test -p glint-gpu -- --nocapture 2>&1 | tee "$log" || status=$?
+    cargo test -p glint --test gpu_device -- --nocapture 2>&1 | tee -a "$log" || status=$?
     # libtest's summary lines: "test result: ok. 5 passed; 0 failed; ...".
     local passed failed
     passed=$(grep -Eo '[0-9]+ passed' "$log" | awk '{s += $1} END {print s + 0}')

@@ -444,7 +444,7 @@ mod tests {
 
     #[test]
     fn device_gpu() {
-        let job = job(&[
+        let gpu = job(&[
             "render",
             "s.json",
             "--integrator",
@@ -453,7 +453,7 @@ mod tests {
             "gpu",
         ])
         .unwrap();
-        assert_eq!(job.device, DeviceArg::Gpu);
+        assert_eq!(gpu.device, DeviceArg::Gpu);
         assert!(job(&["render", "s.json", "--device", "tpu"]).is_err());
     }
 

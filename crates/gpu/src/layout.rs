@@ -841,7 +841,8 @@ fn build_node(
     } else {
         2
     };
-    if count <= MAX_LEAF || depth >= MAX_DEPTH || !(extent[axis] > 0.0) {
+    let spread = extent[axis];
+    if count <= MAX_LEAF || depth >= MAX_DEPTH || spread.is_nan() || spread <= 0.0 {
         return;
     }
     // Binned SAH along the widest centroid axis.
@@ -919,4 +920,177 @@ fn build_node(
         depth + 1,
         nodes,
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glint_render::{GeometryDesc, Instance, Matrix4, Projection};
+
+    fn unbits(value: f32) -> u32 {
+        value.to_bits()
+    }
+
+    /// Pseudo-random numbers in [0, 1) for test scenes.
+    fn uniform(state: &mut u32) -> f32 {
+        *state = state.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+        (*state >> 8) as f32 / (1u32 << 24) as f32
+    }
+
+    fn scene(triangles: usize) -> SceneParts {
+        let mut state = 7;
+        let mut point = || {
+            Vec3::new(
+                uniform(&mut state) * 10.0,
+                uniform(&mut state) * 10.0,
+                uniform(&mut state) * 10.0,
+            )
+        };
+        let mut shapes: Vec<Shape> = (0..triangles)
+            .map(|_| {
+                let a = point();
+                Shape::Triangle {
+                    vertices: [a, a + point() * 0.05, a + point() * 0.05],
+                }
+            })
+            .collect();
+        shapes.push(Shape::Sphere {
+            center: Vec3::splat(5.0),
+            radius: 0.5,
+        });
+        let count = shapes.len();
+        SceneParts {
+            camera: Camera::new(Projection::Perspective, Vec3::ZERO, -Vec3::Z, 1.0, 1.0),
+            materials: vec![],
+            textures: vec![],
+            lights: vec![
+                Light::Triangles {
+                    triangles: vec![
+                        [Vec3::ZERO, Vec3::X, Vec3::Y],
+                        [Vec3::ZERO, Vec3::X * 2.0, Vec3::Y],
+                    ],
+                    intensity: Color::ONE,
+                },
+                Light::Point {
+                    position: Vec3::ONE,
+                    intensity: Color::ONE,
+                },
+            ],
+            background: Background::Color(Color::ZERO),
+            geometries: vec![
+                GeometryDesc {
+                    shapes,
+                    materials: vec![0; count],
+                },
+                GeometryDesc {
+                    shapes: vec![Shape::Box {
+                        min: Vec3::ZERO,
+                        max: Vec3::ONE,
+                    }],
+                    materials: vec![0],
+                },
+            ],
+            instances: vec![
+                Instance {
+                    geometry: 0,
+                    transform: None,
+                    material: None,
+                    casts_shadow: true,
+                },
+                Instance {
+                    geometry: 1,
+                    transform: Transform::from_matrix(&Matrix4::translate(Vec3::splat(20.0))),
+                    material: Some(3),
+                    casts_shadow: false,
+                },
+            ],
+        }
+    }
+
+    /// Walks the flattened BVH: every primitive in exactly one leaf, every leaf's triangles
+    /// inside its node's box, children inside their parent's, depth within the kernel's stack.
+    #[test]
+    fn bvh_covers_every_primitive_once_within_bounds() {
+        let flat = FlatScene::new(&scene(2000));
+        assert_eq!(flat.primitive_count, 2002);
+        let node = |i: usize| (flat.nodes[2 * i], flat.nodes[2 * i + 1]);
+        let mut seen = vec![0u32; flat.primitive_count];
+        // (node, parent box, depth)
+        let mut stack = vec![(0usize, None::<([f32; 4], [f32; 4])>, 0u32)];
+        let mut max_depth = 0;
+        while let Some((index, parent, depth)) = stack.pop() {
+            max_depth = max_depth.max(depth);
+            let (lo, hi) = node(index);
+            if let Some((plo, phi)) = parent {
+                for a in 0..3 {
+                    assert!(
+                        lo[a] >= plo[a] && hi[a] <= phi[a],
+                        "node {index} leaves its parent"
+                    );
+                }
+            }
+            let count = unbits(hi[3]) as usize;
+            let offset = unbits(lo[3]) as usize;
+            if count == 0 {
+                stack.push((index + 1, Some((lo, hi)), depth + 1));
+                stack.push((offset, Some((lo, hi)), depth + 1));
+                continue;
+            }
+            for primitive in offset..offset + count {
+                seen[primitive] += 1;
+                let words = &flat.prims[primitive * PRIM_STRIDE..][..PRIM_STRIDE];
+                if unbits(words[0][3]) == PRIM_TRIANGLE {
+                    for vertex in &words[..3] {
+                        for a in 0..3 {
+                            assert!(vertex[a] >= lo[a] && vertex[a] <= hi[a]);
+                        }
+                    }
+                }
+            }
+        }
+        assert!(
+            seen.iter().all(|&n| n == 1),
+            "a primitive is missing or repeated"
+        );
+        assert!(
+            max_depth < 64,
+            "depth {max_depth} overflows the kernel's stack"
+        );
+        // The instanced box: its transform stored after the primitives, its material
+        // overridden, its shadow flag cleared.
+        let boxed = (0..flat.primitive_count)
+            .find(|&p| unbits(flat.prims[p * PRIM_STRIDE][3]) == PRIM_BOX)
+            .unwrap();
+        let words = &flat.prims[boxed * PRIM_STRIDE..][..PRIM_STRIDE];
+        assert_eq!(unbits(words[1][3]), 3);
+        assert_eq!(unbits(words[3][3]) & FLAG_CASTS_SHADOW, 0);
+        let transform = unbits(words[2][3]) as usize;
+        assert_eq!(
+            flat.params.transforms as usize + transform * TRANSFORM_STRIDE,
+            flat.primitive_count * PRIM_STRIDE
+        );
+        // object_from_world of a translation by 20: the last column is -20.
+        assert_eq!(flat.prims[flat.params.transforms as usize][3], -20.0);
+    }
+
+    /// The light tables: selection by power (π·area·L for the triangles, 4π·I for the point
+    /// light), the triangles' area CDF, and no environment for a black background.
+    #[test]
+    fn light_tables_follow_power_and_area() {
+        let flat = FlatScene::new(&scene(1));
+        assert_eq!(flat.params.light_count, 2);
+        assert_eq!(flat.params.environment_light, NONE);
+        let triangles_power = PI * 1.5;
+        let point_power = 4.0 * PI;
+        let cdf = &flat.tables[..3];
+        assert_eq!(cdf[0], 0.0);
+        assert!((cdf[1] - triangles_power / (triangles_power + point_power)).abs() < 1e-6);
+        assert_eq!(cdf[2], 1.0);
+        let first = flat.params.light_triangles as usize;
+        // Areas 0.5 and 1: the first triangle holds a third of the light.
+        assert!((flat.lights[first][3] - 1.0 / 3.0).abs() < 1e-6);
+        assert_eq!(flat.lights[first + LIGHT_TRIANGLE_STRIDE][3], 1.0);
+        // Its 1/area for the pdf.
+        assert!((flat.lights[2][3] - 1.0 / 1.5).abs() < 1e-6);
+    }
 }

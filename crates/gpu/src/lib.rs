@@ -32,7 +32,7 @@
 
 mod layout;
 
-use std::sync::mpsc;
+use std::sync::{mpsc, Arc, Mutex};
 
 use glint_render::{Color, Features, Film, IntegratorKind, RenderSettings, SceneParts, Vec3};
 use wgpu::util::DeviceExt;
@@ -105,6 +105,7 @@ pub struct GpuRenderer {
     layout: wgpu::BindGroupLayout,
     max_binding: u64,
     samples_per_pass: Option<u32>,
+    device_error: Arc<Mutex<Option<String>>>,
 }
 
 impl std::fmt::Debug for GpuRenderer {
@@ -155,6 +156,15 @@ impl GpuRenderer {
             ..Default::default()
         }))
         .map_err(|error| GpuError::Device(error.to_string()))?;
+        // wgpu's default for errors nobody captures is a panic; keep the first one and turn
+        // it into a `GpuError::Device` at the next check instead.
+        let device_error = Arc::new(Mutex::new(None::<String>));
+        let sink = Arc::clone(&device_error);
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            if let Ok(mut slot) = sink.lock() {
+                slot.get_or_insert_with(|| error.to_string());
+            }
+        }));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("path.wgsl"),
             source: wgpu::ShaderSource::Wgsl(include_str!("path.wgsl").into()),
@@ -188,7 +198,7 @@ impl GpuRenderer {
             compilation_options: Default::default(),
             cache: None,
         });
-        Ok(GpuRenderer {
+        let renderer = GpuRenderer {
             device,
             queue,
             max_binding,
@@ -196,7 +206,23 @@ impl GpuRenderer {
             info,
             pipeline,
             layout,
-        })
+            device_error,
+        };
+        renderer.check_device()?;
+        Ok(renderer)
+    }
+
+    /// The first error the device reported, if any (a shader the driver rejects, memory).
+    fn check_device(&self) -> Result<(), GpuError> {
+        match self.device_error.lock() {
+            Ok(slot) => match slot.as_ref() {
+                Some(error) => Err(GpuError::Device(error.clone())),
+                None => Ok(()),
+            },
+            Err(_) => Err(GpuError::Device(
+                "the device's error handler panicked".into(),
+            )),
+        }
     }
 
     /// Sets how many samples of each pixel one dispatch takes (`None`: the default, one on a
@@ -326,12 +352,14 @@ impl GpuRenderer {
             self.device
                 .poll(wgpu::PollType::wait_indefinitely())
                 .map_err(|error| GpuError::Device(error.to_string()))?;
+            self.check_device()?;
             done += count;
             if !progress(done, total) {
                 return Err(GpuError::Cancelled);
             }
         }
 
+        self.check_device()?;
         let sums = self.read_back(&accum, pixels * ACCUM_BYTES_PER_PIXEL as u64)?;
         let mut film = Film::new(crop_width, crop_height);
         film.origin = (bounds.x0, bounds.y0);
@@ -415,6 +443,7 @@ impl GpuRenderer {
         let values = bytemuck::cast_slice::<u8, [f32; 4]>(&data).to_vec();
         drop(data);
         staging.unmap();
+        self.check_device()?;
         Ok(values)
     }
 }

@@ -19,9 +19,11 @@
 //!
 //! `--nocapture` prints the figures and the timings.
 
-use std::path::PathBuf;
+mod common;
+
 use std::time::Instant;
 
+use common::{cornell, gpu};
 use glint_gpu::{GpuError, GpuRenderer};
 use glint_render::{
     Background, Camera, Color, ColorSource, CubeMap, GeometryDesc, Image, Instance, IntegratorKind,
@@ -35,25 +37,6 @@ const TOLERANCE: f64 = 1.15;
 const BLOCK_TOLERANCE: f64 = 0.02;
 
 type Pixels = Vec<[f64; 3]>;
-
-/// The adapter, or `None` (after printing SKIPPED) when there is none and CI is not set.
-fn gpu(test: &str) -> Option<GpuRenderer> {
-    match GpuRenderer::new() {
-        Ok(gpu) => {
-            println!("{test}: adapter {}", gpu.adapter_name());
-            Some(gpu)
-        }
-        Err(error @ GpuError::NoAdapter(_)) => {
-            if std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "0") {
-                panic!("{test}: CI is set but there is no Vulkan adapter: {error}");
-            }
-            println!("{test}: SKIPPED (no Vulkan adapter: {error})");
-            eprintln!("{test}: SKIPPED (no Vulkan adapter: {error})");
-            None
-        }
-        Err(error) => panic!("{test}: {error}"),
-    }
-}
 
 fn settings(samples: u32, seed: u64) -> RenderSettings {
     RenderSettings {
@@ -237,12 +220,9 @@ fn samples(variable: &str, default: u32) -> u32 {
 
 #[test]
 fn cornell_box_agrees_with_the_cpu() {
-    let path =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/refs/cornell/cornell.json");
-    let loaded = glint_io::load_scene(&path).unwrap_or_else(|error| panic!("{error}"));
     compare(
         "cornell",
-        &loaded.parts,
+        &cornell(),
         samples("GLINT_GPU_TEST_SPP", 256),
         samples("GLINT_CPU_TEST_SPP", 2048),
     );
@@ -503,16 +483,13 @@ fn loop_limit_is_detected_not_rendered() {
     let Some(mut gpu) = gpu("loop limit") else {
         return;
     };
-    let path =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/refs/cornell/cornell.json");
-    let loaded = glint_io::load_scene(&path).unwrap_or_else(|error| panic!("{error}"));
     gpu.set_samples_per_pass(Some(256));
     let settings = RenderSettings {
         width: 16,
         height: 16,
         ..settings(256, 1)
     };
-    match gpu.render(&loaded.parts, &settings, &|_, _| true) {
+    match gpu.render(&cornell(), &settings, &|_, _| true) {
         Err(GpuError::Device(message)) => {
             println!("loop limit: {message}");
             assert!(message.contains("65535"), "{message}");
