@@ -1036,8 +1036,8 @@ mod tests {
                 stack.push((offset, Some((lo, hi)), depth + 1));
                 continue;
             }
-            for primitive in offset..offset + count {
-                seen[primitive] += 1;
+            for (primitive, times) in seen.iter_mut().enumerate().skip(offset).take(count) {
+                *times += 1;
                 let words = &flat.prims[primitive * PRIM_STRIDE..][..PRIM_STRIDE];
                 if unbits(words[0][3]) == PRIM_TRIANGLE {
                     for vertex in &words[..3] {
