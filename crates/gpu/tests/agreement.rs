@@ -238,6 +238,85 @@ fn glass_mirror_texture_environment_agree_with_the_cpu() {
     );
 }
 
+#[test]
+fn other_shaders_orthographic_camera_and_sky_agree_with_the_cpu() {
+    compare(
+        "shaders",
+        &shader_scene(),
+        samples("GLINT_GPU_TEST_SPP", 256),
+        samples("GLINT_CPU_TEST_SPP", 2048),
+    );
+}
+
+/// The shaders `feature_scene` leaves out (Phong, Glaze, CoolToWarm, a rough Mirror, an
+/// emitter no light samples) seen by an orthographic camera under a constant sky, which the
+/// path tracer samples as a uniform environment light.
+fn shader_scene() -> SceneParts {
+    let materials = vec![
+        Material::Phong {
+            diffuse: Color::new(0.5, 0.3, 0.2).into(),
+            specular: Color::splat(0.4).into(),
+            phong_exponent: 20.0,
+        },
+        Material::Glaze {
+            diffuse: Color::new(0.2, 0.4, 0.6).into(),
+            mirror_coef: 0.35,
+        },
+        Material::CoolToWarm {
+            diffuse: Color::new(0.7, 0.7, 0.3).into(),
+        },
+        Material::Mirror { roughness: 0.25 },
+        // An emitter without a light: it shines where seen or hit, and no light samples it.
+        Material::Emissive {
+            radiance: Color::new(2.0, 1.5, 1.0),
+            surface: None,
+            light: None,
+        },
+    ];
+    let sphere = |x: f32, z: f32| Shape::Sphere {
+        center: Vec3::new(x, 0.5, z),
+        radius: 0.5,
+    };
+    SceneParts {
+        camera: Camera::new(
+            Projection::Orthographic,
+            Vec3::new(0.0, 2.0, 4.0),
+            Vec3::new(0.0, -0.4, -1.0),
+            1.0,
+            4.5,
+        ),
+        materials,
+        textures: vec![],
+        lights: vec![Light::Point {
+            position: Vec3::new(-2.0, 4.0, 3.0),
+            intensity: Color::splat(6.0),
+        }],
+        background: Background::Color(Color::new(0.5, 0.6, 0.8)),
+        geometries: vec![GeometryDesc {
+            shapes: vec![
+                Shape::Box {
+                    min: Vec3::new(-3.0, -0.2, -3.0),
+                    max: Vec3::new(3.0, 0.0, 3.0),
+                },
+                sphere(-1.2, 0.0),
+                sphere(0.0, -0.3),
+                sphere(1.2, 0.0),
+                Shape::Box {
+                    min: Vec3::new(-0.4, 0.0, 0.8),
+                    max: Vec3::new(0.4, 0.3, 1.4),
+                },
+            ],
+            materials: vec![1, 0, 3, 2, 4],
+        }],
+        instances: vec![Instance {
+            geometry: 0,
+            transform: None,
+            material: None,
+            casts_shadow: true,
+        }],
+    }
+}
+
 /// An image of `width` x `height` texels from a function of (x, y).
 fn image(width: u32, height: u32, texel: impl Fn(u32, u32) -> Color) -> Image {
     Image {
