@@ -447,3 +447,81 @@ impl GpuRenderer {
         Ok(values)
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::layout::*;
+
+    const KERNEL: &str = include_str!("path.wgsl");
+
+    /// The value of `const NAME: u32 = Nu;` in the kernel.
+    fn kernel_constant(name: &str) -> u32 {
+        let prefix = format!("const {name}: u32 = ");
+        let line = KERNEL
+            .lines()
+            .find(|line| line.starts_with(&prefix))
+            .unwrap_or_else(|| panic!("path.wgsl has no constant {name}"));
+        let literal = line[prefix.len()..]
+            .trim_end_matches(';')
+            .trim_end_matches('u');
+        match literal.strip_prefix("0x") {
+            Some(hex) => u32::from_str_radix(hex, 16),
+            None => literal.parse(),
+        }
+        .unwrap_or_else(|_| panic!("{line}"))
+    }
+
+    /// The kernel repeats the layout's constants by name; they must agree.
+    #[test]
+    fn kernel_and_layout_agree_on_kinds_and_strides() {
+        let constants: &[(&str, u32)] = &[
+            ("PRIM_TRIANGLE", PRIM_TRIANGLE),
+            ("PRIM_SPHERE", PRIM_SPHERE),
+            ("PRIM_BOX", PRIM_BOX),
+            ("PRIM_STRIDE", PRIM_STRIDE as u32),
+            ("TRANSFORM_STRIDE", TRANSFORM_STRIDE as u32),
+            ("BSDF_BLACK", BSDF_BLACK),
+            ("BSDF_DIFFUSE", BSDF_DIFFUSE),
+            ("BSDF_BLINN_PHONG", BSDF_BLINN_PHONG),
+            ("BSDF_PHONG", BSDF_PHONG),
+            ("BSDF_MIRROR", BSDF_MIRROR),
+            ("BSDF_GLAZE", BSDF_GLAZE),
+            ("BSDF_BLINN_PHONG_MIRRORED", BSDF_BLINN_PHONG_MIRRORED),
+            ("BSDF_DIELECTRIC", BSDF_DIELECTRIC),
+            ("MATERIAL_STRIDE", MATERIAL_STRIDE as u32),
+            ("EMITTER_NONE", EMITTER_NONE),
+            ("EMITTER_LIGHT", EMITTER_LIGHT),
+            ("EMITTER_UNSAMPLED", EMITTER_UNSAMPLED),
+            ("LIGHT_POINT", LIGHT_POINT),
+            ("LIGHT_RECTANGLE", LIGHT_RECTANGLE),
+            ("LIGHT_SPHERE", LIGHT_SPHERE),
+            ("LIGHT_TRIANGLES", LIGHT_TRIANGLES),
+            ("LIGHT_ENVIRONMENT", LIGHT_ENVIRONMENT),
+            ("LIGHT_STRIDE", LIGHT_STRIDE as u32),
+            ("LIGHT_TRIANGLE_STRIDE", LIGHT_TRIANGLE_STRIDE as u32),
+            ("NONE", NONE),
+        ];
+        for &(name, value) in constants {
+            assert_eq!(kernel_constant(name), value, "{name}");
+        }
+        assert_eq!(
+            kernel_constant("ACCUM_STRIDE") as usize * 16,
+            super::ACCUM_BYTES_PER_PIXEL
+        );
+    }
+
+    /// The kernel's `Params` has the Rust struct's size: as many u32 and vec4 fields.
+    #[test]
+    fn kernel_params_match_the_uniform_block() {
+        let start = KERNEL.find("struct Params {").expect("struct Params");
+        let end = start + KERNEL[start..].find('}').unwrap();
+        let fields = &KERNEL[start..end];
+        let u32s = fields.matches(": u32,").count();
+        let vec4s = fields.matches(": vec4<f32>,").count();
+        assert_eq!(
+            4 * u32s + 16 * vec4s,
+            std::mem::size_of::<Params>(),
+            "{u32s} u32 and {vec4s} vec4 fields"
+        );
+    }
+}
