@@ -125,7 +125,6 @@ pub struct FlatScene {
     pub tables: Vec<f32>,
     pub texels: Vec<[f32; 4]>,
     pub params: Params,
-    pub primitive_count: usize,
 }
 
 /// One primitive in world terms before the BVH orders them.
@@ -379,7 +378,6 @@ impl FlatScene {
             tables,
             texels,
             params,
-            primitive_count,
         }
     }
 }
@@ -1012,9 +1010,11 @@ mod tests {
     #[test]
     fn bvh_covers_every_primitive_once_within_bounds() {
         let flat = FlatScene::new(&scene(2000));
-        assert_eq!(flat.primitive_count, 2002);
+        // The transforms follow the primitives.
+        let primitive_count = flat.params.transforms as usize / PRIM_STRIDE;
+        assert_eq!(primitive_count, 2002);
         let node = |i: usize| (flat.nodes[2 * i], flat.nodes[2 * i + 1]);
-        let mut seen = vec![0u32; flat.primitive_count];
+        let mut seen = vec![0u32; primitive_count];
         // (node, parent box, depth)
         let mut stack = vec![(0usize, None::<([f32; 4], [f32; 4])>, 0u32)];
         let mut max_depth = 0;
@@ -1058,7 +1058,7 @@ mod tests {
         );
         // The instanced box: its transform stored after the primitives, its material
         // overridden, its shadow flag cleared.
-        let boxed = (0..flat.primitive_count)
+        let boxed = (0..primitive_count)
             .find(|&p| unbits(flat.prims[p * PRIM_STRIDE][3]) == PRIM_BOX)
             .unwrap();
         let words = &flat.prims[boxed * PRIM_STRIDE..][..PRIM_STRIDE];
@@ -1067,7 +1067,7 @@ mod tests {
         let transform = unbits(words[2][3]) as usize;
         assert_eq!(
             flat.params.transforms as usize + transform * TRANSFORM_STRIDE,
-            flat.primitive_count * PRIM_STRIDE
+            primitive_count * PRIM_STRIDE
         );
         // object_from_world of a translation by 20: the last column is -20.
         assert_eq!(flat.prims[flat.params.transforms as usize][3], -20.0);

@@ -26,9 +26,9 @@
 //! let (film, stats) = gpu.render(&loaded.parts, &settings, &|_done, _total| true).unwrap();
 //! ```
 //!
-//! The random numbers differ from the CPU's (independent PCG draws instead of scrambled
-//! Sobol' points), so the two back ends agree in distribution, not pixel for pixel; the
-//! tests in `tests/agreement.rs` check that statistically.
+//! The random numbers differ from the CPU's (independent counter-based draws instead of
+//! scrambled Sobol' points), so the two back ends agree in distribution, not pixel for pixel;
+//! the tests in `tests/agreement.rs` check that statistically.
 
 mod layout;
 
@@ -37,7 +37,7 @@ use std::sync::{mpsc, Arc, Mutex};
 use glint_render::{Color, Features, Film, IntegratorKind, RenderSettings, SceneParts, Vec3};
 use wgpu::util::DeviceExt;
 
-pub use layout::FlatScene;
+use layout::FlatScene;
 
 /// Why the GPU back end did not render.
 #[derive(Debug, thiserror::Error)]
@@ -65,6 +65,9 @@ pub enum GpuError {
 /// (triangles, spheres, boxes, instances, every material, every light, textures, both
 /// backgrounds, both projections) is supported, and so are feature layers, crop windows and
 /// sample ranges.
+///
+/// It takes the scene too, although no scene feature is refused today, so that a feature the
+/// kernel does not cover can be refused here, by name, without changing front ends.
 pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<(), GpuError> {
     let _ = parts;
     if settings.integrator != IntegratorKind::Path {
