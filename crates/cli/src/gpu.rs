@@ -3,9 +3,10 @@
 //! with the GPU's own reporting: the adapter's name first, a progress bar over sample passes,
 //! and a closing line in samples per second (the GPU does not count rays).
 //!
-//! Exit statuses: 2 when the GPU path does not support what was asked (another integrator),
-//! like any other unusable argument; 1 when there is no adapter or the device fails, since
-//! then the machine, not the input, is at fault.
+//! Exit statuses: 2 when the GPU path does not support what was asked (another integrator,
+//! or a scene whose buffers exceed what the adapter can bind), like any other unusable
+//! argument; 1 when there is no adapter or the device fails, since then the machine, not the
+//! input, is at fault.
 
 use std::io::Write;
 use std::time::Instant;
