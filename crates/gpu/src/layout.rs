@@ -1,6 +1,7 @@
 //! The scene flattened into the storage buffers `path.wgsl` reads. Nothing here is shared with
 //! the CPU renderer's private structures: it is built from the public `SceneParts` alone, so
-//! the GPU back end has its own BVH (binary, binned SAH, over world-space primitives) and its
+//! the GPU back end has its own BVHs (binary, binned SAH: one per geometry in its object space,
+//! one over the instances, as glint-render's two-level structure) and its
 //! own copy of the light sampler's tables (selection by power, triangle areas, the cube map's
 //! luminance distribution), computed by the same formulas as `glint-render`'s
 //! `light::sampler`.
@@ -22,13 +23,15 @@ pub const NONE: u32 = u32::MAX;
 pub const PRIM_TRIANGLE: u32 = 0;
 pub const PRIM_SPHERE: u32 = 1;
 pub const PRIM_BOX: u32 = 2;
-/// vec4s per primitive: [v0 | centre | min, kind], [v1 | (radius, ..) | max, material],
-/// [v2, transform], [world normal of a triangle, flags].
+/// vec4s per primitive, in its geometry's object space: [v0 | centre | min, kind],
+/// [v1 | (radius, ..) | max, material], [v2, 0], [unit normal of a triangle, 0].
 pub const PRIM_STRIDE: usize = 4;
-/// vec4s per transform (rows of object_from_world), stored after the primitives.
-pub const TRANSFORM_STRIDE: usize = 3;
-/// Bit 0 of a primitive's flags: it blocks shadow rays.
+/// vec4s per instance, stored after the primitives: three rows of object_from_world (the
+/// identity without a transform), then [geometry's root node, material override, flags, 0].
+pub const INSTANCE_STRIDE: usize = 4;
+/// An instance's flags: it blocks shadow rays; it has a transform.
 pub const FLAG_CASTS_SHADOW: u32 = 1;
+pub const FLAG_TRANSFORMED: u32 = 2;
 
 pub const BSDF_BLACK: u32 = 0;
 pub const BSDF_DIFFUSE: u32 = 1;
@@ -98,7 +101,7 @@ pub struct Params {
     pub column_cdf: u32,
     pub column_start: u32,
     pub first_row: u32,
-    pub transforms: u32,
+    pub instances: u32,
     pub projection: u32,
     pub x0: u32,
     pub y0: u32,
@@ -106,7 +109,9 @@ pub struct Params {
     pub crop_height: u32,
     /// Always 2 (the loop-limit canary of `path.wgsl`).
     pub canary: u32,
-    pub pad: [u32; 2],
+    /// The top-level BVH's root node.
+    pub tlas_root: u32,
+    pub pad: u32,
     pub camera_position: [f32; 4],
     pub camera_u: [f32; 4],
     pub camera_v: [f32; 4],
@@ -127,7 +132,7 @@ pub struct FlatScene {
     pub params: Params,
 }
 
-/// One primitive in world terms before the BVH orders them.
+/// One primitive in its geometry's object space, before the BVH orders them.
 struct Primitive {
     words: [[f32; 4]; PRIM_STRIDE],
     bounds: (Vec3, Vec3),
@@ -164,115 +169,85 @@ fn shape_bounds(shape: &Shape) -> (Vec3, Vec3) {
 
 impl FlatScene {
     pub fn new(parts: &SceneParts) -> FlatScene {
-        // Primitives: every shape of every instance, triangles moved to world space, spheres
-        // and boxes kept in object space with their instance's transform.
-        let mut primitives = Vec::new();
-        let mut transforms: Vec<[[f32; 4]; 3]> = Vec::new();
+        // Bottom level: each geometry's shapes in object space under their own BVH, stored
+        // once however many instances place it (glint-render's two-level structure).
+        let mut nodes: Vec<[f32; 4]> = Vec::new();
+        let mut prims: Vec<[f32; 4]> = Vec::new();
+        let mut roots = Vec::with_capacity(parts.geometries.len());
+        for geometry in &parts.geometries {
+            let primitives: Vec<Primitive> = geometry
+                .shapes
+                .iter()
+                .enumerate()
+                .map(|(index, shape)| {
+                    primitive(
+                        shape,
+                        geometry.materials.get(index).copied().unwrap_or(NONE),
+                    )
+                })
+                .collect();
+            let bounds: Vec<(Vec3, Vec3)> = primitives.iter().map(|p| p.bounds).collect();
+            let (mut local, order) = build_bvh(&bounds);
+            let root = nodes.len() / 2;
+            relocate(&mut local, root, prims.len() / PRIM_STRIDE);
+            nodes.extend_from_slice(&local);
+            for &index in &order {
+                prims.extend_from_slice(&primitives[index].words);
+            }
+            let union = bounds.iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), b| (lo.min(b.0), hi.max(b.1)),
+            );
+            roots.push((root as u32, union, !primitives.is_empty()));
+        }
+
+        // Top level: the instances, each a transform, its geometry's root and its flags.
+        let instances_offset = prims.len() as u32;
+        let mut instance_words: Vec<[[f32; 4]; INSTANCE_STRIDE]> = Vec::new();
+        let mut instance_bounds = Vec::new();
         let mut scene_lo = Vec3::splat(f32::INFINITY);
         let mut scene_hi = Vec3::splat(f32::NEG_INFINITY);
         for instance in &parts.instances {
-            let Some(geometry) = parts.geometries.get(instance.geometry as usize) else {
+            let Some(&(root, bounds, true)) = roots.get(instance.geometry as usize) else {
                 continue;
             };
-            let transform_index = instance.transform.map(|t| {
-                transforms.push(t.object_from_world);
-                (transforms.len() - 1) as u32
-            });
-            let flags = if instance.casts_shadow {
-                FLAG_CASTS_SHADOW
-            } else {
-                0
+            let mut flags = 0;
+            if instance.casts_shadow {
+                flags |= FLAG_CASTS_SHADOW;
+            }
+            let rows = match &instance.transform {
+                Some(t) => {
+                    flags |= FLAG_TRANSFORMED;
+                    t.object_from_world
+                }
+                None => [
+                    [1.0, 0.0, 0.0, 0.0],
+                    [0.0, 1.0, 0.0, 0.0],
+                    [0.0, 0.0, 1.0, 0.0],
+                ],
             };
-            let mut geometry_lo = Vec3::splat(f32::INFINITY);
-            let mut geometry_hi = Vec3::splat(f32::NEG_INFINITY);
-            for (index, shape) in geometry.shapes.iter().enumerate() {
-                let (lo, hi) = shape_bounds(shape);
-                geometry_lo = geometry_lo.min(lo);
-                geometry_hi = geometry_hi.max(hi);
-                let material = instance
-                    .material
-                    .or_else(|| geometry.materials.get(index).copied())
-                    .unwrap_or(NONE);
-                let tail = |kind: u32| (bits(kind), bits(material), bits(flags));
-                let primitive = match *shape {
-                    Shape::Triangle { vertices } => {
-                        let (kind, material, flags) = tail(PRIM_TRIANGLE);
-                        let object_normal =
-                            (vertices[1] - vertices[0]).cross(vertices[2] - vertices[0]);
-                        let (world, normal) = match &instance.transform {
-                            Some(t) => {
-                                let m = &t.object_from_world;
-                                let n = object_normal.normalized();
-                                // Normals by the transpose of object_from_world.
-                                let world_normal = Vec3::new(
-                                    m[0][0] * n.x + m[1][0] * n.y + m[2][0] * n.z,
-                                    m[0][1] * n.x + m[1][1] * n.y + m[2][1] * n.z,
-                                    m[0][2] * n.x + m[1][2] * n.y + m[2][2] * n.z,
-                                );
-                                (
-                                    vertices.map(|v| apply_rows(&t.world_from_object, v, 1.0)),
-                                    world_normal.normalized(),
-                                )
-                            }
-                            None => (vertices, object_normal.normalized()),
-                        };
-                        let lo = world[0].min(world[1]).min(world[2]);
-                        let hi = world[0].max(world[1]).max(world[2]);
-                        Primitive {
-                            words: [
-                                v4(world[0], kind),
-                                v4(world[1], material),
-                                v4(world[2], bits(NONE)),
-                                v4(normal, flags),
-                            ],
-                            bounds: (lo, hi),
-                        }
-                    }
-                    Shape::Sphere { center, radius } => {
-                        let (kind, material, flags) = tail(PRIM_SPHERE);
-                        Primitive {
-                            words: [
-                                v4(center, kind),
-                                [radius, 0.0, 0.0, material],
-                                [0.0, 0.0, 0.0, bits(transform_index.unwrap_or(NONE))],
-                                [0.0, 0.0, 0.0, flags],
-                            ],
-                            bounds: placed_bounds(instance.transform.as_ref(), (lo, hi)),
-                        }
-                    }
-                    Shape::Box { min, max } => {
-                        let (kind, material, flags) = tail(PRIM_BOX);
-                        Primitive {
-                            words: [
-                                v4(min, kind),
-                                v4(max, material),
-                                [0.0, 0.0, 0.0, bits(transform_index.unwrap_or(NONE))],
-                                [0.0, 0.0, 0.0, flags],
-                            ],
-                            bounds: placed_bounds(instance.transform.as_ref(), (lo, hi)),
-                        }
-                    }
-                };
-                primitives.push(primitive);
-            }
-            if geometry_lo.x <= geometry_hi.x {
-                let (lo, hi) =
-                    placed_bounds(instance.transform.as_ref(), (geometry_lo, geometry_hi));
-                scene_lo = scene_lo.min(lo);
-                scene_hi = scene_hi.max(hi);
-            }
+            instance_words.push([
+                rows[0],
+                rows[1],
+                rows[2],
+                [
+                    bits(root),
+                    bits(instance.material.unwrap_or(NONE)),
+                    bits(flags),
+                    0.0,
+                ],
+            ]);
+            let placed = placed_bounds(instance.transform.as_ref(), bounds);
+            scene_lo = scene_lo.min(placed.0);
+            scene_hi = scene_hi.max(placed.1);
+            instance_bounds.push(placed);
         }
-
-        let (nodes, order) = build_bvh(&primitives);
-        let primitive_count = order.len();
-        let mut prims =
-            Vec::with_capacity(primitive_count * PRIM_STRIDE + transforms.len() * TRANSFORM_STRIDE);
+        let (mut top, order) = build_bvh(&instance_bounds);
+        let tlas_root = nodes.len() / 2;
+        relocate(&mut top, tlas_root, 0);
+        nodes.extend_from_slice(&top);
         for &index in &order {
-            prims.extend_from_slice(&primitives[index].words);
-        }
-        let transforms_offset = prims.len() as u32;
-        for rows in &transforms {
-            prims.extend_from_slice(rows);
+            prims.extend_from_slice(&instance_words[index]);
         }
 
         let materials = flatten_materials(parts);
@@ -353,7 +328,7 @@ impl FlatScene {
             column_cdf,
             column_start,
             first_row,
-            transforms: transforms_offset,
+            instances: instances_offset,
             projection: match camera.projection {
                 Projection::Perspective => 0,
                 Projection::Orthographic => 1,
@@ -363,7 +338,8 @@ impl FlatScene {
             crop_width: 0,
             crop_height: 0,
             canary: 2,
-            pad: [0; 2],
+            tlas_root: tlas_root as u32,
+            pad: 0,
             camera_position: v4(camera.position, 0.0),
             camera_u: v4(camera.basis.u, camera.focal_length),
             camera_v: v4(camera.basis.v, camera.image_plane_width),
@@ -379,6 +355,59 @@ impl FlatScene {
             texels,
             params,
         }
+    }
+}
+
+/// One shape in its geometry's object space, with `material` (the instance may override it).
+fn primitive(shape: &Shape, material: u32) -> Primitive {
+    let material = bits(material);
+    match *shape {
+        Shape::Triangle { vertices } => {
+            let normal = (vertices[1] - vertices[0])
+                .cross(vertices[2] - vertices[0])
+                .normalized();
+            Primitive {
+                words: [
+                    v4(vertices[0], bits(PRIM_TRIANGLE)),
+                    v4(vertices[1], material),
+                    v4(vertices[2], 0.0),
+                    v4(normal, 0.0),
+                ],
+                bounds: shape_bounds(shape),
+            }
+        }
+        Shape::Sphere { center, radius } => Primitive {
+            words: [
+                v4(center, bits(PRIM_SPHERE)),
+                [radius, 0.0, 0.0, material],
+                [0.0; 4],
+                [0.0; 4],
+            ],
+            bounds: shape_bounds(shape),
+        },
+        Shape::Box { min, max } => Primitive {
+            words: [
+                v4(min, bits(PRIM_BOX)),
+                v4(max, material),
+                [0.0; 4],
+                [0.0; 4],
+            ],
+            bounds: shape_bounds(shape),
+        },
+    }
+}
+
+/// Moves a BVH built on its own (`build_bvh`) to node `node_base` of the nodes buffer, its
+/// leaves to items from `item_base`.
+fn relocate(nodes: &mut [[f32; 4]], node_base: usize, item_base: usize) {
+    for pair in nodes.chunks_exact_mut(2) {
+        let offset = pair[0][3].to_bits() as usize;
+        let base = if pair[1][3].to_bits() == 0 {
+            node_base
+        } else {
+            item_base
+        };
+        pair[0][3] = bits((offset + base) as u32);
     }
 }
 
@@ -775,12 +804,12 @@ impl CubeTables {
 /// is stored in place of a leaf's first primitive. Returns the nodes (two vec4 each:
 /// [min, first primitive | second child], [max, primitive count (0 for interior nodes)]) and
 /// the primitive order the leaves index.
-fn build_bvh(primitives: &[Primitive]) -> (Vec<[f32; 4]>, Vec<usize>) {
+fn build_bvh(primitives: &[(Vec3, Vec3)]) -> (Vec<[f32; 4]>, Vec<usize>) {
     let mut order: Vec<usize> = (0..primitives.len()).collect();
     let centroids: Vec<Vec3> = primitives
         .iter()
         .map(|p| {
-            let c = (p.bounds.0 + p.bounds.1) * 0.5;
+            let c = (p.0 + p.1) * 0.5;
             if c.is_finite() {
                 c
             } else {
@@ -805,7 +834,7 @@ fn surface_area(lo: Vec3, hi: Vec3) -> f32 {
 }
 
 fn build_node(
-    primitives: &[Primitive],
+    primitives: &[(Vec3, Vec3)],
     centroids: &[Vec3],
     order: &mut [usize],
     first: usize,
@@ -817,8 +846,8 @@ fn build_node(
     let mut centroid_lo = Vec3::splat(f32::INFINITY);
     let mut centroid_hi = Vec3::splat(f32::NEG_INFINITY);
     for &p in order.iter() {
-        lo = lo.min(primitives[p].bounds.0);
-        hi = hi.max(primitives[p].bounds.1);
+        lo = lo.min(primitives[p].0);
+        hi = hi.max(primitives[p].1);
         centroid_lo = centroid_lo.min(centroids[p]);
         centroid_hi = centroid_hi.max(centroids[p]);
     }
@@ -854,8 +883,8 @@ fn build_node(
     for &p in order.iter() {
         let b = bin_of(p);
         bin_count[b] += 1;
-        bin_lo[b] = bin_lo[b].min(primitives[p].bounds.0);
-        bin_hi[b] = bin_hi[b].max(primitives[p].bounds.1);
+        bin_lo[b] = bin_lo[b].min(primitives[p].0);
+        bin_hi[b] = bin_hi[b].max(primitives[p].1);
     }
     let mut best = (f32::INFINITY, BINS / 2);
     for split in 1..BINS {
@@ -1005,21 +1034,15 @@ mod tests {
         }
     }
 
-    /// Walks the flattened BVH: every primitive in exactly one leaf, every leaf's triangles
-    /// inside its node's box, children inside their parent's, depth within the kernel's stack.
-    #[test]
-    fn bvh_covers_every_primitive_once_within_bounds() {
-        let flat = FlatScene::new(&scene(2000));
-        // The transforms follow the primitives.
-        let primitive_count = flat.params.transforms as usize / PRIM_STRIDE;
-        assert_eq!(primitive_count, 2002);
+    /// Walks the BVH from `root`: every node inside its parent, triangles inside their
+    /// leaf's box, depth within the kernel's stack. Returns the leaves' item ranges.
+    fn walk(flat: &FlatScene, root: usize, triangles: bool) -> Vec<(usize, usize)> {
         let node = |i: usize| (flat.nodes[2 * i], flat.nodes[2 * i + 1]);
-        let mut seen = vec![0u32; primitive_count];
+        let mut leaves = Vec::new();
         // (node, parent box, depth)
-        let mut stack = vec![(0usize, None::<([f32; 4], [f32; 4])>, 0u32)];
-        let mut max_depth = 0;
+        let mut stack = vec![(root, None::<([f32; 4], [f32; 4])>, 0u32)];
         while let Some((index, parent, depth)) = stack.pop() {
-            max_depth = max_depth.max(depth);
+            assert!(depth < 64, "depth {depth} overflows the kernel's stack");
             let (lo, hi) = node(index);
             if let Some((plo, phi)) = parent {
                 for a in 0..3 {
@@ -1036,41 +1059,66 @@ mod tests {
                 stack.push((offset, Some((lo, hi)), depth + 1));
                 continue;
             }
-            for (primitive, times) in seen.iter_mut().enumerate().skip(offset).take(count) {
-                *times += 1;
-                let words = &flat.prims[primitive * PRIM_STRIDE..][..PRIM_STRIDE];
-                if unbits(words[0][3]) == PRIM_TRIANGLE {
-                    for vertex in &words[..3] {
-                        for a in 0..3 {
-                            assert!(vertex[a] >= lo[a] && vertex[a] <= hi[a]);
+            leaves.push((offset, count));
+            if triangles {
+                for primitive in offset..offset + count {
+                    let words = &flat.prims[primitive * PRIM_STRIDE..][..PRIM_STRIDE];
+                    if unbits(words[0][3]) == PRIM_TRIANGLE {
+                        for vertex in &words[..3] {
+                            for a in 0..3 {
+                                assert!(vertex[a] >= lo[a] && vertex[a] <= hi[a]);
+                            }
                         }
                     }
                 }
             }
         }
+        leaves
+    }
+
+    /// Each item index in `leaves` exactly once, and together exactly `0..count` from `first`.
+    fn assert_covers(leaves: &[(usize, usize)], first: usize, count: usize) {
+        let mut seen = vec![0u32; count];
+        for &(offset, n) in leaves {
+            for item in offset..offset + n {
+                seen[item - first] += 1;
+            }
+        }
         assert!(
             seen.iter().all(|&n| n == 1),
-            "a primitive is missing or repeated"
+            "an item is missing or repeated"
         );
-        assert!(
-            max_depth < 64,
-            "depth {max_depth} overflows the kernel's stack"
-        );
-        // The instanced box: its transform stored after the primitives, its material
-        // overridden, its shadow flag cleared.
-        let boxed = (0..primitive_count)
-            .find(|&p| unbits(flat.prims[p * PRIM_STRIDE][3]) == PRIM_BOX)
-            .unwrap();
-        let words = &flat.prims[boxed * PRIM_STRIDE..][..PRIM_STRIDE];
-        assert_eq!(unbits(words[1][3]), 3);
-        assert_eq!(unbits(words[3][3]) & FLAG_CASTS_SHADOW, 0);
-        let transform = unbits(words[2][3]) as usize;
+    }
+
+    /// The two levels: the top covers every instance once, each instance's geometry every
+    /// one of its primitives once; the instances carry their transform, material override and
+    /// shadow flag.
+    #[test]
+    fn both_bvh_levels_cover_everything_once_within_bounds() {
+        let flat = FlatScene::new(&scene(2000));
+        let instances = flat.params.instances as usize;
         assert_eq!(
-            flat.params.transforms as usize + transform * TRANSFORM_STRIDE,
-            primitive_count * PRIM_STRIDE
+            instances / PRIM_STRIDE,
+            2002,
+            "the instances follow the primitives"
         );
+        let top = walk(&flat, flat.params.tlas_root as usize, false);
+        assert_covers(&top, 0, 2);
+        let record = |i: usize| &flat.prims[instances + i * INSTANCE_STRIDE..][..INSTANCE_STRIDE];
+        let (plain, boxed) = if unbits(record(0)[3][2]) & FLAG_TRANSFORMED == 0 {
+            (record(0), record(1))
+        } else {
+            (record(1), record(0))
+        };
+        assert_covers(&walk(&flat, unbits(plain[3][0]) as usize, true), 0, 2001);
+        assert_covers(&walk(&flat, unbits(boxed[3][0]) as usize, true), 2001, 1);
+        assert_eq!(unbits(plain[3][1]), NONE);
+        assert_eq!(unbits(plain[3][2]), FLAG_CASTS_SHADOW);
+        assert_eq!(unbits(boxed[3][1]), 3);
+        assert_eq!(unbits(boxed[3][2]), FLAG_TRANSFORMED);
         // object_from_world of a translation by 20: the last column is -20.
-        assert_eq!(flat.prims[flat.params.transforms as usize][3], -20.0);
+        assert_eq!(boxed[0][3], -20.0);
+        assert_eq!(unbits(flat.prims[2001 * PRIM_STRIDE][3]), PRIM_BOX);
     }
 
     /// The light tables: selection by power (π·area·L for the triangles, 4π·I for the point

@@ -21,7 +21,9 @@ const PRIM_TRIANGLE: u32 = 0u;
 const PRIM_SPHERE: u32 = 1u;
 const PRIM_BOX: u32 = 2u;
 const PRIM_STRIDE: u32 = 4u;
-const TRANSFORM_STRIDE: u32 = 3u;
+const INSTANCE_STRIDE: u32 = 4u;
+const FLAG_CASTS_SHADOW: u32 = 1u;
+const FLAG_TRANSFORMED: u32 = 2u;
 
 // Material BSDF kinds (layout.rs BSDF_*).
 const BSDF_BLACK: u32 = 0u;
@@ -74,7 +76,7 @@ struct Params {
     column_cdf: u32,
     column_start: u32,
     first_row: u32,
-    transforms: u32,
+    instances: u32,
     // Perspective 0, orthographic 1.
     projection: u32,
     // The crop window: its top-left pixel and size; the accumulation buffer covers it alone.
@@ -84,7 +86,8 @@ struct Params {
     crop_height: u32,
     // Always 2; read from the uniform so the compiler cannot unroll the canary loop.
     canary: u32,
-    _pad0: u32,
+    // The top-level BVH (over the instances) starts here.
+    tlas_root: u32,
     _pad1: u32,
     camera_position: vec4<f32>,
     // xyz: the basis vectors; w of u: focal length, of v: image-plane width, of w: aspect.
@@ -1056,6 +1059,7 @@ struct Ray {
 struct Hit {
     t: f32,
     primitive: u32,
+    instance: u32,
     b1: f32,
     b2: f32,
 }
@@ -1181,27 +1185,16 @@ fn transform_vector(m: u32, v: vec3<f32>) -> vec3<f32> {
     return vec3<f32>(dot(prims[m].xyz, v), dot(prims[m + 1u].xyz, v), dot(prims[m + 2u].xyz, v));
 }
 
-fn transform_offset(primitive: u32) -> u32 {
-    let index = bitcast<u32>(prims[primitive * PRIM_STRIDE + 2u].w);
-    if (index == NONE) {
-        return NONE;
-    }
-    return params.transforms + index * TRANSFORM_STRIDE;
+fn instance_base(instance: u32) -> u32 {
+    return params.instances + instance * INSTANCE_STRIDE;
 }
 
-// The ray in the primitive's object space (world t kept: the direction is not normalised).
-fn object_ray(ray: Ray, primitive: u32) -> Ray {
-    let m = transform_offset(primitive);
-    if (m == NONE) {
-        return ray;
-    }
-    var r = ray;
-    r.origin = transform_point(m, ray.origin);
-    r.direction = transform_vector(m, ray.direction);
-    return r;
+// [geometry's root node, material override, flags, 0].
+fn instance_info(instance: u32) -> vec4<f32> {
+    return prims[instance_base(instance) + 3u];
 }
 
-// (t, b1, b2) of the primitive, t < 0 for a miss.
+// (t, b1, b2) of the primitive for a ray in its object space, t < 0 for a miss.
 fn intersect_primitive(ray: Ray, primitive: u32) -> vec3<f32> {
     let base = primitive * PRIM_STRIDE;
     let p0 = prims[base];
@@ -1210,15 +1203,10 @@ fn intersect_primitive(ray: Ray, primitive: u32) -> vec3<f32> {
     if (kind == PRIM_TRIANGLE) {
         return intersect_triangle(ray, p0.xyz, p1.xyz, prims[base + 2u].xyz);
     }
-    let local = object_ray(ray, primitive);
     if (kind == PRIM_SPHERE) {
-        return vec3<f32>(intersect_sphere(local, p0.xyz, p1.x), 0.0, 0.0);
+        return vec3<f32>(intersect_sphere(ray, p0.xyz, p1.x), 0.0, 0.0);
     }
-    return vec3<f32>(intersect_box(local, p0.xyz, p1.xyz), 0.0, 0.0);
-}
-
-fn casts_shadow(primitive: u32) -> bool {
-    return (bitcast<u32>(prims[primitive * PRIM_STRIDE + 3u].w) & 1u) != 0u;
+    return vec3<f32>(intersect_box(ray, p0.xyz, p1.xyz), 0.0, 0.0);
 }
 
 fn node_hit(ray_origin: vec3<f32>, inverse_direction: vec3<f32>, node: u32, t_min: f32, t_max: f32) -> bool {
@@ -1233,36 +1221,33 @@ fn node_hit(ray_origin: vec3<f32>, inverse_direction: vec3<f32>, node: u32, t_mi
 
 const STACK_SIZE: u32 = 64u;
 
-// The closest hit in the ray's window (any_hit: the first shadow-casting hit, for occlusion).
-fn traverse(ray_in: Ray, any_hit: bool) -> Hit {
+// One instance's geometry, the ray in its object space (world t kept: the direction is not
+// normalised): records a closer hit in `best`; true when it found one.
+fn traverse_geometry(ray_in: Ray, root: u32, instance: u32, any_hit: bool, best: ptr<function, Hit>) -> bool {
     var ray = ray_in;
-    var best: Hit;
-    best.t = -1.0;
-    best.primitive = NONE;
     let inverse_direction = 1.0 / ray.direction;
     var stack: array<u32, STACK_SIZE>;
     var top = 0u;
-    var node = 0u;
+    var node = root;
+    var found = false;
     loop {
         if (node_hit(ray.origin, inverse_direction, node, ray.t_min, ray.t_max)) {
-            let meta_data = nodes[2u * node];
             let count = bitcast<u32>(nodes[2u * node + 1u].w);
-            let offset = bitcast<u32>(meta_data.w);
+            let offset = bitcast<u32>(nodes[2u * node].w);
             if (count > 0u) {
                 for (var i = 0u; i < count; i += 1u) {
                     let primitive = offset + i;
-                    if (any_hit && !casts_shadow(primitive)) {
-                        continue;
-                    }
                     let h = intersect_primitive(ray, primitive);
                     if (h.x >= 0.0 && h.x >= ray.t_min && h.x <= ray.t_max) {
-                        best.t = h.x;
-                        best.primitive = primitive;
-                        best.b1 = h.y;
-                        best.b2 = h.z;
+                        (*best).t = h.x;
+                        (*best).primitive = primitive;
+                        (*best).instance = instance;
+                        (*best).b1 = h.y;
+                        (*best).b2 = h.z;
                         ray.t_max = h.x;
+                        found = true;
                         if (any_hit) {
-                            return best;
+                            return true;
                         }
                     }
                 }
@@ -1282,7 +1267,72 @@ fn traverse(ray_in: Ray, any_hit: bool) -> Hit {
         top -= 1u;
         node = stack[top];
     }
+    return found;
+}
+
+// The closest hit in the ray's window (any_hit: the first hit on an instance that casts
+// shadows, for occlusion): the top-level BVH over the instances, then each instance's
+// geometry in its object space.
+fn traverse(ray_in: Ray, any_hit: bool) -> Hit {
+    var ray = ray_in;
+    var best: Hit;
+    best.t = -1.0;
+    best.primitive = NONE;
+    best.instance = NONE;
+    let inverse_direction = 1.0 / ray.direction;
+    var stack: array<u32, STACK_SIZE>;
+    var top = 0u;
+    var node = params.tlas_root;
+    loop {
+        if (node_hit(ray.origin, inverse_direction, node, ray.t_min, ray.t_max)) {
+            let count = bitcast<u32>(nodes[2u * node + 1u].w);
+            let offset = bitcast<u32>(nodes[2u * node].w);
+            if (count > 0u) {
+                for (var i = 0u; i < count; i += 1u) {
+                    let instance = offset + i;
+                    let info = instance_info(instance);
+                    let flags = bitcast<u32>(info.z);
+                    if (any_hit && (flags & FLAG_CASTS_SHADOW) == 0u) {
+                        continue;
+                    }
+                    var local = ray;
+                    if ((flags & FLAG_TRANSFORMED) != 0u) {
+                        let m = instance_base(instance);
+                        local.origin = transform_point(m, ray.origin);
+                        local.direction = transform_vector(m, ray.direction);
+                    }
+                    if (traverse_geometry(local, bitcast<u32>(info.x), instance, any_hit, &best)) {
+                        if (any_hit) {
+                            return best;
+                        }
+                        ray.t_max = best.t;
+                    }
+                }
+            } else {
+                if (top < STACK_SIZE) {
+                    stack[top] = offset;
+                    top += 1u;
+                }
+                node = node + 1u;
+                continue;
+            }
+        }
+        if (top == 0u) {
+            break;
+        }
+        top -= 1u;
+        node = stack[top];
+    }
     return best;
+}
+
+// The material of a hit: the instance's override, else the primitive's.
+fn hit_material(hit: Hit) -> u32 {
+    let override_material = bitcast<u32>(instance_info(hit.instance).y);
+    if (override_material != NONE) {
+        return override_material;
+    }
+    return bitcast<u32>(prims[hit.primitive * PRIM_STRIDE + 1u].w);
 }
 
 struct Surface {
@@ -1317,24 +1367,24 @@ fn surface(ray: Ray, hit: Hit, needs_uv: bool) -> Surface {
     let base = hit.primitive * PRIM_STRIDE;
     let p0 = prims[base];
     let p1 = prims[base + 1u];
-    let p3 = prims[base + 3u];
     let kind = bitcast<u32>(p0.w);
     si.point = ray.origin + ray.direction * hit.t;
-    si.material = bitcast<u32>(p1.w);
+    si.material = hit_material(hit);
     si.uv = vec2<f32>(0.0);
-    if (kind == PRIM_TRIANGLE) {
-        // The world-space normal was worked out when the scene was flattened.
-        si.normal = p3.xyz;
-        si.uv = vec2<f32>(hit.b1, hit.b2);
-        return si;
+    var m = NONE;
+    if ((bitcast<u32>(instance_info(hit.instance).z) & FLAG_TRANSFORMED) != 0u) {
+        m = instance_base(hit.instance);
     }
-    let m = transform_offset(hit.primitive);
     var local = si.point;
     if (m != NONE) {
         local = transform_point(m, si.point);
     }
     var n: vec3<f32>;
-    if (kind == PRIM_SPHERE) {
+    if (kind == PRIM_TRIANGLE) {
+        // The object-space normal was worked out when the scene was flattened.
+        n = prims[base + 3u].xyz;
+        si.uv = vec2<f32>(hit.b1, hit.b2);
+    } else if (kind == PRIM_SPHERE) {
         let center = p0.xyz;
         let radius = p1.x;
         n = normalize((local - center) / radius);
@@ -1444,7 +1494,7 @@ fn trace(camera: Ray) -> vec3<f32> {
             }
             break;
         }
-        let material = material_index(bitcast<u32>(prims[hit.primitive * PRIM_STRIDE + 1u].w));
+        let material = material_index(hit_material(hit));
         let mbase = material * MATERIAL_STRIDE;
         let m3 = materials[mbase + 3u];
         let textured = bitcast<u32>(materials[mbase].w) != NONE || bitcast<u32>(materials[mbase + 1u].w) != NONE;
