@@ -256,6 +256,11 @@ pub struct Options {
     #[command(flatten)]
     pub limits: LimitOptions,
 
+    /// Where the path tracer runs: `cpu`, or `gpu` (wgpu on Vulkan; prints the adapter's
+    /// name; only --integrator path).
+    #[arg(long, value_name = "DEVICE", value_enum, default_value_t = DeviceArg::Cpu)]
+    pub device: DeviceArg,
+
     /// Also print the settings and the loading time.
     #[arg(short = 'v', long, action = ArgAction::SetTrue)]
     pub verbose: bool,
@@ -357,6 +362,13 @@ impl From<IntegratorArg> for IntegratorKind {
     }
 }
 
+/// `--device` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DeviceArg {
+    Cpu,
+    Gpu,
+}
+
 /// A colour given on the command line.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rgb(pub [f32; 3]);
@@ -456,6 +468,7 @@ pub struct Job {
     pub background: Option<Color>,
     /// How a PNG output's 8-bit values are made.
     pub png: PngEncoding,
+    pub device: DeviceArg,
     pub verbose: bool,
     /// How the scene's BVHs split (`-s`).
     pub split: SplitMethod,
@@ -575,6 +588,7 @@ impl Options {
                 .map_or(available_threads.max(1), |n| n as usize),
             background: self.background.map(Rgb::to_color),
             png: png_encoding(self.integrator, self.exposure, self.tonemap, self.transfer),
+            device: self.device,
             verbose: self.verbose,
             split: self.split,
             depth_of_field: self
@@ -700,6 +714,22 @@ mod tests {
         assert_eq!(job.settings.integrator, IntegratorKind::Course);
         assert_eq!(job.threads, 8);
         assert_eq!(job.background, None);
+        assert_eq!(job.device, DeviceArg::Cpu);
+    }
+
+    #[test]
+    fn device_gpu() {
+        let gpu = job(&[
+            "render",
+            "s.json",
+            "--integrator",
+            "path",
+            "--device",
+            "gpu",
+        ])
+        .unwrap();
+        assert_eq!(gpu.device, DeviceArg::Gpu);
+        assert!(job(&["render", "s.json", "--device", "tpu"]).is_err());
     }
 
     #[test]

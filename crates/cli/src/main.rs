@@ -8,6 +8,7 @@
 mod args;
 mod bench;
 mod diff;
+mod gpu;
 mod preview;
 mod run;
 

@@ -14,7 +14,7 @@ use glint_render::{
 };
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::args::{Job, UsageError};
+use crate::args::{DeviceArg, Job, UsageError};
 use crate::preview::TileSink;
 
 /// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).
@@ -29,6 +29,11 @@ pub enum Failure {
     Scene(SceneError),
     /// The image could not be written (exit 1).
     Write(ImageWriteError),
+    /// The GPU back end cannot render this scene with these settings (exit 2: like a bad
+    /// argument, the user asked for something this device does not do).
+    GpuUnsupported(glint_gpu::GpuError),
+    /// No GPU adapter, or the device failed (exit 1: the machine, not the input, is at fault).
+    Gpu(glint_gpu::GpuError),
     /// The render threads could not be started (exit 1).
     ThreadPool(rayon::ThreadPoolBuildError),
     /// Ctrl-C or SIGTERM (exit 130). Nothing was written.
@@ -42,10 +47,12 @@ pub enum Failure {
 impl Failure {
     pub fn exit_code(&self) -> u8 {
         match self {
-            Failure::Usage(_) | Failure::Scene(_) | Failure::Strict { .. } | Failure::Memory(_) => {
-                2
-            }
-            Failure::Write(_) | Failure::ThreadPool(_) => 1,
+            Failure::Usage(_)
+            | Failure::Scene(_)
+            | Failure::Strict { .. }
+            | Failure::Memory(_)
+            | Failure::GpuUnsupported(_) => 2,
+            Failure::Write(_) | Failure::ThreadPool(_) | Failure::Gpu(_) => 1,
             Failure::Interrupted => EXIT_INTERRUPTED,
         }
     }
@@ -65,6 +72,7 @@ impl fmt::Display for Failure {
             }
             // It names the file: "cannot write out.png: ...".
             Failure::Write(error) => write!(f, "{error}"),
+            Failure::GpuUnsupported(error) | Failure::Gpu(error) => write!(f, "{error}"),
             Failure::ThreadPool(error) => write!(f, "cannot start the render threads: {error}"),
             Failure::Interrupted => f.write_str("interrupted: no image was written"),
             Failure::Strict { scene, warnings } => write!(
@@ -252,6 +260,9 @@ pub fn run(
         shape_count(&parts),
         job.max_memory,
     )?;
+    if job.device == DeviceArg::Gpu {
+        return crate::gpu::run(job, &parts, interrupt, err, progress_bar);
+    }
     let options = SceneOptions { split: job.split };
     let scene = pool.install(|| Scene::with_options(parts, options));
     let load_time = load_start.elapsed();
@@ -594,7 +605,7 @@ fn threads_text(threads: usize) -> String {
     format!("{threads} thread{}", plural(threads as u64))
 }
 
-fn plural(count: u64) -> &'static str {
+pub(crate) fn plural(count: u64) -> &'static str {
     if count == 1 {
         ""
     } else {
@@ -649,6 +660,7 @@ mod tests {
             threads: 2,
             background: None,
             png: glint_io::PngEncoding::Course,
+            device: DeviceArg::Cpu,
             verbose: false,
             split: glint_render::SplitMethod::Sah,
             depth_of_field: None,

@@ -1,0 +1,151 @@
+//! `--device gpu`: the path tracer on the GPU back end (glint-gpu) instead of the CPU's render
+//! pipeline. The run is the CPU's (`run::run` loads the scene, this module renders and writes)
+//! with the GPU's own reporting: the adapter's name first, a progress bar over sample passes,
+//! and a closing line in samples per second (the GPU does not count rays).
+//!
+//! Exit statuses: 2 when the GPU path does not support what was asked (another integrator,
+//! or a scene whose buffers exceed what the adapter can bind), like any other unusable
+//! argument; 1 when there is no adapter or the device fails, since then the machine, not the
+//! input, is at fault.
+
+use std::io::Write;
+use std::time::Instant;
+
+use glint_gpu::{GpuError, GpuRenderer};
+use glint_render::{RenderStats, SceneParts};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use crate::args::{Job, UsageError};
+use crate::run::{plural, si, Failure, Interrupt, Phase, Summary};
+
+/// Renders `parts` on the GPU and writes the image.
+pub fn run(
+    job: &Job,
+    parts: &SceneParts,
+    interrupt: &Interrupt,
+    err: &mut dyn Write,
+    progress_bar: bool,
+) -> Result<Summary, Failure> {
+    let settings = &job.settings;
+    // Options of the CPU pipeline the GPU path does not have: refused, never ignored.
+    let cpu_only = [
+        (job.preview.is_some(), "the preview window (-x/-y)"),
+        (job.stats, "--stats (the CPU BVH's figures)"),
+        (
+            job.split != glint_render::SplitMethod::default(),
+            "-s (the GPU builds its own SAH BVH)",
+        ),
+    ];
+    if let Some((_, what)) = cpu_only.iter().find(|(asked, _)| *asked) {
+        return Err(unsupported(GpuError::Unsupported(format!(
+            "{what} with --device gpu"
+        ))));
+    }
+    glint_gpu::check_supported(parts, settings).map_err(unsupported)?;
+    let gpu = GpuRenderer::new().map_err(Failure::Gpu)?;
+    let adapter = gpu.adapter_name();
+    let _ = writeln!(err, "device: {adapter}");
+    if job.verbose {
+        let _ = writeln!(
+            err,
+            "rendering {}x{}, {} samples per pixel, depth {}, seed {}, path integrator on the \
+             GPU -> {}",
+            settings.width,
+            settings.height,
+            settings.samples_per_pixel(),
+            settings.max_depth(),
+            settings.seed,
+            job.output.display()
+        );
+    }
+
+    let bar = progress_bar.then(|| {
+        let bar = ProgressBar::with_draw_target(
+            Some(settings.samples_per_pixel() as u64),
+            ProgressDrawTarget::stderr(),
+        );
+        let style = ProgressStyle::with_template(
+            "{elapsed_precise} [{wide_bar}] {pos}/{len} samples per pixel, ETA {eta}",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> ");
+        bar.set_style(style);
+        bar
+    });
+    let progress = |done: u32, total: u32| {
+        if let Some(bar) = &bar {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        }
+        !interrupt.requested()
+    };
+    interrupt.set_phase(Phase::Rendering);
+    let start = Instant::now();
+    let result = gpu.render(parts, settings, &progress);
+    let render_time = start.elapsed();
+    if let Some(bar) = &bar {
+        bar.finish_and_clear();
+    }
+    interrupt.set_phase(Phase::Writing);
+    let (film, stats) = match result {
+        Ok(rendered) if !interrupt.requested() => rendered,
+        Ok(_) | Err(GpuError::Cancelled) => return Err(Failure::Interrupted),
+        Err(error) => return Err(unsupported(error)),
+    };
+    if stats.nonfinite_samples > 0 {
+        let first = stats
+            .first_nonfinite_pixel
+            .map(|(x, y)| format!("; the first in pixel ({x}, {y}) from the top-left"))
+            .unwrap_or_default();
+        let _ = writeln!(
+            err,
+            "warning: {} sample{} returned NaN or infinity and {} left out of the image{first}",
+            stats.nonfinite_samples,
+            plural(stats.nonfinite_samples),
+            if stats.nonfinite_samples == 1 {
+                "was"
+            } else {
+                "were"
+            },
+        );
+    }
+    let options = glint_io::WriteOptions { png: job.png };
+    glint_io::write_image_with(&job.output, &film, &options).map_err(Failure::Write)?;
+
+    let seconds = render_time.as_secs_f64();
+    let rate = if seconds > 0.0 {
+        stats.samples as f64 / seconds
+    } else {
+        0.0
+    };
+    let _ = writeln!(
+        err,
+        "rendered {}x{}, {} rpp in {seconds:.2} s on the GPU: {} samples, {} samples/s -> {}",
+        settings.width,
+        settings.height,
+        settings.samples_per_pixel(),
+        si(stats.samples as f64),
+        si(rate),
+        job.output.display()
+    );
+    Ok(Summary {
+        stats: RenderStats {
+            nonfinite_samples: stats.nonfinite_samples,
+            first_nonfinite_pixel: stats.first_nonfinite_pixel,
+            ..RenderStats::default()
+        },
+        render_time,
+        threads: 0,
+    })
+}
+
+/// The failure for a `GpuError`: what the user asked for (exit 2) or what the machine lacks
+/// (exit 1).
+fn unsupported(error: GpuError) -> Failure {
+    match error {
+        GpuError::Unsupported(_) => Failure::GpuUnsupported(error),
+        GpuError::Invalid(why) => Failure::Usage(UsageError(why)),
+        GpuError::Cancelled => Failure::Interrupted,
+        GpuError::NoAdapter(_) | GpuError::Device(_) => Failure::Gpu(error),
+    }
+}

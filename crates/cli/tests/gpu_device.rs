@@ -1,0 +1,185 @@
+//! `glint render --device gpu`: the adapter's name, the image, and the two ways it refuses
+//! (exit 2 for an integrator the GPU does not run, exit 1 when there is no adapter).
+//! Rendering needs a Vulkan adapter (lavapipe in CI): without one that test prints SKIPPED,
+//! and fails under CI=1.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use tempfile::TempDir;
+
+const GLINT: &str = env!("CARGO_BIN_EXE_glint");
+
+/// A grey diffuse sphere under a constant white sky: with the path tracer, the sphere's
+/// pixels are 0.5 in expectation (its albedo times the sky, all of which it sees) and the
+/// sky's are 1.
+const FURNACE_JSON: &str = r#"{
+  "scene": {
+    "bgColor": "1 1 1",
+    "camera": [{
+      "position": "0 0 0", "viewDir": "0 0 -1", "focalLength": 1.0,
+      "imagePlaneWidth": 0.5, "_name": "main", "_type": "perspective"
+    }],
+    "shader": [{ "diffuse": "0.5 0.5 0.5", "_name": "grey", "_type": "Lambertian" }],
+    "shape": [{
+      "shader": { "_ref": "grey" }, "center": "0 0 -5", "radius": 1,
+      "_name": "ball", "_type": "sphere"
+    }]
+  }
+}
+"#;
+
+fn glint(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Output {
+    let mut command = Command::new(GLINT);
+    command.args(args).current_dir(dir);
+    for (key, value) in env {
+        command.env(key, value);
+    }
+    command.output().expect("glint runs")
+}
+
+fn scene_dir() -> TempDir {
+    let dir = TempDir::new().unwrap();
+    std::fs::write(dir.path().join("furnace.json"), FURNACE_JSON).unwrap();
+    dir
+}
+
+fn ci() -> bool {
+    std::env::var_os("CI").is_some_and(|v| !v.is_empty() && v != "0")
+}
+
+#[test]
+fn gpu_renders_the_furnace_and_names_its_adapter() {
+    let dir = scene_dir();
+    let args = [
+        "render",
+        "furnace.json",
+        "--integrator",
+        "path",
+        "--device",
+        "gpu",
+        "-w",
+        "32",
+        "-h",
+        "32",
+        "-r",
+        "64",
+        "-o",
+        "out.exr",
+    ];
+    let output = glint(dir.path(), &args, &[]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if output.status.code() == Some(1) && stderr.contains("no GPU adapter") {
+        assert!(!ci(), "CI is set but there is no Vulkan adapter: {stderr}");
+        println!("SKIPPED (no Vulkan adapter): {stderr}");
+        return;
+    }
+    assert!(output.status.success(), "{stderr}");
+    // The adapter's name comes first from glint (Mesa may print its own notes before it).
+    assert!(
+        stderr.lines().any(|line| line.starts_with("device: ")),
+        "{stderr}"
+    );
+    assert!(stderr.contains("on the GPU"), "{stderr}");
+    let image = image::open(dir.path().join("out.exr"))
+        .unwrap()
+        .into_rgb32f();
+    assert_eq!(image.dimensions(), (32, 32));
+    // The corner sees the sky: exactly 1. The sphere's pixels are 0.5 in expectation (it is
+    // convex, so all it sees is the sky): the mean of the central 8x8 block must be within
+    // five standard errors (estimated from the block's own scatter) of 0.5.
+    let corner = image.get_pixel(0, 0).0;
+    for c in corner {
+        assert!((c - 1.0).abs() < 1e-6, "corner {corner:?}");
+    }
+    let block: Vec<f64> = (12..20)
+        .flat_map(|y| (12..20).map(move |x| (x, y)))
+        .map(|(x, y)| image.get_pixel(x, y).0[1] as f64)
+        .collect();
+    let n = block.len() as f64;
+    let mean = block.iter().sum::<f64>() / n;
+    let variance = block.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    let standard_error = (variance / n).sqrt();
+    println!("furnace: sphere {mean:.4} +- {standard_error:.4} (expected 0.5)");
+    assert!(
+        (mean - 0.5).abs() <= 5.0 * standard_error && standard_error < 0.01,
+        "sphere {mean} +- {standard_error}, expected 0.5"
+    );
+}
+
+#[test]
+fn gpu_refuses_the_course_integrator_with_exit_2() {
+    let dir = scene_dir();
+    let output = glint(
+        dir.path(),
+        &["render", "furnace.json", "--device", "gpu", "-o", "out.png"],
+        &[],
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(2), "{stderr}");
+    assert!(
+        stderr.contains("does not support the course integrator"),
+        "{stderr}"
+    );
+    assert!(!dir.path().join("out.png").exists());
+}
+
+#[test]
+fn no_adapter_is_a_clear_error_with_exit_1() {
+    let dir = scene_dir();
+    // A Vulkan loader pointed at a driver list that does not exist finds no adapter.
+    let output = glint(
+        dir.path(),
+        &[
+            "render",
+            "furnace.json",
+            "--integrator",
+            "path",
+            "--device",
+            "gpu",
+            "-o",
+            "out.png",
+        ],
+        &[
+            ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+            ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert_eq!(output.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("no GPU adapter found"), "{stderr}");
+    assert!(!dir.path().join("out.png").exists());
+}
+
+/// What only the CPU pipeline has is refused before any device opens, never ignored.
+#[test]
+fn gpu_refuses_cpu_only_options_with_exit_2() {
+    let dir = scene_dir();
+    let cases: [(&[&str], &str); 4] = [
+        (&["-d", "5"], "depth of field (-d)"),
+        (&["-x", "64"], "the preview window (-x/-y)"),
+        (&["--stats"], "--stats"),
+        (
+            &["-s", "objectMedian"],
+            "-s (the GPU builds its own SAH BVH)",
+        ),
+    ];
+    for (extra, named) in cases {
+        let mut args = vec![
+            "render",
+            "furnace.json",
+            "--integrator",
+            "path",
+            "--device",
+            "gpu",
+            "-o",
+            "out.png",
+        ];
+        args.extend_from_slice(extra);
+        let output = glint(dir.path(), &args, &[]);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert_eq!(output.status.code(), Some(2), "{extra:?}: {stderr}");
+        assert!(stderr.contains(named), "{extra:?}: {stderr}");
+        assert!(!dir.path().join("out.png").exists());
+    }
+}
