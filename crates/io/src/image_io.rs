@@ -186,13 +186,7 @@ pub fn output_format(path: &Path) -> Result<OutputFormat, ImageWriteError> {
 /// denoisers take) and `depth.Y`. A PNG holds the beauty alone.
 pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
     let format = output_format(path)?;
-    let expected_pixels = film.width as usize * film.height as usize;
-    let features_fit = film.features.as_ref().is_none_or(|features| {
-        features.albedo.len() == expected_pixels
-            && features.normal.len() == expected_pixels
-            && features.depth.len() == expected_pixels
-    });
-    if film.pixels.len() != expected_pixels || expected_pixels == 0 || !features_fit {
+    if !film_is_whole(film) {
         return Err(ImageWriteError::InvalidFilm {
             path: path.to_path_buf(),
             width: film.width,
@@ -215,11 +209,7 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
         .map_err(io_error)?;
     {
         let mut writer = BufWriter::new(temporary.as_file_mut());
-        match format {
-            OutputFormat::Png => encode_png(film, &mut writer),
-            OutputFormat::Exr => encode_exr(film, &mut writer),
-        }
-        .map_err(|source| ImageWriteError::Encode {
+        encode_to(film, format, &mut writer).map_err(|source| ImageWriteError::Encode {
             path: path.to_path_buf(),
             source,
         })?;
@@ -234,7 +224,46 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
     Ok(())
 }
 
-fn encode_png(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), EncodeError> {
+/// The bytes `write_image` would write for `film` in `format`, held in memory: for front ends
+/// without a file system (the browser), so their files equal the CLI's byte for byte.
+pub fn encode_image(film: &Film, format: OutputFormat) -> Result<Vec<u8>, EncodeError> {
+    if !film_is_whole(film) {
+        return Err(format!(
+            "the film is {} x {} but holds {} pixels",
+            film.width,
+            film.height,
+            film.pixels.len()
+        )
+        .into());
+    }
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    encode_to(film, format, &mut bytes)?;
+    Ok(bytes.into_inner())
+}
+
+/// Whether the film has pixels and as many of them (and of each feature layer) as its size says.
+fn film_is_whole(film: &Film) -> bool {
+    let expected_pixels = film.width as usize * film.height as usize;
+    let features_fit = film.features.as_ref().is_none_or(|features| {
+        features.albedo.len() == expected_pixels
+            && features.normal.len() == expected_pixels
+            && features.depth.len() == expected_pixels
+    });
+    film.pixels.len() == expected_pixels && expected_pixels != 0 && features_fit
+}
+
+fn encode_to(
+    film: &Film,
+    format: OutputFormat,
+    writer: &mut (impl Write + std::io::Seek),
+) -> Result<(), EncodeError> {
+    match format {
+        OutputFormat::Png => encode_png(film, writer),
+        OutputFormat::Exr => encode_exr(film, writer),
+    }
+}
+
+fn encode_png(film: &Film, writer: &mut (impl Write + std::io::Seek)) -> Result<(), EncodeError> {
     let buffer = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8_course())
         .ok_or("film size does not match its pixels")?;
     buffer.write_to(writer, image::ImageFormat::Png)?;
@@ -243,7 +272,7 @@ fn encode_png(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), Enco
 
 /// One EXR part with f32 channels R, G, B (the beauty) and the feature layers' channels, rows
 /// from the top, as the `exr` crate stores them.
-fn encode_exr(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), EncodeError> {
+fn encode_exr(film: &Film, writer: &mut (impl Write + std::io::Seek)) -> Result<(), EncodeError> {
     use exr::prelude::{
         AnyChannel, AnyChannels, Encoding, FlatSamples, Image as ExrImage, Layer, LayerAttributes,
         WritableImage,

@@ -60,7 +60,9 @@ use std::path::Path;
 
 pub use assets::{Assets, FileSystem, MemoryAssets};
 pub use diagnostic::{Diagnostic, SceneError, Severity};
-pub use image_io::{output_format, write_image, EncodeError, ImageWriteError, OutputFormat};
+pub use image_io::{
+    encode_image, output_format, write_image, EncodeError, ImageWriteError, OutputFormat,
+};
 pub use mesh::{load_mesh, Mesh, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
 
