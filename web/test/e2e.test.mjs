@@ -11,7 +11,7 @@ import path from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { chromium } from 'playwright-core';
 import { PNG } from 'pngjs';
-import { serve } from './serve.mjs';
+import { serve } from '../serve.mjs';
 
 const web = path.dirname(path.dirname(fileURLToPath(import.meta.url)));
 const repo = path.dirname(web);
@@ -154,8 +154,10 @@ test('the page renders the example scene with its assets exactly as the CLI', as
 
   // The downloaded files are the CLI's, byte for byte.
   const png = await downloadBytes(page, '#download-png');
+  fs.writeFileSync(path.join(output, 'page.png'), png);
   assert.ok(png.equals(fs.readFileSync(cliPng)), 'the downloaded PNG differs from the CLI\'s');
   const exr = await downloadBytes(page, '#download-exr');
+  fs.writeFileSync(path.join(output, 'page.exr'), exr);
   assert.ok(exr.equals(fs.readFileSync(cliExr)), 'the downloaded EXR differs from the CLI\'s');
   assert.deepEqual(errors, []);
   await context.close();

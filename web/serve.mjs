@@ -6,12 +6,11 @@ import { fileURLToPath } from 'node:url';
 import path from 'node:path';
 import handler from 'serve-handler';
 
-const root = path.dirname(path.dirname(fileURLToPath(import.meta.url)));
+const root = path.dirname(fileURLToPath(import.meta.url));
 
 export function serve(port = 0) {
   const server = http.createServer((request, response) => handler(request, response, {
     public: root,
-    cleanUrls: false,
     directoryListing: false,
   }));
   return new Promise((resolve) => {
