@@ -11,7 +11,10 @@ const WEB: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
 fn example_files() -> (String, Files) {
     let root = Path::new(WEB).join("scenes");
     let mut files = Files::new();
-    for asset in ["textured/images/checker.png", "textured/objFiles/pyramid.obj"] {
+    for asset in [
+        "textured/images/checker.png",
+        "textured/objFiles/pyramid.obj",
+    ] {
         files.add(asset, std::fs::read(root.join(asset)).unwrap());
     }
     let text = std::fs::read_to_string(root.join("textured/textured.xml")).unwrap();
@@ -28,14 +31,20 @@ fn tiles_assembled_and_encoded_equal_the_cli_files() {
     let settings = Settings::new(width, height, 4, "course", 3, None, true).unwrap();
 
     let count = (width * height) as usize;
-    let (mut pixels, mut albedo, mut normal) =
-        (vec![0.0; count * 3], vec![0.0; count * 3], vec![0.0; count * 3]);
+    let (mut pixels, mut albedo, mut normal) = (
+        vec![0.0; count * 3],
+        vec![0.0; count * 3],
+        vec![0.0; count * 3],
+    );
     let mut depth = vec![0.0; count];
     let mut rays = 0.0;
     let tile = 32;
     for y0 in (0..height).step_by(tile) {
         for x0 in (0..width).step_by(tile) {
-            let (x1, y1) = ((x0 + tile as u32).min(width), (y0 + tile as u32).min(height));
+            let (x1, y1) = (
+                (x0 + tile as u32).min(width),
+                (y0 + tile as u32).min(height),
+            );
             let result = loaded.render_tile(&settings, x0, y0, x1, y1).unwrap();
             let tile_width = (x1 - x0) as usize;
             assert_eq!(result.rgb8.len(), result.pixels.len());
@@ -109,7 +118,15 @@ fn a_broken_scene_gives_the_located_error_text() {
     );
     assert!(error.text.ends_with(&error.excerpt));
     assert!(error.excerpt.contains("<radius>wide</radius>\n"));
-    assert!(loaded.render_tile(&Settings::new(4, 4, 1, "course", 0, None, false).unwrap(), 0, 0, 4, 4).is_err());
+    assert!(loaded
+        .render_tile(
+            &Settings::new(4, 4, 1, "course", 0, None, false).unwrap(),
+            0,
+            0,
+            4,
+            4
+        )
+        .is_err());
 }
 
 #[test]
