@@ -442,6 +442,28 @@ mod tests {
     }
 
     #[test]
+    fn encoded_bytes_are_the_written_files() {
+        let mut film = Film::new(5, 3);
+        for (index, pixel) in film.pixels.iter_mut().enumerate() {
+            *pixel = Vec3::new(index as f32 / 15.0, 0.5, 1.5 - index as f32 / 10.0);
+        }
+        let directory = tempfile::tempdir().unwrap();
+        for (format, name) in [
+            (OutputFormat::Png, "out.png"),
+            (OutputFormat::Exr, "out.exr"),
+        ] {
+            let path = directory.path().join(name);
+            write_image(&path, &film).unwrap();
+            assert_eq!(
+                encode_image(&film, format).unwrap(),
+                std::fs::read(&path).unwrap()
+            );
+        }
+        film.pixels.pop();
+        assert!(encode_image(&film, OutputFormat::Png).is_err());
+    }
+
+    #[test]
     fn missing_cube_map_face_names_the_file() {
         let directory = tempfile::tempdir().unwrap();
         let error = load_cube_map(directory.path(), "data/reef_", &crate::FileSystem).unwrap_err();
