@@ -313,7 +313,7 @@ function download(format) {
   const { width, height } = render.settings;
   const features = format === 'exr' && render.albedo;
   const bytes = encode(
-    format, width, height, render.pixels,
+    format, render.settings.integrator, width, height, render.pixels,
     features ? render.albedo : undefined,
     features ? render.normal : undefined,
     features ? render.depth : undefined,

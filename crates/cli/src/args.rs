@@ -20,7 +20,8 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
-use glint_render::{Color, IntegratorKind, RenderSettings};
+use glint_io::{DisplayTransform, PngEncoding, ToneMap, Transfer};
+use glint_render::{Color, IntegratorKind, RenderSettings, SplitMethod};
 
 /// Largest accepted image side. Pixel indices are computed in `u32` in places, and a bigger
 /// image would not fit in memory anyway.
@@ -36,9 +37,12 @@ Examples:
   glint -i scene.xml -o out.png -w 250 -h 250 -r 16
   glint render scene.json -o out.exr --background 0.2,0.2,0.2
 
-Output is PNG (8-bit, clamped, floor(c*255), no gamma, as the course writes it) or EXR
-(linear 32-bit float), chosen by the extension. Without -o the image goes to the scene's
-name with .png in the current directory.
+Output is PNG or EXR (linear 32-bit float, with albedo, normal and depth layers), chosen by
+the extension. A PNG from the course integrator (and the normals and depth views) is written
+as the course writes it: clamped, floor(c*255), no gamma. One from the path tracer (and the
+albedo view) gets the display transform: exposure, tone curve (clamp), sRGB; --exposure,
+--tonemap and --transfer change it, for any integrator. Without -o the image goes to the
+scene's name with .png in the current directory.
 
 Exit status: 0 success, 1 failure (e.g. the image cannot be written), 2 bad scene or bad
 arguments, 130 interrupted (Ctrl-C; nothing is written).";
@@ -79,6 +83,9 @@ pub enum Command {
     },
     /// Measure the ray engine: `glint bench table`, `glint bench rays`, `glint bench make-rays`.
     Bench(crate::bench::BenchArgs),
+    /// Compare image B with reference A (PNG, EXR): MAE, RMSE, PSNR, pixels off by more than
+    /// N levels, NVIDIA's FLIP and its heat map; exit 1 past a --threshold.
+    Diff(crate::diff::DiffArgs),
 }
 
 /// Options shared by both forms.
@@ -133,6 +140,21 @@ pub struct Options {
           default_value_t = IntegratorArg::Course)]
     pub integrator: IntegratorArg,
 
+    /// PNG only: exposure in stops (values times 2^EV) before the tone curve. Giving it, or
+    /// --tonemap or --transfer, turns on the display transform for any integrator.
+    #[arg(long, value_name = "EV", allow_negative_numbers = true, value_parser = parse_exposure,
+          help_heading = PNG_HEADING)]
+    pub exposure: Option<f32>,
+
+    /// PNG only: tone curve. `clamp` (alias `none`): clip each channel to [0,1]; `aces`: Hill's
+    /// fitted ACES RRT+ODT; `agx`: Wrensch's minimal AgX [default: clamp].
+    #[arg(long, value_name = "CURVE", value_enum, help_heading = PNG_HEADING)]
+    pub tonemap: Option<ToneMapArg>,
+
+    /// PNG only: transfer function, `srgb` (IEC 61966-2-1) or `linear` [default: srgb].
+    #[arg(long, value_name = "FUNCTION", value_enum, help_heading = PNG_HEADING)]
+    pub transfer: Option<TransferArg>,
+
     /// Also print the settings and the loading time.
     #[arg(short = 'v', long, action = ArgAction::SetTrue)]
     pub verbose: bool,
@@ -141,24 +163,75 @@ pub struct Options {
     #[arg(short = '?', long, action = ArgAction::Help)]
     pub help: Option<bool>,
 
-    /// Depth-of-field focus distance (glint has no depth of field yet).
-    #[arg(short = 'd', long, value_name = "DIST", help_heading = COURSE_NO_EFFECT)]
+    /// Depth of field: focus at DIST along the view direction (0: off, the course's pinhole).
+    #[arg(short = 'd', long, value_name = "DIST", value_parser = parse_distance)]
     pub depth: Option<f32>,
 
-    /// BVH split method (glint always builds a binned-SAH BVH).
-    #[arg(short = 's', long, value_name = "METHOD", help_heading = COURSE_NO_EFFECT)]
-    pub split: Option<String>,
+    /// Lens radius for -d, in scene units [default: 1/50 of the width the image covers at
+    /// the focus distance].
+    #[arg(long, value_name = "R", value_parser = parse_distance, requires = "depth")]
+    pub aperture: Option<f32>,
 
-    /// Preview window width (glint has no preview window).
-    #[arg(short = 'x', long, value_name = "PIXELS", help_heading = COURSE_NO_EFFECT)]
+    /// How the BVH splits: objectMedian or spatialMedian (the course's lecture), or sah
+    /// (surface area heuristic, fastest to trace). The image is the same with any method.
+    #[arg(short = 's', long, value_name = "METHOD", default_value = "sah",
+          value_parser = parse_split)]
+    pub split: SplitMethod,
+
+    /// After the render, print the BVH's build time, nodes, depth, SAH cost and the nodes a
+    /// camera ray visits (a separate counting pass).
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub stats: bool,
+
+    /// Preview window width: show the image as it renders [default with -y: by the image's
+    /// aspect ratio].
+    #[arg(short = 'x', long, value_name = "PIXELS",
+          value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub winwidth: Option<u32>,
 
-    /// Preview window height (glint has no preview window).
-    #[arg(short = 'y', long, value_name = "PIXELS", help_heading = COURSE_NO_EFFECT)]
+    /// Preview window height [default with -x: by the image's aspect ratio].
+    #[arg(short = 'y', long, value_name = "PIXELS",
+          value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
     pub winheight: Option<u32>,
+
+    /// Close the preview window when the render ends instead of waiting for the user.
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub preview_close: bool,
 }
 
-const COURSE_NO_EFFECT: &str = "Course options accepted for its scripts, with no effect";
+const PNG_HEADING: &str = "PNG output transform (EXR is always linear and untouched)";
+
+/// `--tonemap` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ToneMapArg {
+    // An 8-bit PNG clips somewhere: "no curve" is the per-channel clip.
+    #[value(alias = "none")]
+    Clamp,
+    Aces,
+    Agx,
+}
+
+/// `--transfer` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TransferArg {
+    Srgb,
+    Linear,
+}
+
+/// Parses `--exposure`: a finite number of stops, within ±64 (2^64 overflows nothing in f32,
+/// and no scene needs more).
+pub fn parse_exposure(text: &str) -> Result<f32, String> {
+    let value: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if !value.is_finite() || value.abs() > 64.0 {
+        return Err(format!(
+            "the exposure must be a number of stops between -64 and 64, got {text}"
+        ));
+    }
+    Ok(value)
+}
 
 /// `--integrator` / `--shader` values.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -223,6 +296,29 @@ pub fn parse_rgb(text: &str) -> Result<Rgb, String> {
     Ok(Rgb(rgb))
 }
 
+/// Parses `--depth` and `--aperture`: a finite number >= 0.
+pub fn parse_distance(text: &str) -> Result<f32, String> {
+    let value: f32 = text
+        .trim()
+        .parse()
+        .map_err(|_| format!("'{text}' is not a number"))?;
+    if !value.is_finite() || value < 0.0 {
+        return Err(format!("expected a finite number >= 0, got {text}"));
+    }
+    Ok(value)
+}
+
+/// Parses `--split`: a method's name (any letter case).
+pub fn parse_split(text: &str) -> Result<SplitMethod, String> {
+    SplitMethod::ALL
+        .into_iter()
+        .find(|m| m.name().eq_ignore_ascii_case(text.trim()))
+        .ok_or_else(|| {
+            let names: Vec<&str> = SplitMethod::ALL.iter().map(|m| m.name()).collect();
+            format!("unknown split method; the methods are {}", names.join(", "))
+        })
+}
+
 /// Parses `--aspect`: a finite number > 0.
 pub fn parse_aspect(text: &str) -> Result<f32, String> {
     let value: f32 = text
@@ -257,7 +353,20 @@ pub struct Job {
     pub settings: RenderSettings,
     pub threads: usize,
     pub background: Option<Color>,
+    /// How a PNG output's 8-bit values are made.
+    pub png: PngEncoding,
     pub verbose: bool,
+    /// How the scene's BVHs split (`-s`).
+    pub split: SplitMethod,
+    /// Depth of field (`-d`, `--aperture`): the focus distance and the lens radius, `None`
+    /// for the default radius (which depends on the scene's camera).
+    pub depth_of_field: Option<(f32, Option<f32>)>,
+    /// Print the BVH statistics after the render (`--stats`).
+    pub stats: bool,
+    /// The preview window's size (`-x`, `-y`), if one was asked for.
+    pub preview: Option<(u32, u32)>,
+    /// Close the preview when the render ends (`--preview-close`).
+    pub preview_close: bool,
     /// Notes about accepted options that have no effect, printed before rendering.
     pub notes: Vec<String>,
 }
@@ -270,6 +379,9 @@ impl Cli {
                 Some(Command::Render { scene, options }) => (scene, options),
                 Some(Command::Bench(_)) => {
                     return Err(UsageError("`glint bench` is not a render".to_string()))
+                }
+                Some(Command::Diff(_)) => {
+                    return Err(UsageError("`glint diff` is not a render".to_string()))
                 }
                 None => match self.input {
                     Some(scene) if !scene.as_os_str().is_empty() => (scene, self.options),
@@ -296,19 +408,30 @@ impl Options {
         check_output_extension(&output)?;
 
         let mut notes = Vec::new();
-        if let Some(depth) = self.depth {
-            notes.push(format!(
-                "--depth {depth} has no effect: glint has no depth of field yet"
+        if self.aperture.is_some() && self.depth == Some(0.0) {
+            return Err(UsageError(
+                "--aperture needs depth of field: give a focus distance -d greater than 0"
+                    .to_string(),
             ));
         }
-        if let Some(split) = &self.split {
-            notes.push(format!(
-                "--split {split} has no effect: glint always builds a binned-SAH BVH"
-            ));
+        let display_options =
+            self.exposure.is_some() || self.tonemap.is_some() || self.transfer.is_some();
+        if display_options && output_is_exr(&output) {
+            notes.push(
+                "--exposure/--tonemap/--transfer have no effect on an EXR: it keeps linear values"
+                    .into(),
+            );
         }
-        if self.winwidth.is_some() || self.winheight.is_some() {
-            notes.push("--winwidth/--winheight have no effect: glint has no preview window".into());
-        }
+        // One side given: the other keeps the image's aspect ratio.
+        let scaled = |side: u32, from: u32, to: u32| {
+            ((side as u64 * to as u64).div_ceil(from as u64)).clamp(1, MAX_SIDE as u64) as u32
+        };
+        let preview = match (self.winwidth, self.winheight) {
+            (Some(w), Some(h)) => Some((w, h)),
+            (Some(w), None) => Some((w, scaled(w, self.width, self.height))),
+            (None, Some(h)) => Some((scaled(h, self.height, self.width), h)),
+            (None, None) => None,
+        };
         let settings = RenderSettings {
             width: self.width,
             height: self.height,
@@ -338,10 +461,49 @@ impl Options {
                 .threads
                 .map_or(available_threads.max(1), |n| n as usize),
             background: self.background.map(Rgb::to_color),
+            png: png_encoding(self.integrator, self.exposure, self.tonemap, self.transfer),
             verbose: self.verbose,
+            split: self.split,
+            depth_of_field: self
+                .depth
+                .filter(|&distance| distance > 0.0)
+                .map(|distance| (distance, self.aperture)),
+            stats: self.stats,
+            preview,
+            preview_close: self.preview_close,
             notes,
         })
     }
+}
+
+/// The PNG conversion: the display transform when any of its options is given, else the
+/// integrator's own. The course integrator keeps the course's conversion (its reference images
+/// were made with it), and so do the data views `normals` and `depth`; the path tracer and the
+/// `albedo` view, which are colours, get the display transform's defaults (clamp, sRGB), as
+/// pbrt and Mitsuba write PNGs.
+pub fn png_encoding(
+    integrator: IntegratorArg,
+    exposure: Option<f32>,
+    tonemap: Option<ToneMapArg>,
+    transfer: Option<TransferArg>,
+) -> PngEncoding {
+    let display_by_default = matches!(integrator, IntegratorArg::Path | IntegratorArg::Albedo);
+    if !display_by_default && exposure.is_none() && tonemap.is_none() && transfer.is_none() {
+        return PngEncoding::Course;
+    }
+    let defaults = DisplayTransform::default();
+    PngEncoding::Display(DisplayTransform {
+        exposure: exposure.unwrap_or(defaults.exposure),
+        tone_map: tonemap.map_or(defaults.tone_map, |tonemap| match tonemap {
+            ToneMapArg::Clamp => ToneMap::Clamp,
+            ToneMapArg::Aces => ToneMap::Aces,
+            ToneMapArg::Agx => ToneMap::Agx,
+        }),
+        transfer: transfer.map_or(defaults.transfer, |transfer| match transfer {
+            TransferArg::Srgb => Transfer::Srgb,
+            TransferArg::Linear => Transfer::Linear,
+        }),
+    })
 }
 
 /// The scene's file name with `.png`, in the current directory.
@@ -483,29 +645,80 @@ mod tests {
     }
 
     #[test]
-    fn course_options_without_effect_leave_notes() {
-        let job = job(&[
-            "-i",
-            "s.xml",
-            "-d",
-            "3",
-            "-s",
-            "spatialMedian",
-            "-x",
-            "300",
-            "-r",
-            "8",
-        ])
-        .unwrap();
-        assert_eq!(job.notes.len(), 4, "{:?}", job.notes);
-        assert!(job.notes[0].starts_with("--depth 3 "), "{:?}", job.notes);
-        assert!(
-            job.notes[1].starts_with("--split spatialMedian "),
-            "{:?}",
-            job.notes
+    fn a_grid_that_is_not_square_leaves_a_note() {
+        let job = job(&["-i", "s.xml", "-r", "8"]).unwrap();
+        assert_eq!(job.notes.len(), 1, "{:?}", job.notes);
+        assert!(job.notes[0].contains("2x2"), "{:?}", job.notes);
+    }
+
+    #[test]
+    fn preview_window_size() {
+        let size = |args: &[&str]| job(args).unwrap().preview;
+        assert_eq!(size(&["-i", "s.xml"]), None);
+        assert_eq!(
+            size(&["-i", "s.xml", "-x", "300", "-y", "200"]),
+            Some((300, 200))
         );
-        assert!(job.notes[2].starts_with("--winwidth"), "{:?}", job.notes);
-        assert!(job.notes[3].contains("2x2"), "{:?}", job.notes);
+        assert_eq!(
+            size(&["-i", "s.xml", "-w", "200", "-h", "100", "-x", "401"]),
+            Some((401, 201))
+        );
+        assert_eq!(
+            size(&["-i", "s.xml", "-w", "200", "-h", "100", "--winheight", "50"]),
+            Some((100, 50))
+        );
+        assert!(!job(&["-i", "s.xml", "-x", "9"]).unwrap().preview_close);
+        assert!(
+            job(&["-i", "s.xml", "-x", "9", "--preview-close"])
+                .unwrap()
+                .preview_close
+        );
+        assert!(job(&["-i", "s.xml", "-x", "0"]).is_err());
+    }
+
+    #[test]
+    fn depth_of_field_and_aperture() {
+        assert_eq!(job(&["-i", "s.xml"]).unwrap().depth_of_field, None);
+        assert_eq!(
+            job(&["-i", "s.xml", "-d", "0"]).unwrap().depth_of_field,
+            None
+        );
+        assert_eq!(
+            job(&["-i", "s.xml", "-d", "3"]).unwrap().depth_of_field,
+            Some((3.0, None))
+        );
+        assert_eq!(
+            job(&["-i", "s.xml", "--depth", "3", "--aperture", "0.25"])
+                .unwrap()
+                .depth_of_field,
+            Some((3.0, Some(0.25)))
+        );
+        for args in [
+            &["-i", "s.xml", "-d", "-1"][..],
+            &["-i", "s.xml", "-d", "inf"],
+            &["-i", "s.xml", "-d", "3", "--aperture", "x"],
+            &["-i", "s.xml", "--aperture", "0.2"],
+            &["-i", "s.xml", "-d", "0", "--aperture", "0.2"],
+        ] {
+            assert!(job(args).is_err(), "{args:?} was accepted");
+        }
+    }
+
+    #[test]
+    fn split_methods_by_name_sah_by_default() {
+        assert_eq!(job(&["-i", "s.xml"]).unwrap().split, SplitMethod::Sah);
+        for (name, method) in [
+            ("objectMedian", SplitMethod::ObjectMedian),
+            ("spatialmedian", SplitMethod::SpatialMedian),
+            ("SAH", SplitMethod::Sah),
+        ] {
+            assert_eq!(job(&["-i", "s.xml", "-s", name]).unwrap().split, method);
+        }
+        let error = job(&["-i", "s.xml", "--split", "octree"]).unwrap_err();
+        assert!(
+            error.contains("objectMedian, spatialMedian, sah"),
+            "{error}"
+        );
     }
 
     #[test]
@@ -516,5 +729,72 @@ mod tests {
         assert!(parse_rgb("1,2,3,4").is_err());
         assert!(parse_rgb("-1,0,0").is_err());
         assert!(parse_rgb("").is_err());
+    }
+
+    #[test]
+    fn png_conversion_follows_the_integrator_unless_asked() {
+        let png = |args: &[&str]| {
+            let mut all = vec!["-i", "s.xml"];
+            all.extend_from_slice(args);
+            job(&all).unwrap().png
+        };
+        assert_eq!(png(&[]), PngEncoding::Course);
+        assert_eq!(png(&["--integrator", "normals"]), PngEncoding::Course);
+        assert_eq!(png(&["--integrator", "depth"]), PngEncoding::Course);
+        let display = PngEncoding::Display(DisplayTransform::default());
+        assert_eq!(png(&["--integrator", "path"]), display);
+        assert_eq!(png(&["--integrator", "albedo"]), display);
+        // Any display option turns it on, for the course integrator too.
+        assert_eq!(png(&["--tonemap", "none"]), display);
+        assert_eq!(
+            png(&[
+                "--integrator",
+                "path",
+                "--exposure",
+                "-1.5",
+                "--tonemap",
+                "agx",
+                "--transfer",
+                "linear"
+            ]),
+            PngEncoding::Display(DisplayTransform {
+                exposure: -1.5,
+                tone_map: ToneMap::Agx,
+                transfer: Transfer::Linear,
+            })
+        );
+        assert_eq!(
+            png(&["--tonemap", "aces"]),
+            PngEncoding::Display(DisplayTransform {
+                tone_map: ToneMap::Aces,
+                ..DisplayTransform::default()
+            })
+        );
+    }
+
+    #[test]
+    fn bad_display_options_are_usage_errors() {
+        for args in [
+            ["--exposure", "nan"],
+            ["--exposure", "100"],
+            ["--tonemap", "reinhard"],
+            ["--transfer", "gamma"],
+        ] {
+            let mut all = vec!["-i", "s.xml"];
+            all.extend_from_slice(&args);
+            assert!(job(&all).is_err(), "{args:?}");
+        }
+    }
+
+    #[test]
+    fn display_options_on_an_exr_get_a_note() {
+        let job = job(&["-i", "s.xml", "-o", "o.exr", "--exposure", "2"]).unwrap();
+        assert!(
+            job.notes
+                .iter()
+                .any(|note| note.contains("no effect on an EXR")),
+            "{:?}",
+            job.notes
+        );
     }
 }

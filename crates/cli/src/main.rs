@@ -7,6 +7,8 @@
 
 mod args;
 mod bench;
+mod diff;
+mod preview;
 mod run;
 
 use std::io::IsTerminal;
@@ -34,6 +36,10 @@ fn main() -> ExitCode {
             }
         };
     }
+    if let Some(crate::args::Command::Diff(args)) = &cli.command {
+        let status = diff::run(args, &mut std::io::stdout(), &mut std::io::stderr());
+        return ExitCode::from(status);
+    }
     let available = std::thread::available_parallelism().map_or(1, |n| n.get());
     let job = match cli.into_job(available) {
         Ok(job) => job,
@@ -53,9 +59,34 @@ fn main() -> ExitCode {
     }
 
     // Not locked: the progress bar draws from the render threads.
-    let mut stderr = std::io::stderr();
-    let progress_bar = stderr.is_terminal();
-    match run::run(&job, &INTERRUPT, &mut stderr, progress_bar) {
+    let progress_bar = std::io::stderr().is_terminal();
+    let run = |tiles: Option<&preview::TileSink>| {
+        run::run(
+            &job,
+            &INTERRUPT,
+            &mut std::io::stderr(),
+            progress_bar,
+            tiles,
+        )
+    };
+    let window = job.preview.and_then(|(width, height)| {
+        let settings = &job.settings;
+        preview::Preview::open(
+            width as usize,
+            height as usize,
+            settings.width,
+            settings.height,
+        )
+        .map_err(|why| eprintln!("warning: no preview window ({why}); rendering without it"))
+        .ok()
+    });
+    let outcome = match window {
+        Some(window) => window.run_while(job.preview_close, &|| INTERRUPT.requested(), |tiles| {
+            run(Some(&tiles))
+        }),
+        None => run(None),
+    };
+    match outcome {
         Ok(_) => ExitCode::SUCCESS,
         Err(failure) => fail(&failure),
     }

@@ -8,10 +8,13 @@ use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::time::{Duration, Instant};
 
 use glint_io::{Diagnostic, ImageWriteError, SceneError};
-use glint_render::{Background, Progress, RenderError, RenderStats, Scene};
+use glint_render::{
+    Background, Progress, RenderError, RenderSettings, RenderStats, Scene, SceneOptions, ThinLens,
+};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::{Job, UsageError};
+use crate::preview::TileSink;
 
 /// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).
 pub const EXIT_INTERRUPTED: u8 = 130;
@@ -161,13 +164,15 @@ pub struct Summary {
 }
 
 /// Runs `job`, printing notes, warnings, the progress bar (only if `progress_bar`) and the
-/// closing line to `err`. Errors are returned, not printed: `main` prints them and exits.
-/// No image is written unless the whole run succeeds.
+/// closing line to `err`, and handing each finished tile to `preview` if there is one.
+/// Errors are returned, not printed: `main` prints them and exits. No image is written unless
+/// the whole run succeeds.
 pub fn run(
     job: &Job,
     interrupt: &Interrupt,
     err: &mut dyn Write,
     progress_bar: bool,
+    preview: Option<&TileSink>,
 ) -> Result<Summary, Failure> {
     // Write errors on stderr are ignored throughout: a closed stderr must not fail a render.
     for note in &job.notes {
@@ -194,7 +199,15 @@ pub fn run(
     if let Some(color) = job.background {
         parts.background = Background::Color(color);
     }
-    let scene = pool.install(|| Scene::new(parts));
+    if let Some((focus_distance, radius)) = job.depth_of_field {
+        let lens = ThinLens::with_default_radius(&parts.camera, focus_distance);
+        parts.camera.lens = Some(ThinLens {
+            radius: radius.unwrap_or(lens.radius),
+            ..lens
+        });
+    }
+    let options = SceneOptions { split: job.split };
+    let scene = pool.install(|| Scene::with_options(parts, options));
     let load_time = load_start.elapsed();
 
     let settings = &job.settings;
@@ -202,15 +215,20 @@ pub fn run(
         let depth = format!("depth {}", settings.max_depth());
         let _ = writeln!(
             err,
-            "loaded {} in {:.2} s\nrendering {}x{}, {} samples per pixel, {depth}, seed {}, {} \
-             integrator, {} -> {}",
+            "loaded {} in {:.2} s ({} BVH)\nrendering {}x{}, {} samples per pixel, {depth}, seed \
+             {}, {} integrator{}, {} -> {}",
             job.scene.display(),
             load_time.as_secs_f64(),
+            job.split.name(),
             settings.width,
             settings.height,
             settings.samples_per_pixel(),
             settings.seed,
             settings.integrator.name(),
+            scene.camera.lens.map_or(String::new(), |lens| format!(
+                ", focused at {} with a lens of radius {}",
+                lens.focus_distance, lens.radius
+            )),
             threads_text(job.threads),
             job.output.display()
         );
@@ -218,6 +236,9 @@ pub fn run(
 
     let bar = progress_bar.then(|| new_progress_bar(settings.width, settings.height));
     let progress = |report: &Progress| {
+        if let Some(preview) = preview {
+            preview.send(report);
+        }
         if let Some(bar) = &bar {
             bar.set_length(report.tiles_total as u64);
             bar.inc(1);
@@ -257,15 +278,43 @@ pub fn run(
         );
     }
 
-    let write = glint_io::write_image(&job.output, &film);
+    let options = glint_io::WriteOptions { png: job.png };
+    let write = glint_io::write_image_with(&job.output, &film, &options);
     write.map_err(Failure::Write)?;
 
     let _ = writeln!(err, "{}", closing_line(job, &stats, render_time));
+    if job.stats {
+        let _ = write!(err, "{}", pool.install(|| bvh_stats(&scene, settings)));
+    }
     Ok(Summary {
         stats,
         render_time,
         threads: job.threads,
     })
+}
+
+/// `--stats`' BVH figures: how the split method shaped the tree and what it costs the camera
+/// rays (measured in a separate counting pass, so the render itself counted nothing).
+pub fn bvh_stats(scene: &Scene, settings: &RenderSettings) -> String {
+    let bvh = scene.bvh_stats();
+    let walk = glint_render::measure_traversal(scene, settings);
+    format!(
+        "BVH ({}): built in {:.1} ms; {} tree{}, {} nodes, {} leaves, depth {}, SAH cost {:.2}\n\
+         BVH traversal: {:.2} nodes and {:.2} triangle blocks per camera ray ({} rays through \
+         pixel centres, {:.0}% hit)\n",
+        bvh.split.name(),
+        bvh.build_time.as_secs_f64() * 1e3,
+        bvh.trees,
+        plural(bvh.trees as u64),
+        bvh.nodes,
+        bvh.leaves,
+        bvh.depth,
+        bvh.sah_cost,
+        walk.nodes_per_ray(),
+        walk.blocks_per_ray(),
+        walk.rays,
+        100.0 * walk.hits as f64 / walk.rays.max(1) as f64,
+    )
 }
 
 fn new_progress_bar(width: u32, height: u32) -> ProgressBar {
@@ -371,7 +420,13 @@ mod tests {
             },
             threads: 2,
             background: None,
+            png: glint_io::PngEncoding::Course,
             verbose: false,
+            split: glint_render::SplitMethod::Sah,
+            depth_of_field: None,
+            stats: false,
+            preview: None,
+            preview_close: false,
             notes: Vec::new(),
         };
         let stats = RenderStats {

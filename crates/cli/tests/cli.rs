@@ -163,11 +163,11 @@ fn course_long_options_are_accepted() {
 }
 
 #[test]
-fn course_options_without_effect_are_accepted_with_a_note() {
+fn course_options_depth_split_and_window_take_effect() {
     let dir = scene_dir();
-    let output = glint_in(
-        dir.path(),
-        &[
+    // No display: the preview window cannot open, which must not stop the render.
+    let output = Command::new(GLINT)
+        .args([
             "-i",
             "scene.xml",
             "-o",
@@ -184,19 +184,30 @@ fn course_options_without_effect_are_accepted_with_a_note() {
             "640",
             "-y",
             "480",
-        ],
-    );
+        ])
+        .current_dir(dir.path())
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("cannot run glint");
     assert_exit(&output, 0);
     let text = stderr(&output);
-    assert!(text.contains("note: --depth 2.5 has no effect"), "{text}");
-    assert!(
-        text.contains("note: --split objectMedian has no effect"),
-        "{text}"
+    assert!(!text.contains("has no effect"), "{text}");
+    assert!(text.contains("warning: no preview window"), "{text}");
+    assert_eq!(read_png(&dir.path().join("o.png")).dimensions(), (4, 4));
+}
+
+#[test]
+fn an_unknown_split_method_is_a_usage_error_naming_the_methods() {
+    let dir = scene_dir();
+    let output = glint_in(
+        dir.path(),
+        &["-i", "scene.xml", "-o", "o.png", "-s", "kdtree"],
     );
-    assert!(
-        text.contains("note: --winwidth/--winheight have no effect"),
-        "{text}"
-    );
+    assert_exit(&output, 2);
+    let text = stderr(&output);
+    assert!(text.contains("objectMedian, spatialMedian, sah"), "{text}");
+    assert!(!dir.path().join("o.png").exists());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -334,8 +345,9 @@ fn exr_output_is_linear_float() {
 }
 
 /// `--integrator path` with an .exr output writes the beauty as R, G, B and the denoiser
-/// features as `albedo.*` and `normal.*` channels; the sphere's albedo is its Lambertian
-/// colour and its centre normal faces the camera.
+/// features under Blender's pass names (`Denoising Albedo.R/G/B`, `Denoising Normal.X/Y/Z`,
+/// `Depth.Z`); the sphere's albedo is its Lambertian colour, its centre normal faces the
+/// camera and its depth is the distance to its front pole.
 #[test]
 fn path_tracer_exr_has_albedo_and_normal_layers() {
     let dir = scene_dir();
@@ -371,9 +383,14 @@ fn path_tracer_exr_has_albedo_and_normal_layers() {
     };
     let centre = 3 * 9 + 4;
     // The test scene's sphere is Lambertian (0, 0, 1).
-    assert_eq!(channel("albedo.B")[centre], 1.0);
-    assert_eq!(channel("albedo.R")[centre], 0.0);
-    assert!(channel("normal.B")[centre] > 0.99);
+    assert_eq!(channel("Denoising Albedo.B")[centre], 1.0);
+    assert_eq!(channel("Denoising Albedo.R")[centre], 0.0);
+    assert!(channel("Denoising Normal.Z")[centre] > 0.99);
+    assert!(channel("Denoising Normal.X")[centre].abs() < 0.1);
+    // Camera at the origin, sphere of radius 1 centred at z = -5.
+    let depth = channel("Depth.Z")[centre];
+    assert!((depth - 4.0).abs() < 0.05, "{depth}");
+    assert_eq!(channel("Depth.Z")[0], 0.0, "a missed ray has depth 0");
     assert!(channel("B")[centre] > 0.0);
     assert_eq!(channel("R").len(), 9 * 7);
 }

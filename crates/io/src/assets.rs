@@ -10,6 +10,9 @@ use std::path::{Component, Path, PathBuf};
 pub trait Assets {
     /// The bytes of the file at `path`.
     fn read(&self, path: &Path) -> io::Result<Vec<u8>>;
+
+    /// Whether a file exists at `path` (to pick among alternative names).
+    fn exists(&self, path: &Path) -> bool;
 }
 
 /// The file system.
@@ -19,6 +22,10 @@ pub struct FileSystem;
 impl Assets for FileSystem {
     fn read(&self, path: &Path) -> io::Result<Vec<u8>> {
         std::fs::read(path)
+    }
+
+    fn exists(&self, path: &Path) -> bool {
+        path.is_file()
     }
 }
 
@@ -53,6 +60,10 @@ impl Assets for MemoryAssets {
                 "no such file among the files given",
             )
         })
+    }
+
+    fn exists(&self, path: &Path) -> bool {
+        self.files.contains_key(&normalise(path))
     }
 }
 

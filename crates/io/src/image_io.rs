@@ -8,9 +8,16 @@ use std::path::{Path, PathBuf};
 use glint_render::{Color, CubeMap, Film, Image, Vec3};
 
 use crate::assets::Assets;
+use crate::display::{PngEncoding, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD};
 
-/// Reads a texture or environment-map image. The course applies no gamma anywhere
-/// (FORMAT.md 1.3), so a texel is its 8-bit value / 255; alpha is dropped.
+/// Reads a texture or environment-map image as linear RGB; alpha is dropped.
+///
+/// Images stored as floating point (OpenEXR, Radiance `.hdr`) keep their values as they are,
+/// above 1 included: an HDR sky keeps its sun. Their texels must be finite and not negative
+/// (radiance cannot be); one that is not is an error naming the texel.
+///
+/// Every other image is 8-bit or converted to 8 bits, and the course applies no gamma anywhere
+/// (FORMAT.md 1.3), so a texel is its 8-bit value / 255.
 pub(crate) fn load_image(path: &Path, assets: &dyn Assets) -> Result<Image, String> {
     let bytes = assets.read(path).map_err(|error| error.to_string())?;
     decode_image(&bytes)
@@ -22,6 +29,12 @@ pub(crate) fn decode_image(bytes: &[u8]) -> Result<Image, String> {
         .with_guessed_format()
         .map_err(|error| error.to_string())?;
     let decoded = reader.decode().map_err(|error| error.to_string())?;
+    if matches!(
+        decoded,
+        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+    ) {
+        return float_image(decoded.to_rgb32f());
+    }
     let rgb = decoded.to_rgb8();
     let (width, height) = rgb.dimensions();
     let texels = rgb
@@ -41,10 +54,41 @@ pub(crate) fn decode_image(bytes: &[u8]) -> Result<Image, String> {
     })
 }
 
+/// A floating-point image as it is, refusing non-finite and negative texels.
+fn float_image(rgb: image::Rgb32FImage) -> Result<Image, String> {
+    let (width, height) = rgb.dimensions();
+    let mut texels = Vec::with_capacity(width as usize * height as usize);
+    for (x, y, pixel) in rgb.enumerate_pixels() {
+        let [r, g, b] = pixel.0;
+        if !(r.is_finite() && g.is_finite() && b.is_finite()) || r < 0.0 || g < 0.0 || b < 0.0 {
+            return Err(format!(
+                "texel ({x}, {y}) from the top-left is ({r}, {g}, {b}): an HDR image's values \
+                 must be finite and not negative"
+            ));
+        }
+        texels.push(Color::new(r, g, b));
+    }
+    Ok(Image {
+        width,
+        height,
+        texels,
+    })
+}
+
 /// The six file names of a cube map given by `envMapPrefix` (FORMAT.md 2.1), in the face order
 /// of `CubeMap`: +X, -X, +Y, -Y, +Z, -Z.
-pub(crate) fn cube_face_paths(prefix: &str) -> [String; 6] {
-    ["posX", "negX", "posY", "negY", "posZ", "negZ"].map(|face| format!("{prefix}{face}.png"))
+pub(crate) fn cube_face_paths(prefix: &str, extension: &str) -> [String; 6] {
+    ["posX", "negX", "posY", "negY", "posZ", "negZ"]
+        .map(|face| format!("{prefix}{face}.{extension}"))
+}
+
+/// The course's faces are PNGs; HDR faces may be `.exr` or `.hdr` instead. The first of
+/// png, exr, hdr whose +X face exists names all six (png when none does, for the message).
+fn cube_face_extension(directory: &Path, prefix: &str, assets: &dyn Assets) -> &'static str {
+    ["png", "exr", "hdr"]
+        .into_iter()
+        .find(|extension| assets.exists(&directory.join(format!("{prefix}posX.{extension}"))))
+        .unwrap_or("png")
 }
 
 /// Cuts a vertical-cross environment map (FORMAT.md 3.7: `envMapVertCross`, 3 columns x 4 rows
@@ -99,14 +143,16 @@ pub(crate) fn cut_vertical_cross(cross: &Image) -> Result<[Image; 6], String> {
     ])
 }
 
-/// Loads the six faces named by `envMapPrefix`, resolved against `directory`.
+/// Loads the six faces named by `envMapPrefix`, resolved against `directory` (PNG, or EXR or
+/// Radiance HDR, kept as float).
 pub(crate) fn load_cube_map(
     directory: &Path,
     prefix: &str,
     assets: &dyn Assets,
 ) -> Result<CubeMap, String> {
     let mut faces = Vec::with_capacity(6);
-    for name in cube_face_paths(prefix) {
+    let extension = cube_face_extension(directory, prefix, assets);
+    for name in cube_face_paths(prefix, extension) {
         let path = directory.join(&name);
         let face = load_image(&path, assets)
             .map_err(|error| format!("cannot read face `{name}` ({}): {error}", path.display()))?;
@@ -180,11 +226,34 @@ pub fn output_format(path: &Path) -> Result<OutputFormat, ImageWriteError> {
     }
 }
 
+/// How `write_image_with` writes an image. EXR output is always linear and takes no options.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct WriteOptions {
+    /// How a PNG's 8-bit values are made from the film (the course's conversion by default).
+    pub png: PngEncoding,
+}
+
 /// Writes the film to `path`: `.png` as 8-bit RGB with the course's conversion (clamp,
 /// floor(c·255), no gamma: `Film::to_rgb8_course`), `.exr` as linear RGB f32 with the film's
-/// feature layers, when it has them, as channels `albedo.R/G/B`, `normal.R/G/B` (what
-/// denoisers take) and `depth.Y`. A PNG holds the beauty alone.
+/// feature layers, when it has them (see `write_image_with`). A PNG holds the beauty alone.
 pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
+    write_image_with(path, film, &WriteOptions::default())
+}
+
+/// Writes the film to `path` as `write_image` does, with the PNG's 8-bit values made by
+/// `options.png`. The PNG names its transform in tEXt chunks (`TRANSFORM_KEYWORD`,
+/// `TRANSFER_KEYWORD`, and `Software`), and gets an `sRGB` chunk when its values are
+/// sRGB-encoded.
+///
+/// An EXR keeps the film's linear values untouched, the beauty as channels `R`, `G`, `B`, and
+/// the feature layers, when the film has them, under the pass names of Blender's multilayer
+/// EXR (an empty view-layer name, so Blender reads them as passes of one layer):
+/// `Denoising Albedo.R/G/B`, `Denoising Normal.X/Y/Z` (world space) and `Depth.Z`.
+pub fn write_image_with(
+    path: &Path,
+    film: &Film,
+    options: &WriteOptions,
+) -> Result<(), ImageWriteError> {
     let format = output_format(path)?;
     if !film_is_whole(film) {
         return Err(ImageWriteError::InvalidFilm {
@@ -209,9 +278,11 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
         .map_err(io_error)?;
     {
         let mut writer = BufWriter::new(temporary.as_file_mut());
-        encode_to(film, format, &mut writer).map_err(|source| ImageWriteError::Encode {
-            path: path.to_path_buf(),
-            source,
+        encode_to(film, format, &options.png, &mut writer).map_err(|source| {
+            ImageWriteError::Encode {
+                path: path.to_path_buf(),
+                source,
+            }
         })?;
         writer.flush().map_err(io_error)?;
     }
@@ -224,9 +295,14 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
     Ok(())
 }
 
-/// The bytes `write_image` would write for `film` in `format`, held in memory: for front ends
-/// without a file system (the browser), so their files equal the CLI's byte for byte.
-pub fn encode_image(film: &Film, format: OutputFormat) -> Result<Vec<u8>, EncodeError> {
+/// The bytes `write_image_with` would write for `film` in `format` with `options`, held in
+/// memory: for front ends without a file system (the browser), so that their files equal the
+/// CLI's byte for byte.
+pub fn encode_image(
+    film: &Film,
+    format: OutputFormat,
+    options: &WriteOptions,
+) -> Result<Vec<u8>, EncodeError> {
     if !film_is_whole(film) {
         return Err(format!(
             "the film is {} x {} but holds {} pixels",
@@ -237,7 +313,7 @@ pub fn encode_image(film: &Film, format: OutputFormat) -> Result<Vec<u8>, Encode
         .into());
     }
     let mut bytes = std::io::Cursor::new(Vec::new());
-    encode_to(film, format, &mut bytes)?;
+    encode_to(film, format, &options.png, &mut bytes)?;
     Ok(bytes.into_inner())
 }
 
@@ -255,20 +331,48 @@ fn film_is_whole(film: &Film) -> bool {
 fn encode_to(
     film: &Film,
     format: OutputFormat,
+    png: &PngEncoding,
     writer: &mut (impl Write + std::io::Seek),
 ) -> Result<(), EncodeError> {
     match format {
-        OutputFormat::Png => encode_png(film, writer),
+        OutputFormat::Png => encode_png(film, png, writer),
         OutputFormat::Exr => encode_exr(film, writer),
     }
 }
 
-fn encode_png(film: &Film, writer: &mut (impl Write + std::io::Seek)) -> Result<(), EncodeError> {
-    let buffer = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8_course())
-        .ok_or("film size does not match its pixels")?;
-    buffer.write_to(writer, image::ImageFormat::Png)?;
+fn encode_png(
+    film: &Film,
+    encoding: &PngEncoding,
+    writer: &mut impl Write,
+) -> Result<(), EncodeError> {
+    let mut encoder = png::Encoder::new(writer, film.width, film.height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    if encoding.transfer() == Transfer::Srgb {
+        encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+    }
+    encoder.add_text_chunk(
+        "Software".to_owned(),
+        concat!("Glint ", env!("CARGO_PKG_VERSION")).to_owned(),
+    )?;
+    encoder.add_text_chunk(TRANSFORM_KEYWORD.to_owned(), encoding.describe())?;
+    let transfer = match encoding.transfer() {
+        Transfer::Srgb => "sRGB",
+        Transfer::Linear => "linear",
+    };
+    encoder.add_text_chunk(TRANSFER_KEYWORD.to_owned(), transfer.to_owned())?;
+    let mut png = encoder.write_header()?;
+    png.write_image_data(&encoding.to_rgb8(film))?;
+    png.finish()?;
     Ok(())
 }
+
+/// The EXR channel-name prefix of the albedo layer (Blender's pass name, then `.R/.G/.B`).
+pub const ALBEDO_LAYER: &str = "Denoising Albedo.";
+/// The EXR channel-name prefix of the world-space normal layer (then `.X/.Y/.Z`).
+pub const NORMAL_LAYER: &str = "Denoising Normal.";
+/// The EXR channel of the depth layer (Blender's `Depth` pass, channel `Z`).
+pub const DEPTH_CHANNEL: &str = "Depth.Z";
 
 /// One EXR part with f32 channels R, G, B (the beauty) and the feature layers' channels, rows
 /// from the top, as the `exr` crate stores them.
@@ -278,9 +382,10 @@ fn encode_exr(film: &Film, writer: &mut (impl Write + std::io::Seek)) -> Result<
         WritableImage,
     };
     let rgb = |prefix: &str,
+               suffixes: [&str; 3],
                values: &[Vec3],
                channels: &mut smallvec::SmallVec<[AnyChannel<FlatSamples>; 4]>| {
-        for (component, suffix) in ["R", "G", "B"].into_iter().enumerate() {
+        for (component, suffix) in suffixes.into_iter().enumerate() {
             let samples = values.iter().map(|p| p.to_array()[component]).collect();
             channels.push(AnyChannel::new(
                 format!("{prefix}{suffix}").as_str(),
@@ -289,12 +394,22 @@ fn encode_exr(film: &Film, writer: &mut (impl Write + std::io::Seek)) -> Result<
         }
     };
     let mut channels = smallvec::SmallVec::new();
-    rgb("", &film.pixels, &mut channels);
+    rgb("", ["R", "G", "B"], &film.pixels, &mut channels);
     if let Some(features) = &film.features {
-        rgb("albedo.", &features.albedo, &mut channels);
-        rgb("normal.", &features.normal, &mut channels);
+        rgb(
+            ALBEDO_LAYER,
+            ["R", "G", "B"],
+            &features.albedo,
+            &mut channels,
+        );
+        rgb(
+            NORMAL_LAYER,
+            ["X", "Y", "Z"],
+            &features.normal,
+            &mut channels,
+        );
         channels.push(AnyChannel::new(
-            "depth.Y",
+            DEPTH_CHANNEL,
             FlatSamples::F32(features.depth.clone()),
         ));
     }
@@ -397,7 +512,7 @@ mod tests {
     #[test]
     fn cube_map_files_are_named_in_face_order() {
         assert_eq!(
-            cube_face_paths("images/reef_"),
+            cube_face_paths("images/reef_", "png"),
             [
                 "images/reef_posX.png",
                 "images/reef_negX.png",
@@ -420,7 +535,7 @@ mod tests {
             [0, 255, 255],
             [255, 0, 255],
         ];
-        for (name, color) in cube_face_paths("sky_").iter().zip(colors) {
+        for (name, color) in cube_face_paths("sky_", "png").iter().zip(colors) {
             image::RgbImage::from_pixel(2, 2, image::Rgb(color))
                 .save(directory.path().join(name))
                 .unwrap();
@@ -455,12 +570,12 @@ mod tests {
             let path = directory.path().join(name);
             write_image(&path, &film).unwrap();
             assert_eq!(
-                encode_image(&film, format).unwrap(),
+                encode_image(&film, format, &WriteOptions::default()).unwrap(),
                 std::fs::read(&path).unwrap()
             );
         }
         film.pixels.pop();
-        assert!(encode_image(&film, OutputFormat::Png).is_err());
+        assert!(encode_image(&film, OutputFormat::Png, &WriteOptions::default()).is_err());
     }
 
     #[test]
@@ -468,5 +583,113 @@ mod tests {
         let directory = tempfile::tempdir().unwrap();
         let error = load_cube_map(directory.path(), "data/reef_", &crate::FileSystem).unwrap_err();
         assert!(error.contains("data/reef_posX.png"), "{error}");
+    }
+
+    fn float_rgb(values: &[[f32; 3]], width: u32) -> image::Rgb32FImage {
+        let height = values.len() as u32 / width;
+        image::Rgb32FImage::from_raw(width, height, values.concat()).unwrap()
+    }
+
+    #[test]
+    fn exr_and_hdr_images_keep_values_above_one() {
+        let directory = tempfile::tempdir().unwrap();
+        let texels = [[16.0, 0.5, 0.25], [0.0, 1.0, 3.5]];
+        for extension in ["exr", "hdr"] {
+            let path = directory.path().join(format!("sky.{extension}"));
+            float_rgb(&texels, 2).save(&path).unwrap();
+            let image = load_image(&path, &crate::FileSystem).unwrap();
+            assert_eq!((image.width, image.height), (2, 1));
+            for (loaded, expected) in image.texels.iter().zip(texels) {
+                // EXR stores f32 exactly; Radiance HDR's shared exponent keeps ~1 % .
+                let tolerance = if extension == "exr" { 0.0 } else { 0.01 };
+                for (a, b) in loaded.to_array().into_iter().zip(expected) {
+                    assert!(
+                        (a - b).abs() <= tolerance * b.max(1.0),
+                        "{extension}: {a} vs {b}"
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn eight_bit_images_are_their_levels_over_255() {
+        let directory = tempfile::tempdir().unwrap();
+        let path = directory.path().join("t.png");
+        image::RgbImage::from_raw(2, 1, vec![0, 1, 127, 128, 254, 255])
+            .unwrap()
+            .save(&path)
+            .unwrap();
+        let image = load_image(&path, &crate::FileSystem).unwrap();
+        let expected: Vec<f32> = [0u8, 1, 127, 128, 254, 255]
+            .into_iter()
+            .map(|v| f32::from(v) / 255.0)
+            .collect();
+        let loaded: Vec<f32> = image.texels.iter().flat_map(|c| c.to_array()).collect();
+        assert_eq!(loaded, expected);
+    }
+
+    #[test]
+    fn non_finite_or_negative_hdr_texels_are_refused_by_position() {
+        let directory = tempfile::tempdir().unwrap();
+        for (bad, what) in [(f32::NAN, "NaN"), (f32::INFINITY, "inf"), (-0.5, "-0.5")] {
+            let path = directory.path().join("bad.exr");
+            float_rgb(&[[1.0, 1.0, 1.0], [0.5, bad, 0.5]], 2)
+                .save(&path)
+                .unwrap();
+            let error = load_image(&path, &crate::FileSystem).unwrap_err();
+            assert!(error.contains("texel (1, 0)"), "{what}: {error}");
+        }
+    }
+
+    #[test]
+    fn hdr_cube_map_faces_may_be_exr() {
+        let directory = tempfile::tempdir().unwrap();
+        for (index, name) in cube_face_paths("sky_", "exr").iter().enumerate() {
+            let value = 2.0 + index as f32;
+            float_rgb(&[[value, value, value]; 4], 2)
+                .save(directory.path().join(name))
+                .unwrap();
+        }
+        let map = load_cube_map(directory.path(), "sky_", &crate::FileSystem).unwrap();
+        assert_eq!(map.lookup(Vec3::X), Vec3::splat(2.0));
+        assert_eq!(map.lookup(-Vec3::Z), Vec3::splat(7.0));
+    }
+
+    #[test]
+    fn png_names_its_transform_in_text_chunks() {
+        use crate::display::{DisplayTransform, ToneMap};
+        let directory = tempfile::tempdir().unwrap();
+        let film = Film {
+            pixels: vec![Color::new(0.18, 2.0, 0.0)],
+            ..Film::new(1, 1)
+        };
+        let aces = PngEncoding::Display(DisplayTransform {
+            tone_map: ToneMap::Aces,
+            ..DisplayTransform::default()
+        });
+        for (encoding, transfer, srgb_chunk) in
+            [(PngEncoding::Course, "linear", false), (aces, "sRGB", true)]
+        {
+            let path = directory.path().join("out.png");
+            let options = WriteOptions { png: encoding };
+            write_image_with(&path, &film, &options).unwrap();
+            let decoder = png::Decoder::new(std::io::BufReader::new(File::open(&path).unwrap()));
+            let mut reader = decoder.read_info().unwrap();
+            let info = reader.info();
+            let text = |keyword: &str| {
+                info.uncompressed_latin1_text
+                    .iter()
+                    .find(|chunk| chunk.keyword == keyword)
+                    .map(|chunk| chunk.text.clone())
+            };
+            assert_eq!(text(TRANSFORM_KEYWORD), Some(encoding.describe()));
+            assert_eq!(text(TRANSFER_KEYWORD).as_deref(), Some(transfer));
+            assert!(text("Software").unwrap().starts_with("Glint "));
+            assert_eq!(info.srgb.is_some(), srgb_chunk);
+            let mut pixels = vec![0; reader.output_buffer_size().unwrap()];
+            reader.next_frame(&mut pixels).unwrap();
+            assert_eq!(&pixels[..3], encoding.to_rgb8(&film).as_slice());
+        }
     }
 }

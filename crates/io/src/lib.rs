@@ -1,5 +1,6 @@
 //! Glint's I/O: the course's XML and JSON scene files into the renderer's `SceneParts`, OBJ
-//! meshes and PNG textures with them, and the rendered film out as PNG or EXR.
+//! meshes and textures with them (8-bit as the course reads them, EXR and Radiance HDR as float),
+//! and the rendered film out as PNG (the course's conversion or a display transform) or EXR.
 //!
 //! Loading runs in three stages (DESIGN.md, habits 1-2):
 //! 1. **parse**: XML (roxmltree) or JSON (jsonc-parser) into one located tree (`tree.rs`), the
@@ -45,6 +46,7 @@ mod assets;
 mod build;
 mod desc;
 mod diagnostic;
+mod display;
 mod image_io;
 mod json;
 mod mesh;
@@ -60,8 +62,12 @@ use std::path::Path;
 
 pub use assets::{Assets, FileSystem, MemoryAssets};
 pub use diagnostic::{Diagnostic, SceneError, Severity};
+pub use display::{
+    DisplayTransform, PngEncoding, ToneMap, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD,
+};
 pub use image_io::{
-    encode_image, output_format, write_image, EncodeError, ImageWriteError, OutputFormat,
+    encode_image, output_format, write_image, write_image_with, EncodeError, ImageWriteError,
+    OutputFormat, WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
 };
 pub use mesh::{load_mesh, Mesh, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};

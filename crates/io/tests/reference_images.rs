@@ -11,6 +11,9 @@ use std::path::{Path, PathBuf};
 
 use glint_render::{render, Background, RenderSettings, Scene, Vec3};
 
+mod reference_measure;
+use reference_measure::compare;
+
 fn shared_dir() -> Option<PathBuf> {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared");
     if dir.join("scenes/course").is_dir() {
@@ -22,32 +25,6 @@ fn shared_dir() -> Option<PathBuf> {
             "SKIPPED: ../shared/scenes/course is absent, so reference images cannot be checked"
         );
         None
-    }
-}
-
-struct ImageError {
-    mean_absolute: f64,
-    fraction_over_8: f64,
-}
-
-fn compare(rendered: &[u8], reference: &[u8]) -> ImageError {
-    assert_eq!(rendered.len(), reference.len());
-    let mut sum = 0u64;
-    let mut over = 0usize;
-    for (a, b) in rendered.chunks(3).zip(reference.chunks(3)) {
-        let mut worst = 0;
-        for c in 0..3 {
-            let d = (a[c] as i32 - b[c] as i32).unsigned_abs();
-            sum += d as u64;
-            worst = worst.max(d);
-        }
-        if worst > 8 {
-            over += 1;
-        }
-    }
-    ImageError {
-        mean_absolute: sum as f64 / rendered.len() as f64,
-        fraction_over_8: over as f64 / (rendered.len() / 3) as f64,
     }
 }
 

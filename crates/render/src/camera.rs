@@ -1,7 +1,9 @@
-//! Perspective and orthographic cameras of the course (slide001 pp.18-25, FORMAT.md 1.2).
+//! Perspective and orthographic cameras of the course (slide001 pp.18-25, FORMAT.md 1.2),
+//! with an optional thin lens for depth of field (`-d`, FORMAT.md 1.4).
 
 use crate::math::{Frame, Vec3};
 use crate::ray::Ray;
+use crate::sampling::sample_uniform_disk_concentric;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Projection {
@@ -19,6 +21,44 @@ pub struct Camera {
     pub basis: Frame,
     pub focal_length: f32,
     pub image_plane_width: f32,
+    /// Depth of field: `None` is the course's pinhole (every ray leaves from the position).
+    pub lens: Option<ThinLens>,
+}
+
+/// A thin lens (pbrt's `PerspectiveCamera` lens, Mitsuba 3's `thinlens` sensor): rays leave
+/// from a point of a disk of radius `radius` around the camera position, in the (U, V) plane,
+/// and pass through the point of the plane in focus that the pinhole ray meets. Points on that
+/// plane stay sharp; the others blur in proportion to the radius.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    /// Distance from the lens to the plane in focus, along the view direction (-W).
+    pub focus_distance: f32,
+    /// Lens radius in scene units.
+    pub radius: f32,
+}
+
+impl ThinLens {
+    /// Share of the width the image covers at the focus distance that the default lens
+    /// radius takes: a point far behind the plane in focus (or at half its distance) blurs
+    /// into a disk of 1/25 of the image width.
+    pub const DEFAULT_RADIUS_SHARE: f32 = 1.0 / 50.0;
+
+    /// A lens focused at `focus_distance` with the default radius for `camera`:
+    /// `DEFAULT_RADIUS_SHARE` of the width the image covers at that distance (the image-plane
+    /// width scaled by focus distance / focal length; the image-plane width itself for an
+    /// orthographic camera), so that the blur looks alike whatever the scene's scale.
+    pub fn with_default_radius(camera: &Camera, focus_distance: f32) -> ThinLens {
+        let covered = match camera.projection {
+            Projection::Perspective => {
+                camera.image_plane_width * focus_distance / camera.focal_length
+            }
+            Projection::Orthographic => camera.image_plane_width,
+        };
+        ThinLens {
+            focus_distance,
+            radius: covered.abs() * Self::DEFAULT_RADIUS_SHARE,
+        }
+    }
 }
 
 impl Camera {
@@ -35,6 +75,7 @@ impl Camera {
             basis: Frame::from_two(gaze, Vec3::Y),
             focal_length,
             image_plane_width,
+            lens: None,
         }
     }
 
@@ -54,5 +95,37 @@ impl Camera {
             }
             Projection::Orthographic => Ray::new(self.position + b.u * u + b.v * v, -b.w),
         }
+    }
+
+    /// `ray`, leaving from the point of the lens that `lens_sample` in [0, 1)² maps to (the
+    /// concentric disk mapping, as Mitsuba's `thinlens` does) and passing through the point
+    /// where `ray` meets the plane in focus. Its direction has the same component along the
+    /// view direction as `ray`'s, so a lens of radius 0 gives `ray` back. Without a lens,
+    /// `ray` itself.
+    #[inline]
+    pub fn lens_ray(
+        &self,
+        px: f32,
+        py: f32,
+        nx: u32,
+        ny: u32,
+        aspect: f32,
+        lens_sample: (f32, f32),
+    ) -> Ray {
+        let pinhole = self.ray(px, py, nx, ny, aspect);
+        let Some(lens) = self.lens else {
+            return pinhole;
+        };
+        let b = &self.basis;
+        let (dx, dy) = sample_uniform_disk_concentric(lens_sample.0, lens_sample.1);
+        let offset = b.u * (dx * lens.radius) + b.v * (dy * lens.radius);
+        // The pinhole ray meets the plane in focus at t = focus distance / its component along
+        // the view direction; from the lens point, that point is direction · t − offset away.
+        let along = -pinhole.direction.dot(b.w);
+        let t_focus = lens.focus_distance / along;
+        Ray::new(
+            pinhole.origin + offset,
+            pinhole.direction - offset * (1.0 / t_focus),
+        )
     }
 }

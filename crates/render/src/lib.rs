@@ -84,18 +84,19 @@ mod pipeline;
 mod tests;
 
 // The scene a loader builds, in plain data.
-pub use camera::{Camera, Projection};
+pub use accel::build::SplitMethod;
+pub use camera::{Camera, Projection, ThinLens};
 pub use geometry::{Aabb, Shape};
 pub use light::Light;
 pub use material::{Material, MaterialId};
 pub use math::{Color, Matrix4, Transform, Vec3};
 pub use ray::Ray;
-pub use scene::{Background, GeometryDesc, Instance, Scene, SceneParts};
+pub use scene::{Background, BvhStats, GeometryDesc, Instance, Scene, SceneOptions, SceneParts};
 pub use texture::{ColorSource, CubeMap, Image, TextureId};
 
 // Rendering it.
 pub use film::{Features, Film};
 pub use pipeline::{
-    render, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings, RenderStats,
-    TILE_SIZE,
+    measure_traversal, render, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings,
+    RenderStats, TraversalStats, TILE_SIZE,
 };

@@ -535,3 +535,61 @@ fn render_tiles<P: Copy + Default + Send>(
         first_nonfinite.map(|p| ((p % width as u64) as u32, (p / width as u64) as u32));
     Ok((pixels, stats))
 }
+
+/// What the bottom-level BVHs cost the camera rays (`measure_traversal`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TraversalStats {
+    /// Rays traced: one through the centre of each pixel of `settings.bounds()`.
+    pub rays: u64,
+    /// Rays that hit something.
+    pub hits: u64,
+    /// 8-wide nodes tested and triangle blocks tested, over all the rays (the top level
+    /// over instances is not counted: it does not depend on the split method).
+    pub nodes: u64,
+    pub blocks: u64,
+}
+
+impl TraversalStats {
+    /// Nodes visited per ray.
+    pub fn nodes_per_ray(&self) -> f64 {
+        self.nodes as f64 / self.rays.max(1) as f64
+    }
+
+    /// Triangle blocks tested per ray.
+    pub fn blocks_per_ray(&self) -> f64 {
+        self.blocks as f64 / self.rays.max(1) as f64
+    }
+}
+
+/// Traces a camera ray through the centre of each pixel of `settings.bounds()` (through the
+/// centre of the lens, with depth of field) with a traversal that counts its node and block
+/// tests: a separate pass on the current rayon pool, so that rendering itself counts nothing.
+/// It finds the closest hits `render` finds.
+pub fn measure_traversal(scene: &Scene, settings: &RenderSettings) -> TraversalStats {
+    let bounds = settings.bounds();
+    let (width, height) = (settings.width, settings.height);
+    let aspect = settings.aspect.unwrap_or(width as f32 / height as f32);
+    (bounds.y0..bounds.y1)
+        .into_par_iter()
+        .map(|y| {
+            let mut counts = crate::accel::wide::WalkCounts::default();
+            let mut stats = TraversalStats::default();
+            for x in bounds.x0..bounds.x1 {
+                let j = height - 1 - y;
+                let ray = scene
+                    .camera
+                    .ray(x as f32 + 0.5, j as f32 + 0.5, width, height, aspect);
+                stats.rays += 1;
+                stats.hits += u64::from(scene.count_closest(&ray, &mut counts).is_some());
+            }
+            stats.nodes = counts.nodes;
+            stats.blocks = counts.blocks;
+            stats
+        })
+        .reduce(TraversalStats::default, |a, b| TraversalStats {
+            rays: a.rays + b.rays,
+            hits: a.hits + b.hits,
+            nodes: a.nodes + b.nodes,
+            blocks: a.blocks + b.blocks,
+        })
+}

@@ -18,7 +18,10 @@
 
 use std::path::Path;
 
-use glint_io::{Diagnostic, MemoryAssets, OutputFormat, SceneError, Severity};
+use glint_io::{
+    Diagnostic, DisplayTransform, MemoryAssets, OutputFormat, PngEncoding, SceneError, Severity,
+    WriteOptions,
+};
 use glint_render::{
     Color, Features, Film, IntegratorKind, PixelBounds, RenderSettings, Scene, Vec3,
 };
@@ -141,6 +144,19 @@ pub fn load(text: &str, path: &str, files: &Files) -> Loaded {
     }
 }
 
+/// The PNG encoding `glint render` gives `integrator` without `--exposure`, `--tonemap` or
+/// `--transfer` (the CLI's `args::png_encoding`): the course's conversion for the course
+/// integrator and the data views, the display transform's defaults for the path tracer and
+/// the albedo view.
+fn png_encoding(integrator: IntegratorKind) -> PngEncoding {
+    match integrator {
+        IntegratorKind::Path | IntegratorKind::Albedo => {
+            PngEncoding::Display(DisplayTransform::default())
+        }
+        _ => PngEncoding::Course,
+    }
+}
+
 /// How to render: the CLI's options (`-w`, `-h`, `-r`, `-k`, `--seed`, `--integrator`).
 #[wasm_bindgen]
 #[derive(Clone, Debug)]
@@ -161,13 +177,7 @@ impl Settings {
         max_depth: Option<u32>,
         features: bool,
     ) -> Result<Settings, String> {
-        let integrator = IntegratorKind::from_name(integrator).ok_or_else(|| {
-            let names: Vec<&str> = IntegratorKind::ALL.iter().map(|kind| kind.name()).collect();
-            format!(
-                "unknown integrator `{integrator}` (one of {})",
-                names.join(", ")
-            )
-        })?;
+        let integrator = integrator_named(integrator)?;
         let settings = RenderSettings {
             width,
             height,
@@ -189,8 +199,15 @@ impl Settings {
     }
 }
 
-/// One rendered rectangle: RGB floats row-major from its top-left, the same as 8-bit RGB with
-/// the course's conversion (what the PNG holds, for the canvas), the feature layers when asked
+fn integrator_named(name: &str) -> Result<IntegratorKind, String> {
+    IntegratorKind::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = IntegratorKind::ALL.iter().map(|kind| kind.name()).collect();
+        format!("unknown integrator `{name}` (one of {})", names.join(", "))
+    })
+}
+
+/// One rendered rectangle: RGB floats row-major from its top-left, the same as 8-bit RGB as
+/// the CLI's PNG holds them (for the canvas), the feature layers when asked
 /// for (albedo and normal RGB, depth one float), and the rays it took.
 #[wasm_bindgen(getter_with_clone)]
 #[derive(Clone, Debug)]
@@ -236,7 +253,7 @@ impl Loaded {
         };
         let (film, stats) =
             glint_render::render(scene, &settings, &|_| true).map_err(|error| error.to_string())?;
-        let rgb8 = film.to_rgb8_course();
+        let rgb8 = png_encoding(settings.integrator).to_rgb8(&film);
         let (albedo, normal, depth) = match film.features {
             Some(features) => (
                 flatten(&features.albedo),
@@ -269,11 +286,14 @@ fn unflatten(values: &[f32]) -> Vec<Color> {
 }
 
 /// The bytes of the `width` x `height` image `pixels` (RGB floats, row-major from the top-left)
-/// as `format` (`png` or `exr`), by glint-io's encoder: what `glint render -o out.<format>`
-/// writes. The feature layers go into an EXR when all three are given.
+/// rendered with `integrator`, as `format` (`png` or `exr`), by glint-io's encoder: what
+/// `glint render --integrator <integrator> -o out.<format>` writes. The feature layers go into
+/// an EXR when all three are given.
+#[allow(clippy::too_many_arguments)]
 #[wasm_bindgen]
 pub fn encode(
     format: &str,
+    integrator: &str,
     width: u32,
     height: u32,
     pixels: &[f32],
@@ -286,6 +306,7 @@ pub fn encode(
         "exr" => OutputFormat::Exr,
         other => return Err(format!("unknown image format `{other}` (png or exr)")),
     };
+    let integrator = integrator_named(integrator)?;
     let features = match (albedo, normal, depth) {
         (Some(albedo), Some(normal), Some(depth)) => Some(Features {
             albedo: unflatten(&albedo),
@@ -302,5 +323,8 @@ pub fn encode(
         full_size: (width, height),
         features,
     };
-    glint_io::encode_image(&film, format).map_err(|error| error.to_string())
+    let options = WriteOptions {
+        png: png_encoding(integrator),
+    };
+    glint_io::encode_image(&film, format, &options).map_err(|error| error.to_string())
 }

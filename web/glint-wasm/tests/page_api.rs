@@ -84,6 +84,7 @@ fn tiles_assembled_and_encoded_equal_the_cli_files() {
         glint_io::write_image(&file, &film).unwrap();
         let page = encode(
             format,
+            "course",
             width,
             height,
             &pixels,
@@ -97,6 +98,36 @@ fn tiles_assembled_and_encoded_equal_the_cli_files() {
             "the page's {format} differs from the CLI's"
         );
     }
+}
+
+#[test]
+fn a_path_traced_png_gets_the_cli_display_transform() {
+    let (text, files) = example_files();
+    let loaded = load(&text, "textured/textured.xml", &files);
+    let (width, height) = (24, 16);
+    let settings = Settings::new(width, height, 2, "path", 0, None, false).unwrap();
+    let tile = loaded.render_tile(&settings, 0, 0, width, height).unwrap();
+    let page = encode("png", "path", width, height, &tile.pixels, None, None, None).unwrap();
+
+    // `glint render --integrator path` writes its PNG with the display transform's defaults.
+    let scene_path = Path::new(WEB).join("scenes/textured/textured.xml");
+    let scene = glint_render::Scene::new(glint_io::load_scene(&scene_path).unwrap().parts);
+    let cli_settings = RenderSettings {
+        width,
+        height,
+        samples_per_pixel: 2,
+        integrator: glint_render::IntegratorKind::Path,
+        ..RenderSettings::default()
+    };
+    let (film, _) = glint_render::render(&scene, &cli_settings, &|_| true).unwrap();
+    let options = glint_io::WriteOptions {
+        png: glint_io::PngEncoding::Display(glint_io::DisplayTransform::default()),
+    };
+    let directory = tempfile::tempdir().unwrap();
+    let file = directory.path().join("cli.png");
+    glint_io::write_image_with(&file, &film, &options).unwrap();
+    assert!(page == std::fs::read(&file).unwrap());
+    assert_eq!(tile.rgb8, options.png.to_rgb8(&film));
 }
 
 #[test]
@@ -135,6 +166,6 @@ fn bad_settings_and_formats_are_refused() {
     assert!(Settings::new(4, 4, 1, "photon", 0, None, false)
         .unwrap_err()
         .contains("course, path"));
-    assert!(encode("jpg", 1, 1, &[0.0; 3], None, None, None).is_err());
-    assert!(encode("png", 2, 1, &[0.0; 3], None, None, None).is_err());
+    assert!(encode("jpg", "course", 1, 1, &[0.0; 3], None, None, None).is_err());
+    assert!(encode("png", "course", 2, 1, &[0.0; 3], None, None, None).is_err());
 }

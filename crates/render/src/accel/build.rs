@@ -8,6 +8,14 @@
 //! Ranges whose centroids all coincide, and everything below depth `SAH_DEPTH`, are split at the
 //! median by count, which bounds the tree depth (and so the traversal stack) for any input.
 //! Big subtrees are built in parallel on the current rayon pool.
+//!
+//! The binary split rule is a choice (`SplitMethod`, the CLI's `-s`): the binned SAH above, or
+//! the two rules of the course's acceleration lecture, object median (sort the range along an
+//! axis and split the list in half) and spatial median (split about the middle of the range's
+//! box), each on axis x, y, z in turn by binary level. Whatever the rule, a node's eight
+//! children are found by splitting records in two until there are eight; the median rules
+//! split breadth first (the record of lowest binary level, then of most primitives), which
+//! collapses the top three levels of their binary tree into one wide node.
 
 use rayon::prelude::*;
 
@@ -18,12 +26,53 @@ use crate::accel::wide::{
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
 
-/// Below this depth the SAH chooses splits; deeper, median splits by count finish the job in
-/// at most log₂(2²⁷) more levels.
+/// Below this depth the SAH (or the spatial median) chooses splits; deeper, median splits by
+/// count finish the job in at most log₂(2²⁷) more levels.
 const SAH_DEPTH: usize = 20;
 const BINS: usize = 32;
 /// Subtrees with more primitives than this are built as parallel tasks.
 const PARALLEL_THRESHOLD: usize = 4096;
+
+/// How the builder splits a range of primitives in two (`-s`, FORMAT.md 1.4).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SplitMethod {
+    /// The course's object median: the range sorted by centroid along axis x, y, z in turn
+    /// (by binary level) and split in half by count. Leaves hold one triangle block (four
+    /// triangles) or one other shape.
+    ObjectMedian,
+    /// The course's spatial median: the range split about the middle of its box along axis
+    /// x, y, z in turn, by centroid; where that leaves one side empty, the next axis, and where
+    /// all three do, the object median (and below wide depth 20, as for the SAH, the object
+    /// median always, which bounds the depth). Leaves as for `ObjectMedian`.
+    SpatialMedian,
+    /// Binned surface area heuristic with a block-aware leaf cost (the default: fastest to
+    /// trace).
+    #[default]
+    Sah,
+}
+
+impl SplitMethod {
+    /// Every method, in the order the CLI lists them.
+    pub const ALL: [SplitMethod; 3] = [
+        SplitMethod::ObjectMedian,
+        SplitMethod::SpatialMedian,
+        SplitMethod::Sah,
+    ];
+
+    /// The course's name: `objectMedian`, `spatialMedian`, `sah`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SplitMethod::ObjectMedian => "objectMedian",
+            SplitMethod::SpatialMedian => "spatialMedian",
+            SplitMethod::Sah => "sah",
+        }
+    }
+
+    /// The method called `name` (see `name`).
+    pub fn from_name(name: &str) -> Option<SplitMethod> {
+        SplitMethod::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
 
 /// Build parameters, chosen by what a geometry holds.
 #[derive(Clone, Copy, Debug)]
@@ -156,7 +205,10 @@ struct Record {
     end: usize,
     bounds: Box4,
     centroids: Box4,
+    /// SAH split found for this range (`SplitMethod::Sah` only).
     split: Option<Split>,
+    /// Binary level: 0 at the root, one more at each split (the median rules' axis).
+    level: u32,
 }
 
 impl Record {
@@ -284,18 +336,26 @@ fn measure(prims: &[PrimRef]) -> (Box4, Box4) {
     (bounds, centroids)
 }
 
-/// Splits a record in two: by its SAH split, else at the median by count on the widest
-/// centroid axis. Both halves are non-empty.
+/// Splits a record in two by `method`. With the SAH: by its split, else at the median by count
+/// on the widest centroid axis. Both halves are non-empty.
 fn split_record(
     prims: &mut [PrimRef],
     record: &Record,
     config: &Config,
     depth: usize,
+    method: SplitMethod,
 ) -> (Record, Record) {
     let (start, end) = (record.start, record.end);
     let mut sides = None;
-    let mid = match record.split {
-        Some(split) => {
+    let mid = match (method, record.split) {
+        (SplitMethod::ObjectMedian, _) => object_median(prims, record, record.level as usize % 3),
+        // Halving space need not halve the count (one far primitive beside a cluster): past
+        // the SAH depth the object median bounds the depth, as for the SAH.
+        (SplitMethod::SpatialMedian, _) if depth >= SAH_DEPTH => {
+            object_median(prims, record, record.level as usize % 3)
+        }
+        (SplitMethod::SpatialMedian, _) => spatial_median(prims, record),
+        (SplitMethod::Sah, Some(split)) => {
             // Partition, measuring both sides on the way.
             let binner = Binner::new(&record.centroids, record.len());
             let axis = split.axis;
@@ -320,7 +380,7 @@ fn split_record(
             sides = Some(((left, left_c), (right, right_c)));
             i
         }
-        None => start,
+        (SplitMethod::Sah, None) => start,
     };
     let mid = if mid == start || mid == end {
         sides = None;
@@ -334,11 +394,7 @@ fn split_record(
         } else {
             2
         };
-        let half = (end - start) / 2;
-        prims[start..end].select_nth_unstable_by(half, |a, b| {
-            a.centroid()[axis].total_cmp(&b.centroid()[axis])
-        });
-        start + half
+        object_median(prims, record, axis)
     } else {
         mid
     };
@@ -350,8 +406,9 @@ fn split_record(
             bounds,
             centroids,
             split: None,
+            level: record.level + 1,
         };
-        if r.len() > config.min_leaf && depth < SAH_DEPTH {
+        if method == SplitMethod::Sah && r.len() > config.min_leaf && depth < SAH_DEPTH {
             r.split = find_split(prims, &r, config);
         }
         r
@@ -363,6 +420,47 @@ fn split_record(
     (make(prims, start, mid, left), make(prims, mid, end, right))
 }
 
+/// Puts the lower half of `record`'s primitives by centroid along `axis` first (ties in any
+/// order) and returns where the upper half starts: the object median.
+fn object_median(prims: &mut [PrimRef], record: &Record, axis: usize) -> usize {
+    let (start, end) = (record.start, record.end);
+    let half = (end - start) / 2;
+    prims[start..end]
+        .select_nth_unstable_by(half, |a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]));
+    start + half
+}
+
+/// Partitions `record`'s primitives about the middle of its box (centroid below the middle
+/// first) along the axis of its level, or the next axis where one side would be empty; the
+/// object median where every axis leaves one empty (all centroids on one side of every
+/// middle, e.g. coinciding). Returns where the second part starts.
+fn spatial_median(prims: &mut [PrimRef], record: &Record) -> usize {
+    let (start, end) = (record.start, record.end);
+    let first_axis = record.level as usize % 3;
+    for k in 0..3 {
+        let axis = (first_axis + k) % 3;
+        // Centroids are doubled, so the doubled middle is lo + hi.
+        let middle = record.bounds.lo[axis] + record.bounds.hi[axis];
+        let below = prims[start..end]
+            .iter()
+            .filter(|p| p.centroid()[axis] < middle)
+            .count();
+        if below > 0 && below < end - start {
+            let (mut i, mut j) = (start, end);
+            while i < j {
+                if prims[i].centroid()[axis] < middle {
+                    i += 1;
+                } else {
+                    j -= 1;
+                    prims.swap(i, j);
+                }
+            }
+            return i;
+        }
+    }
+    object_median(prims, record, first_axis)
+}
+
 /// Nodes of a subtree: inner references are indices into `nodes`; leaves still name primitive
 /// ranges (global positions in the primitive array), turned into blocks by `pack`.
 struct Subtree {
@@ -372,6 +470,7 @@ struct Subtree {
 
 struct Builder {
     config: Config,
+    method: SplitMethod,
 }
 
 impl Builder {
@@ -430,33 +529,42 @@ impl Builder {
             .split
             .map_or(f32::INFINITY, |s| config.traversal_cost * area + s.cost);
         let too_deep = depth >= MAX_DEPTH && n <= WIDTH;
-        if n <= config.min_leaf || (n <= config.max_leaf && leaf_cost <= split_cost) || too_deep {
+        let sah = self.method == SplitMethod::Sah;
+        let sah_leaf = sah && n <= config.max_leaf && leaf_cost <= split_cost;
+        if n <= config.min_leaf || sah_leaf || too_deep {
             return self.leaf(prims, base, &record, nodes);
         }
-        // Fill up to eight children by splitting the one of largest area (past the SAH depth:
-        // the largest by count, which halves the depth still needed at every level).
+        // Fill up to eight children by splitting, with the SAH, the one of largest area (past
+        // the SAH depth: the largest by count, which halves the depth still needed at every
+        // level); with the median rules, breadth first (lowest binary level, then most
+        // primitives).
         let median_mode = depth >= SAH_DEPTH;
+        let key = |c: &Record| -> (f32, f32) {
+            if !sah {
+                (-(c.level as f32), c.len() as f32)
+            } else if median_mode {
+                (0.0, c.len() as f32)
+            } else {
+                (0.0, c.bounds.half_area())
+            }
+        };
         let mut slots = [record; WIDTH];
         let mut len = 1;
         while len < WIDTH {
             let mut best: Option<usize> = None;
-            let mut best_key = -1.0f32;
+            let mut best_key = (f32::NEG_INFINITY, f32::NEG_INFINITY);
             for (k, c) in slots[..len].iter().enumerate() {
                 if c.len() <= config.min_leaf {
                     continue;
                 }
-                let key = if median_mode {
-                    c.len() as f32
-                } else {
-                    c.bounds.half_area()
-                };
+                let key = key(c);
                 if key > best_key {
                     best_key = key;
                     best = Some(k);
                 }
             }
             let Some(k) = best else { break };
-            let (left, right) = split_record(prims, &slots[k], config, depth + 1);
+            let (left, right) = split_record(prims, &slots[k], config, depth + 1, self.method);
             slots[k] = left;
             slots[len] = right;
             len += 1;
@@ -520,8 +628,15 @@ impl Builder {
     }
 }
 
-/// Builds the wide BVH of `shapes` on the current rayon pool.
+/// Builds the wide BVH of `shapes` by binned SAH on the current rayon pool.
+#[cfg(any(test, feature = "bench"))]
 pub fn build(shapes: &[Shape]) -> WideBvh {
+    build_with(shapes, SplitMethod::Sah)
+}
+
+/// Builds the wide BVH of `shapes` with the binary splits of `method`, on the current rayon
+/// pool. Any method finds the same closest hits (ties in t go to the lowest index as given).
+pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
     let all_triangles = shapes.iter().all(|s| matches!(s, Shape::Triangle { .. }));
     let config = Config::for_shapes(all_triangles);
     let mut prims: Vec<PrimRef> = shapes
@@ -555,11 +670,12 @@ pub fn build(shapes: &[Shape]) -> WideBvh {
             bounds,
             centroids,
             split: None,
+            level: 0,
         };
-        if record.len() > config.min_leaf {
+        if method == SplitMethod::Sah && record.len() > config.min_leaf {
             record.split = find_split(&prims, &record, &config);
         }
-        let builder = Builder { config };
+        let builder = Builder { config, method };
         builder.subtree(&mut prims, 0, record, 0, &mut nodes)
     };
     pack(

@@ -5,6 +5,8 @@
 
 use rayon::prelude::*;
 
+use crate::accel::build::SplitMethod;
+use crate::accel::wide::{TreeStats, WalkCounts};
 use crate::accel::{LocalHit, WideBvh, PACKET};
 use crate::bvh::Bvh;
 use crate::geometry::{Aabb, Shape};
@@ -92,10 +94,10 @@ impl Materials {
 }
 
 impl Geometry {
-    fn build(desc: GeometryDesc, accel: AccelKind) -> Geometry {
+    fn build(desc: GeometryDesc, accel: AccelKind, split: SplitMethod) -> Geometry {
         match accel {
             AccelKind::Wide => {
-                let bvh = crate::accel::build::build(&desc.shapes);
+                let bvh = crate::accel::build::build_with(&desc.shapes, split);
                 let materials = Materials::new(&desc.materials, &bvh.source);
                 let normals = (0..bvh.primitive_slots() as u32)
                     .map(|p| triangle_normal(&bvh.shape(p)))
@@ -129,6 +131,23 @@ impl Geometry {
         match &self.blas {
             Blas::Wide(bvh) => bvh.bounds(),
             Blas::Binary { bvh, .. } => bvh.bounds(),
+        }
+    }
+
+    /// The shape of the wide BVH; `None` for the binary reference.
+    fn tree_stats(&self) -> Option<TreeStats> {
+        match &self.blas {
+            Blas::Wide(bvh) => Some(bvh.tree_stats()),
+            Blas::Binary { .. } => None,
+        }
+    }
+
+    /// `intersect_preliminary`, counting the wide BVH's node and block tests (none counted for
+    /// the binary reference).
+    fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<(f32, u32)> {
+        match &self.blas {
+            Blas::Wide(bvh) => bvh.count_closest(ray, counts),
+            Blas::Binary { .. } => self.intersect_preliminary(ray),
         }
     }
 
@@ -303,6 +322,21 @@ pub struct PreliminaryHit {
     pub primitive: u32,
 }
 
+/// The bottom-level trees of a scene together (`Instances::tree_stats`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BottomLevelStats {
+    /// Geometries with a wide BVH.
+    pub trees: usize,
+    /// Inner nodes and leaves over all of them.
+    pub nodes: usize,
+    pub leaves: usize,
+    /// The deepest of them.
+    pub depth: usize,
+    /// Their SAH costs averaged with each tree weighted by its primitives (for one geometry,
+    /// its tree's cost).
+    pub sah_cost: f64,
+}
+
 /// Which structure the bottom level (one per geometry) is built as.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum AccelKind {
@@ -328,10 +362,11 @@ impl Instances {
         geometries: Vec<GeometryDesc>,
         instances: Vec<Instance>,
         accel: AccelKind,
+        split: SplitMethod,
     ) -> Instances {
         let geometries: Vec<Geometry> = geometries
             .into_par_iter()
-            .map(|g| Geometry::build(g, accel))
+            .map(|g| Geometry::build(g, accel, split))
             .collect();
         let instance_bounds: Vec<Aabb> = instances
             .iter()
@@ -375,6 +410,55 @@ impl Instances {
             stats.primitive_bytes += g.primitive_bytes();
         }
         stats
+    }
+
+    /// The bottom-level trees' shape, together.
+    pub fn tree_stats(&self) -> BottomLevelStats {
+        let mut out = BottomLevelStats::default();
+        let mut weighted = 0.0f64;
+        let mut weights = 0usize;
+        for g in &self.geometries {
+            if let Some(t) = g.tree_stats() {
+                out.trees += 1;
+                out.nodes += t.nodes;
+                out.leaves += t.leaves;
+                out.depth = out.depth.max(t.depth);
+                let primitives = g.primitive_count();
+                weighted += t.sah_cost * primitives as f64;
+                weights += primitives;
+            }
+        }
+        out.sah_cost = if weights > 0 {
+            weighted / weights as f64
+        } else {
+            0.0
+        };
+        out
+    }
+
+    /// `intersect_preliminary`'s t, counting the bottom-level node and block tests into
+    /// `counts` (the top level is not counted: it does not depend on the split method).
+    pub fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<f32> {
+        if self.instances.len() == 1 {
+            let inst = &self.instances[0];
+            let local = Instances::object_ray(inst, ray, ray.t_max);
+            return self.geometries[inst.geometry as usize]
+                .count_closest(&local, counts)
+                .map(|(t, _)| t);
+        }
+        let mut best = None;
+        self.tlas.traverse(ray, |inst_index, t_limit| {
+            let inst = &self.instances[inst_index as usize];
+            let local = Instances::object_ray(inst, ray, t_limit);
+            match self.geometries[inst.geometry as usize].count_closest(&local, counts) {
+                Some((t, _)) => {
+                    best = Some(t);
+                    t
+                }
+                None => t_limit,
+            }
+        });
+        best
     }
 
     #[cfg(feature = "bench")]

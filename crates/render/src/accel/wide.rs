@@ -621,3 +621,118 @@ pub(crate) fn any<K: Kernel, S: Stack>(
         }
     }
 }
+
+/// The shape of a wide BVH (`WideBvh::tree_stats`), what `--stats` compares split methods by.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TreeStats {
+    /// Inner nodes (8-wide).
+    pub nodes: usize,
+    /// Leaves (ranges of triangle blocks or shapes).
+    pub leaves: usize,
+    /// Inner nodes on the longest path from the root to a leaf.
+    pub depth: usize,
+    /// The SAH cost of the tree for a ray that meets the root's box: Σ over inner nodes of
+    /// area(node) / area(root), plus Σ over leaves of area(leaf) / area(root) · the leaf's block
+    /// (or shape) tests. Traversal and intersection cost one each, as in the builder.
+    pub sah_cost: f64,
+}
+
+impl WideBvh {
+    /// Counts the nodes, leaves and depth of the tree and computes its SAH cost (`TreeStats`).
+    pub fn tree_stats(&self) -> TreeStats {
+        let mut stats = TreeStats::default();
+        let root_area = f64::from(self.bounds.half_area());
+        let ratio = |area: f32| {
+            if root_area > 0.0 {
+                f64::from(area) / root_area
+            } else {
+                1.0
+            }
+        };
+        // (child, its box's half area, inner nodes above it)
+        let mut stack = vec![(self.root, self.bounds.half_area(), 0usize)];
+        while let Some((child, area, above)) = stack.pop() {
+            if child == ChildRef::EMPTY {
+                continue;
+            }
+            if child.is_leaf() {
+                stats.leaves += 1;
+                stats.depth = stats.depth.max(above);
+                stats.sah_cost += ratio(area) * child.range().1 as f64;
+                continue;
+            }
+            stats.nodes += 1;
+            stats.sah_cost += ratio(area);
+            let node = &self.nodes[child.0 as usize];
+            for slot in 0..WIDTH {
+                let b = Aabb {
+                    min: Vec3::new(node.bounds[0][slot], node.bounds[1][slot], node.bounds[2][slot]),
+                    max: Vec3::new(node.bounds[3][slot], node.bounds[4][slot], node.bounds[5][slot]),
+                };
+                stack.push((ChildRef(node.children[slot]), b.half_area(), above + 1));
+            }
+        }
+        stats
+    }
+
+    /// `intersect_preliminary` by the scalar kernel, counting what the walk does: the same
+    /// traversal instantiated with a counting kernel, so the traversal that renders carries no
+    /// counter. For `--stats` only.
+    pub(crate) fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<(f32, u32)> {
+        if !ray_is_valid(ray) {
+            return None;
+        }
+        let kernel = CountingKernel {
+            nodes: std::cell::Cell::new(0),
+            blocks: std::cell::Cell::new(0),
+        };
+        let hit = closest(&kernel, self, ray, &mut ArrayStack::new());
+        counts.nodes += kernel.nodes.get();
+        counts.blocks += kernel.blocks.get();
+        hit
+    }
+}
+
+/// What counting traversals did (`WideBvh::count_closest`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WalkCounts {
+    /// Inner nodes whose children's boxes were tested.
+    pub nodes: u64,
+    /// Triangle blocks tested (other shapes are not counted).
+    pub blocks: u64,
+}
+
+/// `ScalarKernel` counting its node and block tests.
+struct CountingKernel {
+    nodes: std::cell::Cell<u64>,
+    blocks: std::cell::Cell<u64>,
+}
+
+impl Kernel for CountingKernel {
+    type BoxRay = BoxPlanes;
+
+    fn box_ray(&self, ray: &Ray) -> BoxPlanes {
+        ScalarKernel.box_ray(ray)
+    }
+
+    fn node(&self, node: &WideNode, r: &BoxPlanes, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
+        self.nodes.set(self.nodes.get() + 1);
+        ScalarKernel.node(node, r, t_max, entry)
+    }
+
+    fn block(
+        &self,
+        block: &TriangleBlock,
+        ray: &WoopRay,
+        t_min: f32,
+        t_max: f32,
+    ) -> Option<(usize, f32)> {
+        self.blocks.set(self.blocks.get() + 1);
+        ScalarKernel.block(block, ray, t_min, t_max)
+    }
+
+    fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool {
+        self.blocks.set(self.blocks.get() + 1);
+        ScalarKernel.block_any(block, ray, t_min, t_max)
+    }
+}

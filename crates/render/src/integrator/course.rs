@@ -98,6 +98,7 @@ pub fn schlick(cos: f32, refractive_index: f32) -> f32 {
 const SALT_LIGHT: u64 = 0x1157;
 const SALT_GLOSSY: u64 = 0x6105;
 const SALT_BOUNCE: u64 = 0xb0c3;
+const SALT_LENS: u64 = 0x1e25;
 
 /// Picks a point on `light` as seen from `p`. `exact` requests the deterministic point the
 /// course uses with one ray per pixel (an area light's centre, FORMAT.md 4.5); otherwise the
@@ -192,8 +193,7 @@ pub(crate) fn grid_samples(
                 (q as f32 + rng.next_f32()) / grid as f32,
             )
         };
-        let ray = pixel.camera_ray(scene, ox, oy);
-        let ctx = SampleContext {
+        let mut ctx = SampleContext {
             rng,
             lights,
             sample_index: s,
@@ -202,6 +202,14 @@ pub(crate) fn grid_samples(
             max_depth: pixel.max_depth,
             rays: 1,
         };
+        // With depth of field, a point on the lens from the sample's stratified lens cell
+        // (the grid's cells shuffled against the pixel's, as for area lights); drawn after
+        // the pixel jitter, so that without a lens nothing changes.
+        let lens = match scene.camera.lens {
+            Some(_) => ctx.stratified_2d(SALT_LENS),
+            None => (0.5, 0.5),
+        };
+        let ray = pixel.camera_ray(scene, ox, oy, lens);
         (ray, ctx)
     };
     let mut emit = |radiance: Color, ray: &Ray, ctx: &SampleContext, rays: &mut u64| {

@@ -47,17 +47,19 @@ impl PixelContext {
         self.y as u64 * self.width as u64 + self.x as u64
     }
 
-    /// The camera ray through (`ox`, `oy`) in [0, 1)² within the pixel.
+    /// The camera ray through (`ox`, `oy`) in [0, 1)² within the pixel, leaving the lens (if
+    /// the camera has one) at the point `lens` in [0, 1)² maps to.
     #[inline]
-    pub fn camera_ray(&self, scene: &Scene, ox: f32, oy: f32) -> Ray {
+    pub fn camera_ray(&self, scene: &Scene, ox: f32, oy: f32, lens: (f32, f32)) -> Ray {
         // The lecture's j counts rows from the bottom; film row 0 is the top.
         let j = self.height - 1 - self.y;
-        scene.camera.ray(
+        scene.camera.lens_ray(
             self.x as f32 + ox,
             j as f32 + oy,
             self.width,
             self.height,
             self.aspect,
+            lens,
         )
     }
 }

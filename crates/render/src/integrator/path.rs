@@ -156,7 +156,7 @@ impl PathIntegrator {
     }
 
     /// Radiance arriving along `camera_ray` (whose direction need not be unit), with random
-    /// numbers from `sampler` (dimensions from `FIRST_PATH_DIMENSION` on; the camera's are
+    /// numbers from `sampler` (dimensions from `first_path_dimension` on; the camera's are
     /// below). Adds the rays it traces to `rays` and fills `first_hit`.
     pub fn trace<S: PathSampler>(
         &self,
@@ -181,10 +181,11 @@ impl PathIntegrator {
         let mut specular_bounce = true;
         let mut bsdf_pdf = 0.0f32;
         let mut depth = 0u32;
+        let first_dimension = first_path_dimension(scene);
         loop {
             // Each vertex draws its numbers from its own block of dimensions, so a pixel's
             // samples are stratified against each other vertex by vertex.
-            let dimension = FIRST_PATH_DIMENSION + DIMENSIONS_PER_VERTEX * depth;
+            let dimension = first_dimension + DIMENSIONS_PER_VERTEX * depth;
             *rays += 1;
             let Some(hit) = scene.intersect_preliminary(&ray) else {
                 let background = scene.background_radiance(ray.direction);
@@ -361,7 +362,11 @@ impl Integrator for PathIntegrator {
         for s in samples {
             let mut sampler = sobol.sampler(s);
             let (ox, oy) = sampler.sample_2d(0);
-            let ray = pixel.camera_ray(scene, ox, oy);
+            let lens = match scene.camera.lens {
+                Some(_) => sampler.sample_2d(LENS_DIMENSION),
+                None => (0.5, 0.5),
+            };
+            let ray = pixel.camera_ray(scene, ox, oy, lens);
             let mut first_hit = FirstHit::default();
             let radiance = self.trace(scene, &ray, &mut sampler, rays, &mut first_hit);
             sink(Sample {
@@ -373,7 +378,20 @@ impl Integrator for PathIntegrator {
 }
 
 /// Dimensions 0 and 1 place the sample in its pixel (uniformly over the pixel: a box filter,
-/// as Mitsuba's reference renders use); the path's own start here.
+/// as Mitsuba's reference renders use); the path's own start here, or after the lens's.
 pub const FIRST_PATH_DIMENSION: u32 = 2;
+/// With depth of field, dimensions 2 and 3 place the sample on the lens (stratified across the
+/// pixel's samples like the pixel position) and the path starts at 4; without, nothing
+/// changes.
+pub const LENS_DIMENSION: u32 = FIRST_PATH_DIMENSION;
+
+/// The path's first dimension: `FIRST_PATH_DIMENSION`, after the lens's with depth of field.
+#[inline]
+pub fn first_path_dimension(scene: &Scene) -> u32 {
+    match scene.camera.lens {
+        Some(_) => LENS_DIMENSION + 2,
+        None => FIRST_PATH_DIMENSION,
+    }
+}
 /// Per path vertex: light and point on it (2), lobe, direction (2), roulette.
 const DIMENSIONS_PER_VERTEX: u32 = 6;

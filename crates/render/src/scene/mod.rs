@@ -2,7 +2,11 @@
 //! it: camera, materials, textures, lights and background beside the two-level acceleration
 //! structure (`accel::instances`). `Scene::surface` completes any hit into shading data.
 
+use std::time::{Duration, Instant};
+
+use crate::accel::build::SplitMethod;
 use crate::accel::instances::{AccelKind, AccelStats, Geometry, Hit, Instances, PreliminaryHit};
+use crate::accel::wide::WalkCounts;
 use crate::accel::PACKET;
 use crate::camera::Camera;
 use crate::geometry::{Aabb, PrimitiveHit};
@@ -35,6 +39,33 @@ pub struct SceneParts {
     pub instances: Vec<Instance>,
 }
 
+/// How `Scene::with_options` builds the acceleration structures.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub struct SceneOptions {
+    /// How the bottom-level BVHs (one per geometry) choose their splits (`-s`); the top level
+    /// over instances stays binned SAH. Any method gives the same image.
+    pub split: SplitMethod,
+}
+
+/// What the bottom-level BVHs of a scene look like (`Scene::bvh_stats`): what `--stats`
+/// compares split methods by.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BvhStats {
+    pub split: SplitMethod,
+    /// Wall time of building every acceleration structure (both levels).
+    pub build_time: Duration,
+    /// Geometries with their own BVH.
+    pub trees: usize,
+    /// 8-wide inner nodes and leaves, over all the trees.
+    pub nodes: usize,
+    pub leaves: usize,
+    /// Inner nodes on the longest root-to-leaf path of the deepest tree.
+    pub depth: usize,
+    /// Expected node visits plus block (or shape) tests for a ray meeting a tree's root box,
+    /// by the surface area heuristic; averaged over the trees weighted by their primitives.
+    pub sah_cost: f64,
+}
+
 /// A scene ready to trace. Built once from `SceneParts`; immutable and shared by all threads.
 pub struct Scene {
     pub camera: Camera,
@@ -43,6 +74,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub background: Background,
     pub(crate) accel: Instances,
+    split: SplitMethod,
+    build_time: Duration,
 }
 
 /// Shading data at the closest hit.
@@ -100,12 +133,22 @@ impl AnyHit for PreliminaryHit {
 }
 
 impl Scene {
+    /// Builds the scene with the default options (SAH splits).
     pub fn new(parts: SceneParts) -> Scene {
-        Scene::with_accel(parts, AccelKind::default())
+        Scene::with_options(parts, SceneOptions::default())
+    }
+
+    /// Builds the scene as `options` say (the split method of its BVHs).
+    pub fn with_options(parts: SceneParts, options: SceneOptions) -> Scene {
+        Scene::build(parts, AccelKind::default(), options.split)
     }
 
     /// Builds with a chosen bottom-level structure (tests and benches compare them).
     pub fn with_accel(parts: SceneParts, accel: AccelKind) -> Scene {
+        Scene::build(parts, accel, SplitMethod::default())
+    }
+
+    fn build(parts: SceneParts, accel: AccelKind, split: SplitMethod) -> Scene {
         let SceneParts {
             camera,
             materials,
@@ -115,14 +158,38 @@ impl Scene {
             geometries,
             instances,
         } = parts;
+        let start = Instant::now();
+        let accel = Instances::build(geometries, instances, accel, split);
         Scene {
             camera,
             materials,
             textures,
             lights,
             background,
-            accel: Instances::build(geometries, instances, accel),
+            accel,
+            split,
+            build_time: start.elapsed(),
         }
+    }
+
+    /// The shape of the bottom-level BVHs and how long building the structures took.
+    pub fn bvh_stats(&self) -> BvhStats {
+        let trees = self.accel.tree_stats();
+        BvhStats {
+            split: self.split,
+            build_time: self.build_time,
+            trees: trees.trees,
+            nodes: trees.nodes,
+            leaves: trees.leaves,
+            depth: trees.depth,
+            sah_cost: trees.sah_cost,
+        }
+    }
+
+    /// `intersect`'s t, adding the bottom-level node and block tests of the walk to `counts`
+    /// (a separate, slower traversal: for statistics only).
+    pub(crate) fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<f32> {
+        self.accel.count_closest(ray, counts)
     }
 
     /// The two-level structure itself (benchmarks and the ray engine's tests).

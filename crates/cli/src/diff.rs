@@ -1,0 +1,615 @@
+//! `glint diff A B`: how far image B is from the reference A, in the measures a student or a
+//! CI needs, with NVIDIA's FLIP and its heat map.
+//!
+//! Every image is read twice over: as the 8-bit values a viewer shows (a PNG as stored; an EXR
+//! or HDR encoded like the path tracer's default PNG: clamp, sRGB, rounded) and as linear values
+//! (an EXR as stored; a PNG decoded by its transfer function). The measures:
+//! - 8-bit: mean absolute error and RMSE in levels of 255 over all pixels and channels, PSNR
+//!   = 20·log10(255 / RMSE);
+//! - linear: MAE and RMSE of the linear values, PSNR = 20·log10(1 / RMSE) (peak: white, 1.0);
+//! - the share of pixels where any channel differs by more than N levels (N = `--levels`, 8
+//!   by default): with the MAE, the measure of the reference-image tests
+//!   (crates/io/tests/reference_images.rs);
+//! - FLIP (Andersson et al. 2020, LDR-FLIP through the `nv-flip` crate, 67 pixels per degree):
+//!   the mean of its per-pixel error map over the 8-bit images as displayed.
+//!
+//! Exit status: 0 within every `--threshold`, 1 past one (or when the heat map cannot be
+//! written), 2 bad input (an unreadable file, images of different sizes, non-finite values).
+
+use std::fmt;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use clap::{Args, ValueEnum};
+use glint_io::{DisplayTransform, Transfer, TRANSFER_KEYWORD};
+use glint_render::Color;
+
+/// `glint diff` arguments.
+#[derive(Args, Debug)]
+#[command(after_help = DIFF_HELP)]
+pub struct DiffArgs {
+    /// The reference image (PNG, EXR or Radiance HDR; alpha is ignored).
+    #[arg(value_name = "A")]
+    pub reference: PathBuf,
+
+    /// The image compared with the reference, of the same size.
+    #[arg(value_name = "B")]
+    pub test: PathBuf,
+
+    /// Write FLIP's error map as a PNG heat map (the magma colour map: black is no error).
+    #[arg(long, value_name = "OUT.png")]
+    pub heatmap: Option<PathBuf>,
+
+    /// Exit 1 when a measure is past its limit: NAME=VALUE with NAME one of flip, mae, rmse,
+    /// over (percent), mae-linear, rmse-linear (upper limits), psnr, psnr-linear (lower
+    /// limits, dB). A bare number is FLIP's mean. Repeat it or separate with commas.
+    #[arg(long, value_name = "LIMITS", value_delimiter = ',', value_parser = parse_threshold)]
+    pub threshold: Vec<Threshold>,
+
+    /// Count the pixels off by more than N levels of 255 in any channel.
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub levels: u8,
+
+    /// How an 8-bit image's values are decoded to linear: `auto` reads the PNG's tags (Glint's
+    /// own, or an sRGB or gAMA chunk) and takes an untagged image as linear, the course's
+    /// convention (its renders apply no gamma).
+    #[arg(long, value_name = "HOW", value_enum, default_value_t = PngTransferArg::Auto)]
+    pub png_transfer: PngTransferArg,
+
+    /// Print help (`glint` turns off `-h`, which is the image height for renders).
+    #[arg(short = '?', long, action = clap::ArgAction::Help)]
+    pub help: Option<bool>,
+}
+
+const DIFF_HELP: &str = "\
+Examples:
+  glint diff reference.png mine.png
+  glint diff reference.png mine.png --threshold mae=1.5,over=2 --heatmap flip.png
+
+Exit status: 0 within every threshold, 1 past one (or the heat map cannot be written), 2 bad
+input (unreadable, different sizes).";
+
+/// `--png-transfer` values.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PngTransferArg {
+    Auto,
+    Srgb,
+    Linear,
+}
+
+/// A measure `--threshold` can limit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Measure {
+    Flip,
+    Mae,
+    Rmse,
+    Psnr,
+    Over,
+    MaeLinear,
+    RmseLinear,
+    PsnrLinear,
+}
+
+impl Measure {
+    const ALL: [(&'static str, Measure); 8] = [
+        ("flip", Measure::Flip),
+        ("mae", Measure::Mae),
+        ("rmse", Measure::Rmse),
+        ("psnr", Measure::Psnr),
+        ("over", Measure::Over),
+        ("mae-linear", Measure::MaeLinear),
+        ("rmse-linear", Measure::RmseLinear),
+        ("psnr-linear", Measure::PsnrLinear),
+    ];
+
+    fn name(self) -> &'static str {
+        Measure::ALL
+            .iter()
+            .find(|(_, measure)| *measure == self)
+            .map_or("?", |(name, _)| name)
+    }
+
+    /// PSNR is better higher: its limit is a floor.
+    fn is_floor(self) -> bool {
+        matches!(self, Measure::Psnr | Measure::PsnrLinear)
+    }
+
+    fn value(self, report: &Report) -> f64 {
+        match self {
+            Measure::Flip => report.flip_mean,
+            Measure::Mae => report.levels.mae,
+            Measure::Rmse => report.levels.rmse,
+            Measure::Psnr => report.levels.psnr(255.0),
+            Measure::Over => 100.0 * report.over_fraction(),
+            Measure::MaeLinear => report.linear.mae,
+            Measure::RmseLinear => report.linear.rmse,
+            Measure::PsnrLinear => report.linear.psnr(1.0),
+        }
+    }
+}
+
+/// One `--threshold` limit.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Threshold {
+    pub measure: Measure,
+    pub limit: f64,
+}
+
+/// Parses `NAME=VALUE` (`over=2` or `over=2%` in percent) or a bare number (FLIP's mean).
+pub fn parse_threshold(text: &str) -> Result<Threshold, String> {
+    let text = text.trim();
+    let (measure, value) = match text.split_once('=') {
+        Some((name, value)) => {
+            let name = name.trim().to_lowercase();
+            let measure = Measure::ALL
+                .iter()
+                .find(|(known, _)| *known == name)
+                .map(|(_, measure)| *measure)
+                .ok_or_else(|| {
+                    let names: Vec<&str> = Measure::ALL.iter().map(|(name, _)| *name).collect();
+                    format!("unknown measure '{name}' (one of {})", names.join(", "))
+                })?;
+            (measure, value.trim())
+        }
+        None => (Measure::Flip, text),
+    };
+    let number = if measure == Measure::Over {
+        value.strip_suffix('%').unwrap_or(value).trim()
+    } else {
+        value
+    };
+    let limit: f64 = number
+        .parse()
+        .map_err(|_| format!("'{value}' is not a number"))?;
+    if !limit.is_finite() || limit < 0.0 {
+        return Err(format!(
+            "a threshold must be a finite number >= 0, got {value}"
+        ));
+    }
+    Ok(Threshold { measure, limit })
+}
+
+/// Why `glint diff` could not compare: exit status 2.
+#[derive(Debug)]
+pub struct BadInput(pub String);
+
+impl fmt::Display for BadInput {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+/// An image read for comparison.
+#[derive(Clone, Debug)]
+pub struct DiffImage {
+    pub width: u32,
+    pub height: u32,
+    /// RGB, three per pixel, as displayed.
+    pub levels: Vec<u8>,
+    /// RGB, three per pixel, linear.
+    pub linear: Vec<f32>,
+    /// What it is and how it was read, for the report.
+    pub description: String,
+}
+
+/// Reads `path` (PNG, EXR, Radiance HDR, or anything else the `image` crate decodes).
+pub fn read_image(path: &Path, png_transfer: PngTransferArg) -> Result<DiffImage, BadInput> {
+    let fail = |why: String| BadInput(format!("cannot read {}: {why}", path.display()));
+    let reader = image::ImageReader::open(path)
+        .map_err(|error| fail(error.to_string()))?
+        .with_guessed_format()
+        .map_err(|error| fail(error.to_string()))?;
+    let format = reader.format();
+    let decoded = reader.decode().map_err(|error| fail(error.to_string()))?;
+    let (width, height) = (decoded.width(), decoded.height());
+    let format_name = format.map_or("image", |format| format.extensions_str()[0]);
+    if matches!(
+        decoded,
+        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+    ) {
+        let linear = decoded.to_rgb32f().into_raw();
+        if let Some(index) = linear.iter().position(|v| !v.is_finite()) {
+            let pixel = (index / 3) as u32;
+            return Err(fail(format!(
+                "pixel ({}, {}) from the top-left is not finite",
+                pixel % width,
+                pixel / width
+            )));
+        }
+        let colors: Vec<Color> = linear
+            .chunks_exact(3)
+            .map(|c| Color::new(c[0], c[1], c[2]))
+            .collect();
+        let levels = DisplayTransform::default().to_rgb8(&colors);
+        return Ok(DiffImage {
+            width,
+            height,
+            levels,
+            linear,
+            description: format!(
+                "{} {width}x{height}, linear float (8-bit: clamp, sRGB)",
+                format_name.to_uppercase()
+            ),
+        });
+    }
+    let levels = decoded.to_rgb8().into_raw();
+    let (transfer, why) = match png_transfer {
+        PngTransferArg::Srgb => (Transfer::Srgb, "--png-transfer"),
+        PngTransferArg::Linear => (Transfer::Linear, "--png-transfer"),
+        PngTransferArg::Auto if format == Some(image::ImageFormat::Png) => {
+            png_tagged_transfer(path)
+                .unwrap_or((Transfer::Linear, "untagged: the course's convention"))
+        }
+        PngTransferArg::Auto => (Transfer::Linear, "untagged: the course's convention"),
+    };
+    let table: Vec<f32> = (0..=255u8)
+        .map(|level| transfer.decode(f32::from(level) / 255.0))
+        .collect();
+    let linear = levels.iter().map(|&level| table[level as usize]).collect();
+    let transfer_name = match transfer {
+        Transfer::Srgb => "sRGB",
+        Transfer::Linear => "linear",
+    };
+    Ok(DiffImage {
+        width,
+        height,
+        levels,
+        linear,
+        description: format!(
+            "{} {width}x{height}, 8-bit {transfer_name} ({why})",
+            format_name.to_uppercase()
+        ),
+    })
+}
+
+/// The transfer function a PNG's chunks name: Glint's own tEXt, else an sRGB chunk, else a
+/// gAMA chunk of 1/2.2 (sRGB) or 1.0 (linear). `None` when it names none.
+fn png_tagged_transfer(path: &Path) -> Option<(Transfer, &'static str)> {
+    let file = std::fs::File::open(path).ok()?;
+    let reader = png::Decoder::new(std::io::BufReader::new(file))
+        .read_info()
+        .ok()?;
+    let info = reader.info();
+    let glint = info
+        .uncompressed_latin1_text
+        .iter()
+        .find(|chunk| chunk.keyword == TRANSFER_KEYWORD);
+    match glint.map(|chunk| chunk.text.as_str()) {
+        Some("sRGB") => return Some((Transfer::Srgb, "Glint's tag")),
+        Some("linear") => return Some((Transfer::Linear, "Glint's tag")),
+        _ => {}
+    }
+    if info.srgb.is_some() {
+        return Some((Transfer::Srgb, "sRGB chunk"));
+    }
+    let gamma = info.gama_chunk.or(info.source_gamma)?.into_value();
+    if (gamma - 1.0 / 2.2).abs() < 0.01 {
+        Some((Transfer::Srgb, "gAMA chunk"))
+    } else if (gamma - 1.0).abs() < 0.01 {
+        Some((Transfer::Linear, "gAMA chunk"))
+    } else {
+        None
+    }
+}
+
+/// Mean absolute and root-mean-square differences.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Errors {
+    pub mae: f64,
+    pub rmse: f64,
+}
+
+impl Errors {
+    fn of(pairs: impl Iterator<Item = (f64, f64)>) -> Errors {
+        let (mut absolute, mut squared, mut count) = (0.0, 0.0, 0usize);
+        for (a, b) in pairs {
+            let d = a - b;
+            absolute += d.abs();
+            squared += d * d;
+            count += 1;
+        }
+        let count = count.max(1) as f64;
+        Errors {
+            mae: absolute / count,
+            rmse: (squared / count).sqrt(),
+        }
+    }
+
+    /// 20·log10(peak / RMSE); infinite for identical images.
+    pub fn psnr(&self, peak: f64) -> f64 {
+        if self.rmse == 0.0 {
+            f64::INFINITY
+        } else {
+            20.0 * (peak / self.rmse).log10()
+        }
+    }
+}
+
+/// Every measure of one comparison.
+#[derive(Clone, Debug)]
+pub struct Report {
+    pub levels: Errors,
+    pub linear: Errors,
+    /// Pixels where some channel differs by more than `threshold_levels` levels.
+    pub pixels_over: usize,
+    pub pixels: usize,
+    pub threshold_levels: u8,
+    pub flip_mean: f64,
+}
+
+impl Report {
+    pub fn over_fraction(&self) -> f64 {
+        self.pixels_over as f64 / self.pixels.max(1) as f64
+    }
+}
+
+/// Compares `test` with `reference`, and returns FLIP's error map beside the measures.
+pub fn compare(
+    reference: &DiffImage,
+    test: &DiffImage,
+    threshold_levels: u8,
+) -> Result<(Report, nv_flip::FlipImageFloat), BadInput> {
+    if (reference.width, reference.height) != (test.width, test.height) {
+        return Err(BadInput(format!(
+            "the images differ in size: A is {}x{}, B is {}x{} (glint diff compares images of \
+             the same size)",
+            reference.width, reference.height, test.width, test.height
+        )));
+    }
+    let levels = Errors::of(
+        reference
+            .levels
+            .iter()
+            .zip(&test.levels)
+            .map(|(&a, &b)| (f64::from(a), f64::from(b))),
+    );
+    let linear = Errors::of(
+        reference
+            .linear
+            .iter()
+            .zip(&test.linear)
+            .map(|(&a, &b)| (f64::from(a), f64::from(b))),
+    );
+    let pixels_over = reference
+        .levels
+        .chunks_exact(3)
+        .zip(test.levels.chunks_exact(3))
+        .filter(|(a, b)| {
+            a.iter()
+                .zip(*b)
+                .any(|(&a, &b)| a.abs_diff(b) > threshold_levels)
+        })
+        .count();
+    let flip_image = |image: &DiffImage| {
+        nv_flip::FlipImageRgb8::with_data(image.width, image.height, &image.levels)
+    };
+    let error_map = nv_flip::flip(
+        flip_image(reference),
+        flip_image(test),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let flip_mean = f64::from(nv_flip::FlipPool::from_image(&error_map).mean());
+    let report = Report {
+        levels,
+        linear,
+        pixels_over,
+        pixels: reference.levels.len() / 3,
+        threshold_levels,
+        flip_mean,
+    };
+    Ok((report, error_map))
+}
+
+/// The report as printed: one measure family per line, numbers first after their names.
+pub fn format_report(a: &DiffImage, b: &DiffImage, report: &Report) -> String {
+    format!(
+        "A: {}\nB: {}\n\
+         8-bit:  MAE {:.4} levels  RMSE {:.4} levels  PSNR {:.2} dB\n\
+         linear: MAE {:.6}  RMSE {:.6}  PSNR {:.2} dB\n\
+         over {} levels: {:.4} % of pixels ({} of {})\n\
+         FLIP: mean {:.6} (LDR-FLIP, {} pixels per degree)\n",
+        a.description,
+        b.description,
+        report.levels.mae,
+        report.levels.rmse,
+        report.levels.psnr(255.0),
+        report.linear.mae,
+        report.linear.rmse,
+        report.linear.psnr(1.0),
+        report.threshold_levels,
+        100.0 * report.over_fraction(),
+        report.pixels_over,
+        report.pixels,
+        report.flip_mean,
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    )
+}
+
+/// The thresholds `report` is past, in words.
+pub fn failed_thresholds(report: &Report, thresholds: &[Threshold]) -> Vec<String> {
+    thresholds
+        .iter()
+        .filter_map(|threshold| {
+            let value = threshold.measure.value(report);
+            let past = if threshold.measure.is_floor() {
+                value < threshold.limit
+            } else {
+                value > threshold.limit
+            };
+            past.then(|| {
+                let relation = if threshold.measure.is_floor() {
+                    "<"
+                } else {
+                    ">"
+                };
+                let unit = if threshold.measure == Measure::Over {
+                    " %"
+                } else {
+                    ""
+                };
+                format!(
+                    "{} {value:.4}{unit} {relation} {}{unit}",
+                    threshold.measure.name(),
+                    threshold.limit
+                )
+            })
+        })
+        .collect()
+}
+
+/// Writes FLIP's error map through the magma colour map, atomically (a temporary file in the
+/// target directory, renamed).
+fn write_heatmap(path: &Path, error_map: &nv_flip::FlipImageFloat) -> Result<(), String> {
+    let colored = error_map.apply_color_lut(&nv_flip::magma_lut());
+    let image = image::RgbImage::from_raw(colored.width(), colored.height(), colored.to_vec())
+        .ok_or("the heat map's size does not match its pixels")?;
+    let directory = match path.parent() {
+        Some(parent) if !parent.as_os_str().is_empty() => parent,
+        _ => Path::new("."),
+    };
+    let mut temporary = tempfile::Builder::new()
+        .prefix(".glint-")
+        .suffix(".partial")
+        .tempfile_in(directory)
+        .map_err(|error| error.to_string())?;
+    {
+        let mut writer = std::io::BufWriter::new(temporary.as_file_mut());
+        image
+            .write_to(&mut writer, image::ImageFormat::Png)
+            .map_err(|error| error.to_string())?;
+        writer.flush().map_err(|error| error.to_string())?;
+    }
+    temporary
+        .persist(path)
+        .map_err(|error| error.error.to_string())?;
+    Ok(())
+}
+
+/// Runs `glint diff`: the report on `out`, problems on `err`; returns the exit status.
+pub fn run(args: &DiffArgs, out: &mut dyn Write, err: &mut dyn Write) -> u8 {
+    if let Some(heatmap) = &args.heatmap {
+        let is_png = heatmap
+            .extension()
+            .is_some_and(|extension| extension.eq_ignore_ascii_case("png"));
+        if !is_png {
+            let _ = writeln!(
+                err,
+                "error: the heat map is a PNG: '{}' must end in .png",
+                heatmap.display()
+            );
+            return 2;
+        }
+    }
+    let compared = read_image(&args.reference, args.png_transfer).and_then(|a| {
+        let b = read_image(&args.test, args.png_transfer)?;
+        let (report, error_map) = compare(&a, &b, args.levels)?;
+        Ok((a, b, report, error_map))
+    });
+    let (a, b, report, error_map) = match compared {
+        Ok(compared) => compared,
+        Err(BadInput(why)) => {
+            let _ = writeln!(err, "error: {why}");
+            return 2;
+        }
+    };
+    let _ = write!(out, "{}", format_report(&a, &b, &report));
+    if let Some(heatmap) = &args.heatmap {
+        if let Err(why) = write_heatmap(heatmap, &error_map) {
+            let _ = writeln!(err, "error: cannot write {}: {why}", heatmap.display());
+            return 1;
+        }
+        let _ = writeln!(out, "heat map: {}", heatmap.display());
+    }
+    let failed = failed_thresholds(&report, &args.threshold);
+    if failed.is_empty() {
+        0
+    } else {
+        let _ = writeln!(err, "past the threshold: {}", failed.join("; "));
+        1
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image(levels: Vec<u8>, width: u32) -> DiffImage {
+        let height = (levels.len() / 3) as u32 / width;
+        DiffImage {
+            width,
+            height,
+            linear: levels.iter().map(|&v| f32::from(v) / 255.0).collect(),
+            levels,
+            description: String::new(),
+        }
+    }
+
+    #[test]
+    fn thresholds_parse() {
+        assert_eq!(
+            parse_threshold("0.05").unwrap(),
+            Threshold {
+                measure: Measure::Flip,
+                limit: 0.05
+            }
+        );
+        assert_eq!(parse_threshold("over=2%").unwrap().limit, 2.0);
+        assert_eq!(
+            parse_threshold(" PSNR-linear = 30 ").unwrap().measure,
+            Measure::PsnrLinear
+        );
+        for bad in ["ssim=1", "mae=", "mae=-1", "mae=nan", "flip"] {
+            assert!(parse_threshold(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn measures_of_a_known_difference() {
+        // Four pixels; B differs from A by 10 levels in one channel of one pixel, by 2 in one
+        // channel of another.
+        let a = image(vec![100; 12], 2);
+        let mut levels = vec![100; 12];
+        levels[0] = 110;
+        levels[4] = 98;
+        let b = image(levels, 2);
+        let (report, _) = compare(&a, &b, 8).unwrap();
+        assert!((report.levels.mae - 12.0 / 12.0).abs() < 1e-12);
+        assert!((report.levels.rmse - (104.0f64 / 12.0).sqrt()).abs() < 1e-12);
+        assert_eq!((report.pixels_over, report.pixels), (1, 4));
+        let psnr = 20.0 * (255.0 / (104.0f64 / 12.0).sqrt()).log10();
+        assert!((report.levels.psnr(255.0) - psnr).abs() < 1e-9);
+        assert!((report.linear.mae - 12.0 / 12.0 / 255.0).abs() < 1e-6);
+        assert!(report.flip_mean > 0.0);
+        let (same, _) = compare(&a, &a, 8).unwrap();
+        assert_eq!(same.flip_mean, 0.0);
+        assert_eq!(same.levels.psnr(255.0), f64::INFINITY);
+    }
+
+    #[test]
+    fn thresholds_fail_past_their_limit_and_psnr_below_it() {
+        let a = image(vec![100; 12], 2);
+        let mut levels = vec![100; 12];
+        levels[0] = 110;
+        let b = image(levels, 2);
+        let (report, _) = compare(&a, &b, 8).unwrap();
+        let limits = |text: &str| -> Vec<Threshold> {
+            text.split(',')
+                .map(|t| parse_threshold(t).unwrap())
+                .collect()
+        };
+        assert!(failed_thresholds(&report, &limits("mae=1,over=25")).is_empty());
+        let failed = failed_thresholds(&report, &limits("mae=0.5,over=24,psnr=100"));
+        assert_eq!(failed.len(), 3, "{failed:?}");
+        assert!(failed[1].starts_with("over 25.0000 % > 24 %"), "{failed:?}");
+    }
+
+    #[test]
+    fn different_sizes_are_bad_input() {
+        let a = image(vec![0; 12], 2);
+        let b = image(vec![0; 12], 4);
+        let Err(error) = compare(&a, &b, 8) else {
+            panic!("different sizes compared")
+        };
+        assert!(error.0.contains("A is 2x2, B is 4x1"), "{error}");
+    }
+}

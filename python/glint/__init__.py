@@ -1,0 +1,347 @@
+"""Glint from Python: load the course's ray-tracing scenes and render them into numpy arrays.
+
+The same renderer as the ``glint`` command: for the same scene, settings and seed,
+:func:`render` returns exactly the pixels the CLI writes to an EXR file.
+
+>>> import glint, numpy as np
+>>> scene = glint.scene_from_dict(BALL)
+>>> image = glint.render(scene, width=32, height=24, spp=4)
+>>> image.shape, image.dtype
+((24, 32, 3), dtype('float32'))
+>>> bool(image[12, 16, 0] > image[12, 16, 1])  # the ball in the middle is red
+True
+>>> glint.to_srgb8(image).dtype
+dtype('uint8')
+
+Tiles of one frame can be rendered anywhere (other processes, other machines, Dask tasks) and
+put together into the same image, bit for bit:
+
+>>> full = np.zeros((24, 32, 3), np.float32)
+>>> for crop in glint.tiles(32, 24, size=16):
+...     full[crop] = glint.render(scene, width=32, height=24, spp=4, crop=crop)
+>>> np.array_equal(full, image)
+True
+
+(``BALL`` is a small scene in the course's JSON, as a dict: ``glint.BALL``.)
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import warnings
+from collections.abc import Mapping
+from typing import Callable, Union
+
+import numpy as np
+
+from glint import _glint
+from glint._glint import TILE_SIZE, Scene, SceneError, SceneWarning
+
+__all__ = [
+    "BALL",
+    "INTEGRATORS",
+    "RGB",
+    "TILE_SIZE",
+    "Scene",
+    "SceneError",
+    "SceneWarning",
+    "load_scene",
+    "load_scene_text",
+    "render",
+    "scene_from_dict",
+    "tiles",
+    "to_srgb8",
+    "write_image",
+]
+
+PathLike = Union[str, "os.PathLike[str]"]
+Crop = tuple[slice, slice]
+RGB = tuple[float, float, float]
+
+#: The integrators :func:`render` knows, as the CLI's ``--integrator`` names them.
+INTEGRATORS = ("course", "path", "normals", "albedo", "depth")
+
+#: A red ball in front of a grey background, lit by a point light: the course's JSON as a dict.
+BALL = {
+    "scene": {
+        "camera": [
+            {
+                "_name": "main",
+                "_type": "perspective",
+                "position": "0 0 3",
+                "viewDir": "0 0 -1",
+                "focalLength": 1.0,
+                "imagePlaneWidth": 1.0,
+            }
+        ],
+        "light": [{"_type": "point", "position": "2 2 3", "intensity": "1 1 1"}],
+        "shader": [{"_name": "red", "_type": "Lambertian", "diffuse": "0.8 0.1 0.1"}],
+        "shape": [
+            {
+                "_name": "ball",
+                "_type": "sphere",
+                "shader": {"_ref": "red"},
+                "center": "0 0 0",
+                "radius": 1.0,
+            }
+        ],
+        "bgColor": "0.2 0.2 0.2",
+    }
+}
+
+
+def _issue_warnings(scene: Scene) -> None:
+    # stacklevel 3: the frame that called load_scene & co., not this helper or that function.
+    for warning in scene.warnings:
+        warnings.warn(warning, stacklevel=3)
+
+
+def load_scene(path: PathLike, background: RGB | None = None) -> Scene:
+    """Loads a course scene file, XML or JSON, and builds it for rendering.
+
+    Meshes, textures and environment maps are found relative to the file's directory.
+    ``background=(r, g, b)`` replaces the scene's background, as the CLI's ``--background``
+    does (the course's reference renders used ``(0.2, 0.2, 0.2)``). What the
+    loader works around (unknown keys, missing textures...) is issued as a :class:`SceneWarning`
+    naming ``file:line:col``; a scene that cannot be loaded raises :class:`SceneError` (with
+    ``file``, ``line``, ``column`` and ``message``), a file that cannot be read ``OSError``
+    (``FileNotFoundError``...).
+
+    >>> glint.load_scene("no/such/scene.xml")
+    Traceback (most recent call last):
+    FileNotFoundError: [Errno 2] No such file or directory: 'no/such/scene.xml'
+    """
+    scene = _glint.load_scene(os.fspath(path), _rgb(background))
+    _issue_warnings(scene)
+    return scene
+
+
+def _rgb(background: RGB | None) -> RGB | None:
+    if background is None:
+        return None
+    r, g, b = (float(c) for c in background)
+    return (r, g, b)
+
+
+def _text_path(format: str, base_dir: PathLike | None, name: str | None) -> str:
+    if format not in ("json", "xml"):
+        raise ValueError(f"format must be 'json' or 'xml', not {format!r}")
+    name = name if name is not None else f"<text>.{format}"
+    return name if base_dir is None else os.path.join(os.fspath(base_dir), name)
+
+
+def load_scene_text(
+    text: str,
+    format: str = "json",
+    base_dir: PathLike | None = None,
+    name: str | None = None,
+    background: RGB | None = None,
+) -> Scene:
+    """Loads a scene from its text, in the course's JSON (``format="json"``) or XML.
+
+    Diagnostics name the text ``name`` (default ``<text>.json`` or ``<text>.xml``) inside
+    ``base_dir``, and assets are found relative to ``base_dir`` (default: the current
+    directory). ``background``, warnings and errors as for :func:`load_scene`.
+
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     scene = glint.load_scene_text('''<scene bgColor="0 0 1">
+    ...       <camera name="main" type="perspective"><position>0 0 3</position>
+    ...         <viewDir>0 0 -1</viewDir><focalLength>1</focalLength>
+    ...         <imagePlaneWidth>1</imagePlaneWidth></camera>
+    ...     </scene>''', format="xml")
+    >>> warning = caught[0].message
+    >>> type(warning).__name__, warning.file, warning.line, warning.column
+    ('SceneWarning', '<text>.xml', 1, 1)
+    >>> warning.message
+    'the scene has no shapes; the image shows only the background'
+    >>> glint.render(scene, width=2, height=2)[0, 0].tolist()  # only the blue background
+    [0.0, 0.0, 1.0]
+    >>> glint.load_scene_text('{"scene": {"camera": 7}}')
+    Traceback (most recent call last):
+    glint.SceneError: <text>.json:1:22: ...
+    """
+    first = text.lstrip("\ufeff \t\r\n")[:1]
+    if (format == "xml" and first in ("{", "[")) or (format == "json" and first == "<"):
+        raise ValueError(f"format={format!r}, but the text starts with {first!r}")
+    scene = _glint.load_scene_text(text, _text_path(format, base_dir, name), _rgb(background))
+    _issue_warnings(scene)
+    return scene
+
+
+def scene_from_dict(
+    scene: Mapping,
+    base_dir: PathLike | None = None,
+    name: str = "<dict>.json",
+    background: RGB | None = None,
+) -> Scene:
+    """Loads a scene given as the course's JSON document in Python objects (``{"scene": ...}``).
+
+    The dict is written out as indented JSON, so a diagnostic's line and column point into that
+    text, and its message shows the offending line. Diagnostics name it ``name`` inside
+    ``base_dir``; assets are found relative to ``base_dir`` (default: the current directory).
+    ``background`` as for :func:`load_scene`.
+
+    >>> bad = {"scene": {**BALL["scene"], "bgColor": "0.2 0.2"}}
+    >>> glint.scene_from_dict(bad)
+    Traceback (most recent call last):
+    glint.SceneError: <dict>.json:38:16: expected three numbers ... found `0.2 0.2`
+        "bgColor": "0.2 0.2"
+                   ^
+    """
+    text = json.dumps(scene, indent=2)
+    path = _text_path("json", base_dir, name)
+    loaded = _glint.load_scene_text(text, path, _rgb(background))
+    _issue_warnings(loaded)
+    return loaded
+
+
+def _bounds(crop: Crop, width: int, height: int) -> tuple[int, int, int, int]:
+    """``(x0, x1, y0, y1)`` of a numpy-style crop ``(rows, columns)``."""
+    if not (isinstance(crop, tuple) and len(crop) == 2 and all(isinstance(s, slice) for s in crop)):
+        raise TypeError(
+            "crop must be a pair of slices (rows, columns) such as np.s_[0:16, 32:48], "
+            f"not {crop!r}"
+        )
+    (y0, y1, y_step), (x0, x1, x_step) = crop[0].indices(height), crop[1].indices(width)
+    if x_step != 1 or y_step != 1:
+        raise ValueError(f"crop slices must have step 1, not {crop!r}")
+    if x1 <= x0 or y1 <= y0:
+        raise ValueError(f"crop {crop!r} is empty in a {width}x{height} image")
+    return (x0, x1, y0, y1)
+
+
+def render(
+    scene: Scene,
+    width: int = 100,
+    height: int = 100,
+    spp: int = 1,
+    integrator: str = "course",
+    seed: int = 0,
+    threads: int | None = None,
+    max_depth: int | None = None,
+    aspect: float | None = None,
+    crop: Crop | None = None,
+    features: bool = False,
+    progress: Callable[[float], object] | None = None,
+) -> np.ndarray | dict[str, np.ndarray]:
+    """Renders ``scene`` into a linear float32 array of shape ``(height, width, 3)``.
+
+    The arguments are the CLI's: ``spp`` samples per pixel (``-r``; the course's integrators
+    take them on an N x N grid, N = floor(sqrt(spp))), ``integrator`` one of
+    :data:`INTEGRATORS` (``--integrator``), ``seed`` (``--seed``), ``threads`` (``-n``; default
+    all cores), ``max_depth`` (``-k``; default 4 for the course, unbounded for ``path``),
+    ``aspect`` (``-a``; default width / height). The same arguments give the same pixels as the
+    CLI, on any number of threads.
+
+    ``crop`` renders only part of the image, given as numpy indexes it
+    (``np.s_[y0:y1, x0:x1]``): ``render(s, crop=c)`` equals ``render(s)[c]``, bit for bit.
+    With ``features=True`` the result is a dict: ``beauty``, ``albedo`` and ``normal``
+    (``(H, W, 3)``) and ``depth`` (``(H, W)``), the first-hit layers a denoiser takes.
+
+    Samples that come out NaN or infinite are left out of their pixels, as in the CLI, with a
+    ``RuntimeWarning`` saying how many and where the first was.
+
+    The GIL is released while rendering. Ctrl-C raises ``KeyboardInterrupt`` once the tiles
+    being rendered are done (when called from the main thread: Python delivers signals only
+    there). ``progress``, when given, is called on the calling thread with the fraction done
+    (0 to 1, ending with 1.0), at most about ten times a second; an exception it raises stops
+    the render and is raised here.
+
+    >>> scene = glint.scene_from_dict(BALL)
+    >>> layers = glint.render(scene, width=8, height=8, integrator="path", features=True)
+    >>> sorted(layers), layers["depth"].shape
+    (['albedo', 'beauty', 'depth', 'normal'], (8, 8))
+    >>> seen = []
+    >>> corner = glint.render(scene, width=8, height=8, crop=np.s_[0:4, 4:8], progress=seen.append)
+    >>> corner.shape, seen[-1]
+    ((4, 4, 3), 1.0)
+    """
+    bounds = None if crop is None else _bounds(crop, width, height)
+    return _glint.render(
+        scene,
+        width,
+        height,
+        spp,
+        integrator,
+        seed,
+        threads,
+        max_depth,
+        aspect,
+        bounds,
+        features,
+        progress,
+    )
+
+
+def tiles(width: int, height: int, size: int = 4 * TILE_SIZE) -> list[Crop]:
+    """The crops that cover a ``width`` x ``height`` image in ``size`` x ``size`` tiles, row by
+    row: pieces of one frame to render apart (see :func:`render`'s ``crop``).
+
+    >>> glint.tiles(100, 50, size=64)
+    [(slice(0, 50, None), slice(0, 64, None)), (slice(0, 50, None), slice(64, 100, None))]
+    """
+    if size < 1:
+        raise ValueError(f"the tile size must be at least 1, not {size}")
+    return [
+        (slice(y, min(y + size, height)), slice(x, min(x + size, width)))
+        for y in range(0, height, size)
+        for x in range(0, width, size)
+    ]
+
+
+def _float32(name: str, array: object, dimensions: int) -> np.ndarray:
+    array = np.ascontiguousarray(array, dtype=np.float32)
+    if array.ndim != dimensions:
+        shape = "(H, W, 3)" if dimensions == 3 else "(H, W)"
+        raise ValueError(f"{name} must have shape {shape}, not {array.shape}")
+    return array
+
+
+def write_image(path: PathLike, image: np.ndarray | Mapping[str, np.ndarray]) -> None:
+    """Writes an image as the CLI does, by the file name's extension: ``.png`` (8-bit, the
+    course's conversion: clamp, floor(c * 255), no gamma) or ``.exr`` (linear float32).
+
+    ``image`` is an ``(H, W, 3)`` array, or :func:`render`'s dict with ``features=True``,
+    whose feature layers go into the EXR as the CLI writes them (``albedo.R`` ...,
+    ``normal.R`` ..., ``depth.Y``). The file is written whole or not at all.
+
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> glint.write_image(folder / "ball.png", glint.render(glint.scene_from_dict(BALL)))
+    >>> (folder / "ball.png").read_bytes()[1:4]
+    b'PNG'
+    """
+    path = os.fspath(path)
+    if isinstance(image, Mapping):
+        layers = [(key, image.get(key)) for key in ("albedo", "normal", "depth")]
+        _glint.write_image(
+            path,
+            _float32("beauty", image["beauty"], 3),
+            *(
+                None if layer is None else _float32(key, layer, 2 if key == "depth" else 3)
+                for key, layer in layers
+            ),
+        )
+    else:
+        _glint.write_image(path, _float32("the image", image, 3))
+
+
+def to_srgb8(array: np.ndarray, exposure: float = 0.0) -> np.ndarray:
+    """Linear RGB to displayable 8-bit sRGB: scaled by 2**exposure, clamped to [0, 1], the sRGB
+    transfer curve, rounded. NaN becomes 0. For matplotlib's ``imshow`` or ``PIL.Image``.
+
+    (The course's PNGs, which :func:`write_image` writes, have no gamma; this is for looking.)
+
+    >>> glint.to_srgb8(np.array([0.0, 0.18, 1.0, 7.0], np.float32)).tolist()
+    [0, 118, 255, 255]
+    >>> glint.to_srgb8(np.array([0.09], np.float32), exposure=1).tolist()
+    [118]
+    """
+    linear = np.asarray(array, dtype=np.float32) * np.float32(2.0**exposure)
+    linear = np.nan_to_num(np.clip(linear, 0.0, 1.0), nan=0.0)
+    encoded = np.where(
+        linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1.0 / 2.4) - 0.055
+    )
+    return np.round(encoded * 255.0).astype(np.uint8)

@@ -1,0 +1,70 @@
+# Type stubs for the native module `glint._glint` (src/lib.rs). Use it through `glint`.
+
+from collections.abc import Callable
+from typing import Any, final
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "SceneError",
+    "SceneWarning",
+    "Scene",
+    "load_scene",
+    "load_scene_text",
+    "_restore",
+    "render",
+    "write_image",
+    "TILE_SIZE",
+]
+
+TILE_SIZE: int
+
+class SceneError(ValueError):
+    file: str
+    line: int
+    column: int
+    message: str
+
+class SceneWarning(UserWarning):
+    file: str
+    line: int
+    column: int
+    message: str
+
+@final
+class Scene:
+    @property
+    def name(self) -> str: ...
+    @property
+    def warnings(self) -> list[SceneWarning]: ...
+    def __reduce__(
+        self,
+    ) -> tuple[Any, tuple[str, str | None, tuple[float, float, float] | None]]: ...
+
+_RGB = tuple[float, float, float]
+
+def load_scene(path: str, background: _RGB | None = None) -> Scene: ...
+def load_scene_text(text: str, path: str, background: _RGB | None = None) -> Scene: ...
+def _restore(path: str, text: str | None = None, background: _RGB | None = None) -> Scene: ...
+def render(
+    scene: Scene,
+    width: int,
+    height: int,
+    spp: int,
+    integrator: str,
+    seed: int,
+    threads: int | None,
+    max_depth: int | None,
+    aspect: float | None,
+    bounds: tuple[int, int, int, int] | None,
+    features: bool,
+    progress: Callable[[float], object] | None,
+) -> npt.NDArray[np.float32] | dict[str, npt.NDArray[np.float32]]: ...
+def write_image(
+    path: str,
+    beauty: npt.NDArray[np.float32],
+    albedo: npt.NDArray[np.float32] | None = None,
+    normal: npt.NDArray[np.float32] | None = None,
+    depth: npt.NDArray[np.float32] | None = None,
+) -> None: ...

@@ -1,0 +1,618 @@
+//! `glint._glint`: the native half of Glint's Python module. It wraps the renderer's public API
+//! and nothing else (`glint_io::load_scene` / `load_scene_from_text`, `glint_render::Scene`,
+//! `RenderSettings`, `render`, `glint_io::write_image`); `glint/__init__.py` puts the
+//! documented, keyword-friendly functions in front of it (crop slices, feature dicts, sRGB).
+//!
+//! Threads and the GIL: loading, building the acceleration structure, rendering and writing
+//! run with the GIL released. `render` runs the renderer on a helper thread while the calling
+//! thread waits with the GIL released and wakes every `POLL` to check for signals (Python runs
+//! signal handlers only on the main thread, so the renderer's worker threads cannot) and to
+//! call the progress callable, so both happen on the caller's own thread.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
+
+use glint_io::{Diagnostic, ImageWriteError, LoadedScene};
+use glint_render::{
+    Background, Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderError,
+    RenderSettings, RenderStats, Vec3,
+};
+use numpy::ndarray::{Array2, Array3, ArrayView2, ArrayView3};
+use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
+use pyo3::exceptions::{PyOSError, PyUserWarning, PyValueError};
+use pyo3::panic::PanicException;
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+pyo3::create_exception!(
+    glint,
+    SceneError,
+    PyValueError,
+    "A scene file that cannot be loaded: a syntax error or an invalid value.\n\n\
+     ``str(error)`` is the message the ``glint`` CLI prints after ``error:`` (location, message, \
+     the offending line and a caret); the attributes ``file``, ``line``, ``column`` (1-based) \
+     and ``message`` give its parts."
+);
+
+pyo3::create_exception!(
+    glint,
+    SceneWarning,
+    PyUserWarning,
+    "Something in a scene that was ignored or replaced by a fallback; the scene still loads.\n\n\
+     Issued through :mod:`warnings` when a scene loads, and kept in ``Scene.warnings``. \
+     ``str(warning)`` is the text the ``glint`` CLI prints after ``warning:``; the attributes \
+     ``file``, ``line``, ``column`` (1-based) and ``message`` give its parts."
+);
+
+/// How often the waiting caller checks for Ctrl-C and reports progress.
+const POLL: Duration = Duration::from_millis(100);
+
+/// Largest accepted image side and path length: the CLI's limits (`crates/cli/src/args.rs`).
+/// The course integrator recurses on a worker thread's stack, so deeper paths would crash.
+const MAX_SIDE: u32 = 65_535;
+const MAX_DEPTH: u32 = 100;
+const MAX_THREADS: usize = 1024;
+
+/// Where a scene came from, so that it can be loaded again when unpickled (on a Dask worker).
+#[derive(Debug)]
+enum Source {
+    File(PathBuf),
+    Text { text: String, path: PathBuf },
+}
+
+impl Source {
+    fn load(&self) -> Result<LoadedScene, glint_io::SceneError> {
+        match self {
+            Source::File(path) => glint_io::load_scene(path),
+            Source::Text { text, path } => glint_io::load_scene_from_text(text, path),
+        }
+    }
+
+    fn name(&self) -> &Path {
+        match self {
+            Source::File(path) | Source::Text { path, .. } => path,
+        }
+    }
+
+    fn text(&self) -> Option<&str> {
+        match self {
+            Source::File(_) => None,
+            Source::Text { text, .. } => Some(text),
+        }
+    }
+}
+
+/// A loaded scene with its acceleration structure built, ready to render. Make one with
+/// ``glint.load_scene``, ``glint.load_scene_text`` or ``glint.scene_from_dict``.
+///
+/// A scene pickles as where it came from (the file's absolute path, or the text and its base
+/// directory) and is loaded again when unpickled, so the processes that unpickle it (Dask
+/// workers) need the same files.
+#[pyclass(frozen, module = "glint", name = "Scene")]
+struct PyScene {
+    scene: glint_render::Scene,
+    /// As given: names the scene in diagnostics and `repr`.
+    source: Source,
+    /// The source's path made absolute at load time, for loading again in another process.
+    absolute_path: PathBuf,
+    /// The background that replaced the scene's, if one did.
+    background: Option<[f32; 3]>,
+    warnings: Vec<Diagnostic>,
+}
+
+#[pymethods]
+impl PyScene {
+    /// The scene file's path, or the name a scene loaded from text goes by in diagnostics.
+    #[getter]
+    fn name(&self) -> String {
+        self.source.name().display().to_string()
+    }
+
+    /// The ``SceneWarning`` s met while loading (already issued through :mod:`warnings`).
+    #[getter]
+    fn warnings<'py>(&self, py: Python<'py>) -> PyResult<Vec<Bound<'py, PyAny>>> {
+        self.warnings
+            .iter()
+            .map(|warning| located_exception::<SceneWarning>(py, warning))
+            .collect()
+    }
+
+    fn __repr__(&self) -> String {
+        format!("<glint.Scene {:?}>", self.name())
+    }
+
+    fn __reduce__<'py>(&self, py: Python<'py>) -> PyResult<Reduced<'py>> {
+        let restore = py.import("glint._glint")?.getattr("_restore")?;
+        let path = path_string(&self.absolute_path)?;
+        let text = self.source.text().map(str::to_owned);
+        Ok((restore, (path, text, self.background)))
+    }
+}
+
+/// What `Scene.__reduce__` returns: `_restore` and its arguments (path, text, background).
+type Reduced<'py> = (
+    Bound<'py, PyAny>,
+    (String, Option<String>, Option<[f32; 3]>),
+);
+
+fn path_string(path: &Path) -> PyResult<String> {
+    path.to_str().map(str::to_owned).ok_or_else(|| {
+        PyValueError::new_err(format!("the path {} is not valid Unicode", path.display()))
+    })
+}
+
+/// Loads and builds a scene with the GIL released; `background` replaces the scene's (the
+/// CLI's `--background`).
+fn load(py: Python<'_>, source: Source, background: Option<[f32; 3]>) -> PyResult<PyScene> {
+    if let Some(rgb) = background {
+        if rgb.iter().any(|c| !c.is_finite() || *c < 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "background components must be finite and >= 0, not {rgb:?}"
+            )));
+        }
+    }
+    let loaded = py
+        .detach(|| source.load())
+        .map_err(|error| scene_error(py, error))?;
+    let LoadedScene {
+        mut parts,
+        warnings,
+    } = loaded;
+    if let Some([r, g, b]) = background {
+        parts.background = Background::Color(Color::new(r, g, b));
+    }
+    let scene = py.detach(|| glint_render::Scene::new(parts));
+    let absolute_path = std::path::absolute(source.name())?;
+    Ok(PyScene {
+        scene,
+        source,
+        absolute_path,
+        background,
+        warnings,
+    })
+}
+
+/// Loads the scene file at `path` (XML or JSON). Warnings are returned in `Scene.warnings`
+/// for the caller to issue.
+#[pyfunction]
+#[pyo3(signature = (path, background=None))]
+fn load_scene(py: Python<'_>, path: PathBuf, background: Option<[f32; 3]>) -> PyResult<PyScene> {
+    load(py, Source::File(path), background)
+}
+
+/// Loads a scene from its text; `path` names it in diagnostics and locates its assets.
+#[pyfunction]
+#[pyo3(signature = (text, path, background=None))]
+fn load_scene_text(
+    py: Python<'_>,
+    text: String,
+    path: PathBuf,
+    background: Option<[f32; 3]>,
+) -> PyResult<PyScene> {
+    load(py, Source::Text { text, path }, background)
+}
+
+/// Unpickles a `Scene`: loads it again from where it came from.
+#[pyfunction]
+#[pyo3(signature = (path, text=None, background=None))]
+fn _restore(
+    py: Python<'_>,
+    path: PathBuf,
+    text: Option<String>,
+    background: Option<[f32; 3]>,
+) -> PyResult<PyScene> {
+    match text {
+        None => load(py, Source::File(path), background),
+        Some(text) => load(py, Source::Text { text, path }, background),
+    }
+}
+
+/// `file:line:col: message`, then the offending line and a caret: what the CLI prints after
+/// `error: ` or `warning: ` (its `located`, crates/cli/src/run.rs).
+fn located(diagnostic: &Diagnostic) -> String {
+    let mut text = format!(
+        "{}:{}:{}: {}",
+        diagnostic.path.display(),
+        diagnostic.line,
+        diagnostic.column,
+        diagnostic.message
+    );
+    if let Some(excerpt) = diagnostic.source_excerpt() {
+        text.push('\n');
+        text.push_str(&excerpt);
+    }
+    text
+}
+
+/// A `SceneError` or `SceneWarning` instance carrying the diagnostic's parts as attributes.
+fn located_exception<'py, T: pyo3::PyTypeInfo>(
+    py: Python<'py>,
+    diagnostic: &Diagnostic,
+) -> PyResult<Bound<'py, PyAny>> {
+    let exception = py.get_type::<T>().call1((located(diagnostic),))?;
+    exception.setattr("file", diagnostic.path.display().to_string())?;
+    exception.setattr("line", diagnostic.line)?;
+    exception.setattr("column", diagnostic.column)?;
+    exception.setattr("message", diagnostic.message.as_str())?;
+    Ok(exception)
+}
+
+/// `OSError(errno, strerror, filename)`, which Python turns into `FileNotFoundError` and its
+/// siblings; an error without an errno (wrapped by a library) gets the subclass of its kind
+/// and `text` as its message, and `filename` too.
+fn os_error(py: Python<'_>, error: &std::io::Error, path: &Path, text: String) -> PyErr {
+    let filename = path.display().to_string();
+    let Some(errno) = error.raw_os_error() else {
+        let exception = PyErr::from(std::io::Error::new(error.kind(), text));
+        // Best effort: the exception is right without the attribute too.
+        let _ = exception.value(py).setattr("filename", filename);
+        return exception;
+    };
+    let strerror = py
+        .import("os")
+        .and_then(|os| os.call_method1("strerror", (errno,)))
+        .and_then(|message| message.extract::<String>())
+        .unwrap_or(text);
+    PyOSError::new_err((errno, strerror, filename))
+}
+
+fn scene_error(py: Python<'_>, error: glint_io::SceneError) -> PyErr {
+    match &error {
+        glint_io::SceneError::Io { path, source } => os_error(py, source, path, error.to_string()),
+        glint_io::SceneError::Invalid(diagnostic) => {
+            match located_exception::<SceneError>(py, diagnostic) {
+                Ok(exception) => PyErr::from_value(exception),
+                Err(failure) => failure,
+            }
+        }
+    }
+}
+
+/// One value handed from the render thread to the waiting caller.
+struct Slot<T> {
+    value: Mutex<Option<T>>,
+    ready: Condvar,
+}
+
+impl<T> Slot<T> {
+    fn new() -> Slot<T> {
+        Slot {
+            value: Mutex::new(None),
+            ready: Condvar::new(),
+        }
+    }
+
+    fn put(&self, value: T) {
+        let mut slot = self
+            .value
+            .lock()
+            .unwrap_or_else(|poison| poison.into_inner());
+        *slot = Some(value);
+        self.ready.notify_all();
+    }
+
+    /// The value, once it is there, waiting at most `timeout` (or for ever with `None`).
+    fn take(&self, timeout: Option<Duration>) -> Option<T> {
+        let mut slot = self
+            .value
+            .lock()
+            .unwrap_or_else(|poison| poison.into_inner());
+        while slot.is_none() {
+            match timeout {
+                Some(timeout) => {
+                    let (guard, wait) = self
+                        .ready
+                        .wait_timeout(slot, timeout)
+                        .unwrap_or_else(|poison| poison.into_inner());
+                    slot = guard;
+                    if wait.timed_out() {
+                        break;
+                    }
+                }
+                None => {
+                    slot = self
+                        .ready
+                        .wait(slot)
+                        .unwrap_or_else(|poison| poison.into_inner());
+                }
+            }
+        }
+        slot.take()
+    }
+}
+
+/// Renders `scene`; the keyword-friendly `glint.render` in `__init__.py` calls this. `bounds`
+/// is `(x0, x1, y0, y1)`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (scene, width, height, spp, integrator, seed, threads, max_depth, aspect, bounds, features, progress))]
+fn render<'py>(
+    py: Python<'py>,
+    scene: &Bound<'py, PyScene>,
+    width: u32,
+    height: u32,
+    spp: u32,
+    integrator: &str,
+    seed: u64,
+    threads: Option<usize>,
+    max_depth: Option<u32>,
+    aspect: Option<f32>,
+    bounds: Option<(u32, u32, u32, u32)>,
+    features: bool,
+    progress: Option<Bound<'py, PyAny>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let integrator = IntegratorKind::from_name(integrator).ok_or_else(|| {
+        let names: Vec<&str> = IntegratorKind::ALL.iter().map(|kind| kind.name()).collect();
+        PyValueError::new_err(format!(
+            "unknown integrator {integrator:?}: use one of {}",
+            names.join(", ")
+        ))
+    })?;
+    if width > MAX_SIDE || height > MAX_SIDE {
+        return Err(PyValueError::new_err(format!(
+            "the image is {width}x{height}: each side must be at most {MAX_SIDE}"
+        )));
+    }
+    if spp == 0 {
+        return Err(PyValueError::new_err("spp must be at least 1"));
+    }
+    if let Some(depth) = max_depth.filter(|&depth| depth > MAX_DEPTH) {
+        return Err(PyValueError::new_err(format!(
+            "max_depth {depth} is too deep: at most {MAX_DEPTH}"
+        )));
+    }
+    if let Some(threads) = threads.filter(|&t| t == 0 || t > MAX_THREADS) {
+        return Err(PyValueError::new_err(format!(
+            "threads must be between 1 and {MAX_THREADS}, not {threads}"
+        )));
+    }
+    let settings = RenderSettings {
+        width,
+        height,
+        samples_per_pixel: spp,
+        max_depth,
+        aspect,
+        seed,
+        integrator,
+        features,
+        pixel_bounds: bounds.map(|(x0, x1, y0, y1)| PixelBounds { x0, x1, y0, y1 }),
+        sample_range: None,
+        threads,
+    };
+    settings.validate().map_err(PyValueError::new_err)?;
+
+    let scene = &scene.get().scene;
+    let (film, stats) = render_waiting(py, scene, &settings, progress.as_ref())?;
+    if stats.nonfinite_samples > 0 {
+        warn_nonfinite(py, &stats)?;
+    }
+    film_to_python(py, film)
+}
+
+/// The CLI's warning about samples that were NaN or infinite (and left out of their pixels),
+/// as a `RuntimeWarning` pointing at the caller of `glint.render`.
+fn warn_nonfinite(py: Python<'_>, stats: &RenderStats) -> PyResult<()> {
+    let first = stats
+        .first_nonfinite_pixel
+        .map(|(x, y)| format!("; the first in pixel ({x}, {y}) from the top-left"))
+        .unwrap_or_default();
+    let count = stats.nonfinite_samples;
+    let (plural, were) = if count == 1 {
+        ("", "was")
+    } else {
+        ("s", "were")
+    };
+    let message = format!(
+        "{count} sample{plural} returned NaN or infinity and {were} left out of the image{first}"
+    );
+    let message = std::ffi::CString::new(message).expect("the message has no NUL");
+    let category = py.get_type::<pyo3::exceptions::PyRuntimeWarning>();
+    // Stack level 2: the code that called `glint.render` in `__init__.py`.
+    PyErr::warn(py, &category, &message, 2)
+}
+
+/// Runs the render on a helper thread; the caller waits without the GIL and, every `POLL`,
+/// takes it back to check for signals (a `KeyboardInterrupt` cancels the render at the end of
+/// the tiles in flight) and to report progress. An exception from either cancels the render
+/// and is raised once the render thread has stopped.
+fn render_waiting(
+    py: Python<'_>,
+    scene: &glint_render::Scene,
+    settings: &RenderSettings,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(Film, RenderStats)> {
+    let tiles_done = AtomicUsize::new(0);
+    let tiles_total = AtomicUsize::new(0);
+    let cancel = AtomicBool::new(false);
+    let on_tile = |report: &Progress| {
+        tiles_total.store(report.tiles_total, Ordering::Relaxed);
+        tiles_done.fetch_max(report.tiles_done, Ordering::Relaxed);
+        !cancel.load(Ordering::Relaxed)
+    };
+    let outcome = Slot::new();
+    std::thread::scope(|threads| {
+        let (on_tile, outcome_ref) = (&on_tile, &outcome);
+        let worker =
+            threads.spawn(move || outcome_ref.put(glint_render::render(scene, settings, on_tile)));
+        let mut reported = None;
+        let result = loop {
+            let finished = py.detach(|| outcome.take(Some(POLL)));
+            let checked = py.check_signals().and_then(|()| {
+                let Some(callback) = progress else {
+                    return Ok(());
+                };
+                let fraction = match &finished {
+                    Some(Ok(_)) => 1.0,
+                    _ => {
+                        let done = tiles_done.load(Ordering::Relaxed);
+                        done as f64 / tiles_total.load(Ordering::Relaxed).max(1) as f64
+                    }
+                };
+                if reported != Some(fraction) {
+                    reported = Some(fraction);
+                    callback.call1((fraction,))?;
+                }
+                Ok(())
+            });
+            if let Err(error) = checked {
+                // The render stops at the end of the tiles in flight and returns `Cancelled`.
+                cancel.store(true, Ordering::Relaxed);
+                break Err(error);
+            }
+            if let Some(finished) = finished {
+                break Ok(finished);
+            }
+            if worker.is_finished() {
+                // Gone without a result unless it put one just after the wait timed out.
+                match outcome.take(Some(Duration::ZERO)) {
+                    Some(finished) => break Ok(finished),
+                    None => break Err(PanicException::new_err("the render thread panicked")),
+                }
+            }
+        };
+        // Join here, so that a panic in the render thread becomes an exception rather than a
+        // panic of the scope.
+        if let Err(payload) = py.detach(|| worker.join()) {
+            let why = payload
+                .downcast_ref::<&str>()
+                .map(|text| text.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_default();
+            return Err(PanicException::new_err(format!(
+                "the renderer panicked: {why}"
+            )));
+        }
+        match result? {
+            Ok(rendered) => Ok(rendered),
+            Err(RenderError::Invalid(why)) => Err(PyValueError::new_err(why)),
+            // Only this function cancels, and then `result` is the exception that made it.
+            Err(RenderError::Cancelled) => Err(PyValueError::new_err("the render was cancelled")),
+        }
+    })
+}
+
+fn colors_to_array(colors: &[Color], width: usize, height: usize) -> Array3<f32> {
+    let flat: Vec<f32> = colors.iter().flat_map(|color| color.to_array()).collect();
+    Array3::from_shape_vec((height, width, 3), flat).expect("a film holds width x height pixels")
+}
+
+/// The beauty as an `(H, W, 3)` float32 array, or with feature layers a dict of `beauty`,
+/// `albedo`, `normal` (each `(H, W, 3)`) and `depth` (`(H, W)`).
+fn film_to_python(py: Python<'_>, film: Film) -> PyResult<Bound<'_, PyAny>> {
+    let (width, height) = (film.width as usize, film.height as usize);
+    let beauty = PyArray3::from_owned_array(py, colors_to_array(&film.pixels, width, height));
+    let Some(features) = film.features else {
+        return Ok(beauty.into_any());
+    };
+    let layers = PyDict::new(py);
+    layers.set_item("beauty", beauty)?;
+    let albedo = colors_to_array(&features.albedo, width, height);
+    layers.set_item("albedo", PyArray3::from_owned_array(py, albedo))?;
+    let normal = colors_to_array(&features.normal, width, height);
+    layers.set_item("normal", PyArray3::from_owned_array(py, normal))?;
+    let depth = Array2::from_shape_vec((height, width), features.depth)
+        .expect("a film holds width x height depths");
+    layers.set_item("depth", PyArray2::from_owned_array(py, depth))?;
+    Ok(layers.into_any())
+}
+
+fn array_to_colors(array: ArrayView3<'_, f32>) -> Vec<Color> {
+    array
+        .outer_iter()
+        .flat_map(|row| {
+            row.outer_iter()
+                .map(|pixel| Vec3::new(pixel[0], pixel[1], pixel[2]))
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+fn check_rgb(name: &str, shape: &[usize], expected: (usize, usize)) -> PyResult<()> {
+    if shape != [expected.0, expected.1, 3] {
+        return Err(PyValueError::new_err(format!(
+            "{name} must have shape ({}, {}, 3), not {shape:?}",
+            expected.0, expected.1
+        )));
+    }
+    Ok(())
+}
+
+/// Writes an image with `glint_io::write_image`: `.png` (8-bit, the course's conversion) or
+/// `.exr` (linear float32, with the feature layers when all three are given).
+#[pyfunction]
+#[pyo3(signature = (path, beauty, albedo=None, normal=None, depth=None))]
+fn write_image(
+    py: Python<'_>,
+    path: PathBuf,
+    beauty: PyReadonlyArray3<'_, f32>,
+    albedo: Option<PyReadonlyArray3<'_, f32>>,
+    normal: Option<PyReadonlyArray3<'_, f32>>,
+    depth: Option<PyReadonlyArray2<'_, f32>>,
+) -> PyResult<()> {
+    let shape = beauty.shape();
+    let (height, width) = (shape[0], shape[1]);
+    check_rgb("the image", shape, (height, width))?;
+    if width == 0 || height == 0 || width > MAX_SIDE as usize || height > MAX_SIDE as usize {
+        return Err(PyValueError::new_err(format!(
+            "the image is {width}x{height}: each side must be between 1 and {MAX_SIDE}"
+        )));
+    }
+    let features = match (albedo, normal, depth) {
+        (None, None, None) => None,
+        (Some(albedo), Some(normal), Some(depth)) => {
+            check_rgb("albedo", albedo.shape(), (height, width))?;
+            check_rgb("normal", normal.shape(), (height, width))?;
+            let depth: ArrayView2<'_, f32> = depth.as_array();
+            if depth.shape() != [height, width] {
+                return Err(PyValueError::new_err(format!(
+                    "depth must have shape ({height}, {width}), not {:?}",
+                    depth.shape()
+                )));
+            }
+            Some(Features {
+                albedo: array_to_colors(albedo.as_array()),
+                normal: array_to_colors(normal.as_array()),
+                depth: depth.iter().copied().collect(),
+            })
+        }
+        _ => {
+            return Err(PyValueError::new_err(
+                "feature layers go together: give albedo, normal and depth, or none of them",
+            ))
+        }
+    };
+    let film = Film {
+        width: width as u32,
+        height: height as u32,
+        pixels: array_to_colors(beauty.as_array()),
+        origin: (0, 0),
+        full_size: (width as u32, height as u32),
+        features,
+    };
+    let written = py.detach(|| glint_io::write_image(&path, &film));
+    written.map_err(|error| match &error {
+        ImageWriteError::UnsupportedExtension { .. } | ImageWriteError::InvalidFilm { .. } => {
+            PyValueError::new_err(error.to_string())
+        }
+        ImageWriteError::Io { path, source } => os_error(py, source, path, error.to_string()),
+        ImageWriteError::Encode { .. } => PyOSError::new_err(error.to_string()),
+    })
+}
+
+/// The native half of `glint`; import `glint` instead.
+#[pymodule]
+fn _glint(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = module.py();
+    module.add("SceneError", py.get_type::<SceneError>())?;
+    module.add("SceneWarning", py.get_type::<SceneWarning>())?;
+    module.add_class::<PyScene>()?;
+    module.add_function(wrap_pyfunction!(load_scene, module)?)?;
+    module.add_function(wrap_pyfunction!(load_scene_text, module)?)?;
+    module.add_function(wrap_pyfunction!(_restore, module)?)?;
+    module.add_function(wrap_pyfunction!(render, module)?)?;
+    module.add_function(wrap_pyfunction!(write_image, module)?)?;
+    module.add("TILE_SIZE", glint_render::TILE_SIZE)?;
+    Ok(())
+}

@@ -1,0 +1,88 @@
+#!/usr/bin/env bash
+# The one test command (README, .ci/run): installs what is missing, builds once, runs every
+# suite, and closes with one line per suite and the totals.
+#   scripts/test-all.sh              install what is missing, then test everything
+#   scripts/test-all.sh --no-install test with what is installed (a suite missing something fails
+#                                    under CI=1 and says SKIPPED otherwise)
+# Suites: the Rust workspace (`cargo test --workspace`: unit, reference-image, corpus, Mitsuba,
+# software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh), every
+# README command in a fresh clone (scripts/readme-examples.sh), and each
+# front end's own script (`ci.sh install|test`, listed in SUITES below).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$(pwd)
+
+# Suites beyond cargo, each a script with `install` and `test` subcommands.
+SUITES=(python/ci.sh crates/cli/preview-ci.sh)
+
+install=1
+if [ "${1:-}" = "--no-install" ]; then
+  install=0
+fi
+
+if ! command -v cargo >/dev/null 2>&1; then
+  if [ -x "$HOME/.cargo/bin/cargo" ]; then
+    export PATH="$HOME/.cargo/bin:$PATH"
+  elif [ "$install" = 1 ]; then
+    echo "== installing Rust (rustup, stable)"
+    curl --proto '=https' --tlsv1.2 -sSf https://sh.rustup.rs | sh -s -- -y --profile minimal
+    export PATH="$HOME/.cargo/bin:$PATH"
+  else
+    echo "error: cargo not found" >&2
+    exit 1
+  fi
+fi
+
+if [ "$install" = 1 ]; then
+  for suite in "${SUITES[@]}"; do
+    echo "== $suite install"
+    "$suite" install
+  done
+fi
+
+logs=$(mktemp -d)
+trap 'rm -rf "$logs"' EXIT
+declare -A result
+
+# Totals from the `test result:` lines cargo prints, one per test binary.
+cargo_totals() {
+  awk '/^test result:/ { for (i = 1; i <= NF; i++) { if ($i == "passed;") p += $(i-1); if ($i == "failed;") f += $(i-1) } }
+       END { printf "%d passed, %d failed", p, f }' "$1"
+}
+
+echo "== cargo test --workspace"
+status=0
+cargo test --workspace --locked 2>&1 | tee "$logs/cargo.log" || status=$?
+result[cargo]="$(cargo_totals "$logs/cargo.log")$([ "$status" = 0 ] || echo " (exit $status)")"
+failed=$status
+
+echo "== course images bit for bit (scripts/same-images.sh)"
+status=0
+scripts/same-images.sh 2>&1 | tee "$logs/same-images.log" || status=$?
+result[same-images]=$(tail -n 1 "$logs/same-images.log")
+[ "$status" = 0 ] || failed=1
+
+echo "== README examples in a fresh clone (scripts/readme-examples.sh)"
+status=0
+CARGO_TARGET_DIR="$root/target" scripts/readme-examples.sh 2>&1 | tee "$logs/readme.log" || status=$?
+result[readme]=$(tail -n 1 "$logs/readme.log")
+[ "$status" = 0 ] || failed=1
+
+for suite in "${SUITES[@]}"; do
+  echo "== $suite test"
+  status=0
+  "$root/$suite" test 2>&1 | tee "$logs/suite.log" || status=$?
+  result[$suite]="$(tail -n 1 "$logs/suite.log")$([ "$status" = 0 ] || echo " (exit $status)")"
+  [ "$status" = 0 ] || failed=1
+done
+
+echo
+echo "== summary"
+for name in cargo same-images readme "${SUITES[@]}"; do
+  printf '%-26s %s\n' "$name" "${result[$name]}"
+done
+if [ "$failed" != 0 ]; then
+  echo "FAILED" >&2
+  exit 1
+fi
+echo "all suites passed"
