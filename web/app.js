@@ -182,6 +182,7 @@ function startRender() {
     total: tiles.length,
     done: 0,
     rays: 0,
+    nonfinite: 0,
     start: performance.now(),
     firstPixel: null,
     pixels: new Float32Array(pixelCount * 3),
@@ -230,7 +231,7 @@ function onWorkerMessage(worker, data) {
   }
 }
 
-function storeTile({ tile, rgb8, pixels, albedo, normal, depth, rays }) {
+function storeTile({ tile, rgb8, pixels, albedo, normal, depth, rays, nonfinite }) {
   const { width } = render.settings;
   const tileWidth = tile.x1 - tile.x0;
   const tileHeight = tile.y1 - tile.y0;
@@ -259,6 +260,7 @@ function storeTile({ tile, rgb8, pixels, albedo, normal, depth, rays }) {
   }
   render.done += 1;
   render.rays += rays;
+  render.nonfinite += nonfinite;
 }
 
 function showProgress() {
@@ -290,7 +292,10 @@ function finishRender() {
   ui.downloadPng.disabled = false;
   ui.downloadExr.disabled = false;
   const { width, height } = render.settings;
-  setStatus('done', `rendered ${width}x${height} in ${ui.elapsed.textContent}`);
+  const dropped = render.nonfinite
+    ? `; ${render.nonfinite} samples returned NaN or infinity and were left out of the image`
+    : '';
+  setStatus('done', `rendered ${width}x${height} in ${ui.elapsed.textContent}${dropped}`);
 }
 
 function cancelRender() {

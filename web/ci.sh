@@ -12,8 +12,9 @@ bindgen_version() {
 
 install() {
     if ! command -v chromium >/dev/null 2>&1; then
-        apt-get update
-        DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends chromium
+        sudo=$([ "$(id -u)" = 0 ] || echo sudo)
+        $sudo apt-get update
+        $sudo env DEBIAN_FRONTEND=noninteractive apt-get install -y --no-install-recommends chromium
     fi
     rustup target add wasm32-unknown-unknown
     version=$(bindgen_version)

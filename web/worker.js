@@ -45,6 +45,7 @@ function renderTile({ job, tile }) {
     normal: result.normal,
     depth: result.depth,
     rays: result.rays,
+    nonfinite: result.nonfinite_samples,
   };
   result.free();
   return message;
