@@ -43,6 +43,7 @@ not_run_reason() {
     "cargo test --workspace"* | scripts/test-all.sh*) echo "the test suite itself (CI runs it)" ;;
     *"-- bench table"*) echo "a benchmark of several minutes" ;;
     bench/embree_compare.sh*) echo "needs Embree 4 (see bench/README.md)" ;;
+    *"npm run serve"*) echo "serves the page until stopped (web/ci.sh test serves and tests it)" ;;
     bench/cornell_vs_mitsuba.py*) echo "needs Mitsuba 3 (see bench/README.md)" ;;
     *) return 1 ;;
   esac
@@ -52,8 +53,9 @@ passed=0
 failed=0
 for command in "${commands[@]}"; do
   if reason=$(not_run_reason "$command"); then
-    program=${command%% *}
-    if [ "$program" = cargo ] || [ -x "$program" ]; then
+    program=${command#(}
+    program=${program%% *}
+    if [ -x "$program" ] || command -v "$program" >/dev/null; then
       echo "not run ($reason): $command"
     else
       echo "FAILED: $command: $program does not exist or is not executable"

@@ -316,13 +316,7 @@ pub fn write_image_with(
     options: &WriteOptions,
 ) -> Result<(), ImageWriteError> {
     let format = output_format(path)?;
-    let expected_pixels = film.width as usize * film.height as usize;
-    let features_fit = film.features.as_ref().is_none_or(|features| {
-        features.albedo.len() == expected_pixels
-            && features.normal.len() == expected_pixels
-            && features.depth.len() == expected_pixels
-    });
-    if film.pixels.len() != expected_pixels || expected_pixels == 0 || !features_fit {
+    if !film_is_whole(film) {
         return Err(ImageWriteError::InvalidFilm {
             path: path.to_path_buf(),
             width: film.width,
@@ -341,13 +335,11 @@ pub fn write_image_with(
     // Encoded in memory first, so the temporary file exists only for the write and rename:
     // a process killed while encoding leaves nothing behind.
     let mut encoded = std::io::Cursor::new(Vec::new());
-    match format {
-        OutputFormat::Png => encode_png(film, &options.png, &mut encoded),
-        OutputFormat::Exr => encode_exr(film, &mut encoded),
-    }
-    .map_err(|source| ImageWriteError::Encode {
-        path: path.to_path_buf(),
-        source,
+    encode_to(film, format, &options.png, &mut encoded).map_err(|source| {
+        ImageWriteError::Encode {
+            path: path.to_path_buf(),
+            source,
+        }
     })?;
     // The process id in the name tells a later run whether the writer is gone for good
     // (`remove_stale_partials`).
@@ -440,10 +432,55 @@ fn process_alive(_pid: u32) -> bool {
     true
 }
 
+/// The bytes `write_image_with` would write for `film` in `format` with `options`, held in
+/// memory: for front ends without a file system (the browser), so that their files equal the
+/// CLI's byte for byte.
+pub fn encode_image(
+    film: &Film,
+    format: OutputFormat,
+    options: &WriteOptions,
+) -> Result<Vec<u8>, EncodeError> {
+    if !film_is_whole(film) {
+        return Err(format!(
+            "the film is {} x {} but holds {} pixels",
+            film.width,
+            film.height,
+            film.pixels.len()
+        )
+        .into());
+    }
+    let mut bytes = std::io::Cursor::new(Vec::new());
+    encode_to(film, format, &options.png, &mut bytes)?;
+    Ok(bytes.into_inner())
+}
+
+/// Whether the film has pixels and as many of them (and of each feature layer) as its size says.
+fn film_is_whole(film: &Film) -> bool {
+    let expected_pixels = film.width as usize * film.height as usize;
+    let features_fit = film.features.as_ref().is_none_or(|features| {
+        features.albedo.len() == expected_pixels
+            && features.normal.len() == expected_pixels
+            && features.depth.len() == expected_pixels
+    });
+    film.pixels.len() == expected_pixels && expected_pixels != 0 && features_fit
+}
+
+fn encode_to(
+    film: &Film,
+    format: OutputFormat,
+    png: &PngEncoding,
+    writer: &mut (impl Write + std::io::Seek),
+) -> Result<(), EncodeError> {
+    match format {
+        OutputFormat::Png => encode_png(film, png, writer),
+        OutputFormat::Exr => encode_exr(film, writer),
+    }
+}
+
 fn encode_png(
     film: &Film,
     encoding: &PngEncoding,
-    writer: &mut std::io::Cursor<Vec<u8>>,
+    writer: &mut impl Write,
 ) -> Result<(), EncodeError> {
     let mut encoder = png::Encoder::new(writer, film.width, film.height);
     encoder.set_color(png::ColorType::Rgb);
@@ -476,7 +513,7 @@ pub const DEPTH_CHANNEL: &str = "Depth.Z";
 
 /// One EXR part with f32 channels R, G, B (the beauty) and the feature layers' channels, rows
 /// from the top, as the `exr` crate stores them.
-fn encode_exr(film: &Film, writer: &mut std::io::Cursor<Vec<u8>>) -> Result<(), EncodeError> {
+fn encode_exr(film: &Film, writer: &mut (impl Write + std::io::Seek)) -> Result<(), EncodeError> {
     use exr::prelude::{
         AnyChannel, AnyChannels, Encoding, FlatSamples, Image as ExrImage, Layer, LayerAttributes,
         WritableImage,
@@ -691,6 +728,28 @@ mod tests {
                 "looking along {direction:?}"
             );
         }
+    }
+
+    #[test]
+    fn encoded_bytes_are_the_written_files() {
+        let mut film = Film::new(5, 3);
+        for (index, pixel) in film.pixels.iter_mut().enumerate() {
+            *pixel = Vec3::new(index as f32 / 15.0, 0.5, 1.5 - index as f32 / 10.0);
+        }
+        let directory = tempfile::tempdir().unwrap();
+        for (format, name) in [
+            (OutputFormat::Png, "out.png"),
+            (OutputFormat::Exr, "out.exr"),
+        ] {
+            let path = directory.path().join(name);
+            write_image(&path, &film).unwrap();
+            assert_eq!(
+                encode_image(&film, format, &WriteOptions::default()).unwrap(),
+                std::fs::read(&path).unwrap()
+            );
+        }
+        film.pixels.pop();
+        assert!(encode_image(&film, OutputFormat::Png, &WriteOptions::default()).is_err());
     }
 
     #[test]

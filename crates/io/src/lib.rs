@@ -67,7 +67,7 @@ pub use display::{
     DisplayTransform, PngEncoding, ToneMap, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD,
 };
 pub use image_io::{
-    output_format, remove_stale_partials, write_image, write_image_with, EncodeError,
+    encode_image, output_format, remove_stale_partials, write_image, write_image_with, EncodeError,
     ImageWriteError, OutputFormat, WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
 };
 pub use limits::{format_bytes, Limits, BYTES_PER_TEXEL};

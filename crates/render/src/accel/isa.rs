@@ -3,8 +3,15 @@
 //! it instead of checking again, so the choice is made in one place.
 
 /// Proof that this CPU has AVX2 and FMA: only `Avx2::detect` makes one.
+#[cfg(target_arch = "x86_64")]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Avx2(());
+
+/// On other targets (wasm32, aarch64) there is no such proof: the type has no values, so the
+/// AVX2 paths of `simd.rs` are statically unreachable.
+#[cfg(not(target_arch = "x86_64"))]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Avx2 {}
 
 impl Avx2 {
     /// `Some` when the CPU runs the AVX2+FMA kernels.

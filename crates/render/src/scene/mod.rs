@@ -2,7 +2,8 @@
 //! it: camera, materials, textures, lights and background beside the two-level acceleration
 //! structure (`accel::instances`). `Scene::surface` completes any hit into shading data.
 
-use std::time::{Duration, Instant};
+// std's clock natively; in the browser std has none (`web_time` is std's re-export elsewhere).
+use web_time::{Duration, Instant};
 
 use crate::accel::build::SplitMethod;
 use crate::accel::instances::{AccelKind, AccelStats, Geometry, Hit, Instances, PreliminaryHit};

@@ -1,0 +1,366 @@
+// The page: choose or drop a scene, check it with the renderer (diagnostics as the CLI prints
+// them), render it in tiles on a pool of Web Workers, and download the image encoded by the
+// same Rust code as the CLI's.
+import init, { Files, encode, load } from './pkg/glint_wasm.js';
+
+const EXAMPLES = [
+  { name: 'Three spheres', root: 'scenes/', scene: 'three_spheres.xml', assets: [] },
+  {
+    name: 'Textured sphere and OBJ pyramid',
+    root: 'scenes/',
+    scene: 'textured/textured.xml',
+    assets: ['textured/images/checker.png', 'textured/objFiles/pyramid.obj'],
+  },
+];
+const TILE = 32;
+const SCENE_FILE = /\.(xml|json)$/i;
+
+const $ = (id) => document.getElementById(id);
+const ui = {
+  example: $('example'), dropZone: $('drop-zone'), openFiles: $('open-files'),
+  openFolder: $('open-folder'), sceneFile: $('scene-file'), sceneText: $('scene-text'),
+  assetList: $('asset-list'), diagnostics: $('diagnostics'), width: $('width'),
+  height: $('height'), spp: $('spp'), integrator: $('integrator'), maxDepth: $('max-depth'),
+  seed: $('seed'), features: $('features'), render: $('render'), cancel: $('cancel'),
+  downloadPng: $('download-png'), downloadExr: $('download-exr'), status: $('status'),
+  progress: $('progress'), tiles: $('tiles'), elapsed: $('elapsed'),
+  raysPerSecond: $('rays-per-second'), firstPixel: $('first-pixel'), workers: $('workers'),
+  canvas: $('canvas'),
+};
+
+// The files at hand, by path; the scene is one of them (or text typed into the page).
+let files = new Map();
+let scenePath = 'scene.xml';
+let pool = [];
+let render = null; // the render in progress or the last one finished
+let jobCounter = 0;
+
+const workerCount = Number(new URLSearchParams(location.search).get('workers'))
+  || navigator.hardwareConcurrency || 1;
+
+function setStatus(state, text) {
+  ui.status.dataset.state = state;
+  ui.status.textContent = text;
+}
+
+function startPool() {
+  pool = Array.from({ length: workerCount }, () => {
+    const worker = new Worker('worker.js', { type: 'module' });
+    worker.onmessage = ({ data }) => onWorkerMessage(worker, data);
+    worker.onerror = (event) => failRender(`a worker failed: ${event.message}`);
+    return worker;
+  });
+  ui.workers.textContent = String(workerCount);
+}
+
+function stopPool() {
+  for (const worker of pool) worker.terminate();
+  pool = [];
+}
+
+// ---- Choosing a scene ----
+
+function setFiles(newFiles) {
+  files = newFiles;
+  const scenes = [...files.keys()].filter((path) => SCENE_FILE.test(path)).sort(
+    (a, b) => a.split('/').length - b.split('/').length || a.localeCompare(b),
+  );
+  ui.sceneFile.replaceChildren(...scenes.map((path) => new Option(path, path)));
+  const others = [...files.keys()].filter((path) => !SCENE_FILE.test(path));
+  ui.assetList.textContent = others.length ? `assets: ${others.join(', ')}` : 'no assets';
+  if (scenes.length) {
+    showScene(scenes[0]);
+  } else {
+    ui.diagnostics.textContent = 'error: no scene file (.xml or .json) among the files given';
+  }
+}
+
+function showScene(path) {
+  scenePath = path;
+  ui.sceneFile.value = path;
+  ui.sceneText.value = new TextDecoder().decode(files.get(path));
+  checkScene();
+}
+
+async function chooseExample(index) {
+  const example = EXAMPLES[index];
+  const names = [example.scene, ...example.assets];
+  const bytes = await Promise.all(names.map(async (name) => {
+    const response = await fetch(example.root + name);
+    if (!response.ok) throw new Error(`cannot fetch ${example.root + name}: ${response.status}`);
+    return new Uint8Array(await response.arrayBuffer());
+  }));
+  setFiles(new Map(names.map((name, i) => [name, bytes[i]])));
+}
+
+// Files from a drop: folders walked with webkitGetAsEntry where the browser offers entries,
+// else the plain file list.
+async function droppedFiles(dataTransfer) {
+  const entries = [...dataTransfer.items]
+    .map((item) => item.webkitGetAsEntry?.())
+    .filter(Boolean);
+  const found = new Map();
+  if (!entries.length) {
+    for (const file of dataTransfer.files) {
+      found.set(file.name, new Uint8Array(await file.arrayBuffer()));
+    }
+    return found;
+  }
+  const walk = async (entry) => {
+    if (entry.isFile) {
+      const file = await new Promise((resolve, reject) => entry.file(resolve, reject));
+      found.set(entry.fullPath.replace(/^\//, ''), new Uint8Array(await file.arrayBuffer()));
+    } else if (entry.isDirectory) {
+      const reader = entry.createReader();
+      for (;;) {
+        const batch = await new Promise((resolve, reject) => reader.readEntries(resolve, reject));
+        if (!batch.length) break;
+        for (const child of batch) await walk(child);
+      }
+    }
+  };
+  for (const entry of entries) await walk(entry);
+  return found;
+}
+
+async function inputFiles(input) {
+  const found = new Map();
+  for (const file of input.files) {
+    found.set(file.webkitRelativePath || file.name, new Uint8Array(await file.arrayBuffer()));
+  }
+  return found;
+}
+
+// Loads the scene as the workers will, and shows its error or warnings as the CLI prints them.
+function checkScene() {
+  const assets = new Files();
+  for (const [path, bytes] of files) assets.add(path, bytes);
+  const loaded = load(ui.sceneText.value, scenePath, assets);
+  assets.free();
+  ui.diagnostics.textContent = loaded.messages.map((message) => message.text).join('\n');
+  ui.diagnostics.dataset.state = loaded.ok ? 'ok' : 'error';
+  const ok = loaded.ok;
+  loaded.free();
+  return ok;
+}
+
+// ---- Rendering ----
+
+function readSettings() {
+  const integer = (input) => Math.max(Number(input.min || 0), Math.floor(Number(input.value)));
+  return {
+    width: integer(ui.width),
+    height: integer(ui.height),
+    spp: integer(ui.spp),
+    integrator: ui.integrator.value,
+    seed: integer(ui.seed),
+    maxDepth: ui.maxDepth.value === '' ? undefined : integer(ui.maxDepth),
+    features: ui.features.checked,
+  };
+}
+
+function startRender() {
+  if (render?.running) return;
+  if (!checkScene()) {
+    setStatus('error', 'the scene has an error: see below the scene text');
+    return;
+  }
+  const settings = readSettings();
+  const { width, height } = settings;
+  const tiles = [];
+  for (let y0 = 0; y0 < height; y0 += TILE) {
+    for (let x0 = 0; x0 < width; x0 += TILE) {
+      tiles.push({ x0, y0, x1: Math.min(x0 + TILE, width), y1: Math.min(y0 + TILE, height) });
+    }
+  }
+  const pixelCount = width * height;
+  render = {
+    job: ++jobCounter,
+    running: true,
+    settings,
+    queue: tiles,
+    total: tiles.length,
+    done: 0,
+    rays: 0,
+    nonfinite: 0,
+    start: performance.now(),
+    firstPixel: null,
+    pixels: new Float32Array(pixelCount * 3),
+    albedo: settings.features ? new Float32Array(pixelCount * 3) : null,
+    normal: settings.features ? new Float32Array(pixelCount * 3) : null,
+    depth: settings.features ? new Float32Array(pixelCount) : null,
+  };
+  ui.canvas.width = width;
+  ui.canvas.height = height;
+  const context = ui.canvas.getContext('2d');
+  context.clearRect(0, 0, width, height);
+  ui.firstPixel.textContent = '–';
+  ui.render.disabled = true;
+  ui.cancel.disabled = false;
+  ui.downloadPng.disabled = true;
+  ui.downloadExr.disabled = true;
+  setStatus('rendering', 'rendering…');
+  showProgress();
+  const message = {
+    type: 'job',
+    job: render.job,
+    text: ui.sceneText.value,
+    path: scenePath,
+    files: [...files],
+    settings,
+  };
+  for (const worker of pool) worker.postMessage(message);
+  render.timer = setInterval(showProgress, 250);
+}
+
+function nextTile(worker) {
+  const tile = render.queue.shift();
+  if (tile) worker.postMessage({ type: 'tile', job: render.job, tile });
+}
+
+function onWorkerMessage(worker, data) {
+  if (!render?.running || data.job !== render.job) return;
+  if (data.type === 'ready') {
+    nextTile(worker);
+  } else if (data.type === 'tile') {
+    storeTile(data);
+    nextTile(worker);
+    if (render.done === render.total) finishRender();
+  } else if (data.type === 'failed') {
+    failRender(data.error);
+  }
+}
+
+function storeTile({ tile, rgb8, pixels, albedo, normal, depth, rays, nonfinite }) {
+  const { width } = render.settings;
+  const tileWidth = tile.x1 - tile.x0;
+  const tileHeight = tile.y1 - tile.y0;
+  const image = new ImageData(tileWidth, tileHeight);
+  for (let row = 0; row < tileHeight; row += 1) {
+    const start = ((tile.y0 + row) * width + tile.x0);
+    const from = row * tileWidth;
+    render.pixels.set(pixels.subarray(from * 3, (from + tileWidth) * 3), start * 3);
+    if (render.albedo) {
+      render.albedo.set(albedo.subarray(from * 3, (from + tileWidth) * 3), start * 3);
+      render.normal.set(normal.subarray(from * 3, (from + tileWidth) * 3), start * 3);
+      render.depth.set(depth.subarray(from, from + tileWidth), start);
+    }
+  }
+  for (let i = 0; i < tileWidth * tileHeight; i += 1) {
+    image.data[i * 4] = rgb8[i * 3];
+    image.data[i * 4 + 1] = rgb8[i * 3 + 1];
+    image.data[i * 4 + 2] = rgb8[i * 3 + 2];
+    image.data[i * 4 + 3] = 255;
+  }
+  ui.canvas.getContext('2d').putImageData(image, tile.x0, tile.y0);
+  if (render.firstPixel === null) {
+    render.firstPixel = performance.now() - render.start;
+    ui.firstPixel.textContent = `${render.firstPixel.toFixed(0)} ms`;
+    ui.firstPixel.dataset.ms = String(render.firstPixel);
+  }
+  render.done += 1;
+  render.rays += rays;
+  render.nonfinite += nonfinite;
+}
+
+function showProgress() {
+  const seconds = (performance.now() - render.start) / 1000;
+  ui.progress.value = render.done / render.total;
+  ui.tiles.textContent = `${render.done} / ${render.total}`;
+  ui.elapsed.textContent = `${seconds.toFixed(2)} s`;
+  ui.elapsed.dataset.seconds = String(seconds);
+  ui.raysPerSecond.textContent = seconds > 0 ? siUnits(render.rays / seconds) : '–';
+}
+
+function siUnits(value) {
+  if (value >= 1e9) return `${(value / 1e9).toFixed(2)} G`;
+  if (value >= 1e6) return `${(value / 1e6).toFixed(2)} M`;
+  if (value >= 1e3) return `${(value / 1e3).toFixed(1)} k`;
+  return value.toFixed(0);
+}
+
+function endRender() {
+  render.running = false;
+  clearInterval(render.timer);
+  showProgress();
+  ui.render.disabled = false;
+  ui.cancel.disabled = true;
+}
+
+function finishRender() {
+  endRender();
+  ui.downloadPng.disabled = false;
+  ui.downloadExr.disabled = false;
+  const { width, height } = render.settings;
+  const dropped = render.nonfinite
+    ? `; ${render.nonfinite} samples returned NaN or infinity and were left out of the image`
+    : '';
+  setStatus('done', `rendered ${width}x${height} in ${ui.elapsed.textContent}${dropped}`);
+}
+
+function cancelRender() {
+  if (!render?.running) return;
+  endRender();
+  stopPool();
+  startPool();
+  setStatus('cancelled', `cancelled after ${render.done} of ${render.total} tiles`);
+}
+
+function failRender(error) {
+  if (!render?.running) return;
+  endRender();
+  stopPool();
+  startPool();
+  setStatus('error', `the render failed: ${error}`);
+}
+
+function download(format) {
+  const { width, height } = render.settings;
+  const features = format === 'exr' && render.albedo;
+  const bytes = encode(
+    format, render.settings.integrator, width, height, render.pixels,
+    features ? render.albedo : undefined,
+    features ? render.normal : undefined,
+    features ? render.depth : undefined,
+  );
+  const url = URL.createObjectURL(new Blob([bytes], { type: `image/${format === 'png' ? 'png' : 'x-exr'}` }));
+  const link = document.createElement('a');
+  link.href = url;
+  link.download = `${scenePath.split('/').pop().replace(SCENE_FILE, '')}.${format}`;
+  link.click();
+  setTimeout(() => URL.revokeObjectURL(url), 10000);
+}
+
+// ---- Wiring ----
+
+async function main() {
+  await init();
+  EXAMPLES.forEach((example, index) => ui.example.add(new Option(example.name, String(index))));
+  ui.example.onchange = () => {
+    if (ui.example.value !== '') chooseExample(Number(ui.example.value)).catch((error) => {
+      ui.diagnostics.textContent = `error: ${error.message}`;
+    });
+  };
+  ui.sceneFile.onchange = () => showScene(ui.sceneFile.value);
+  ui.openFiles.onchange = async () => setFiles(await inputFiles(ui.openFiles));
+  ui.openFolder.onchange = async () => setFiles(await inputFiles(ui.openFolder));
+  ui.dropZone.ondragover = (event) => {
+    event.preventDefault();
+    ui.dropZone.classList.add('over');
+  };
+  ui.dropZone.ondragleave = () => ui.dropZone.classList.remove('over');
+  ui.dropZone.ondrop = async (event) => {
+    event.preventDefault();
+    ui.dropZone.classList.remove('over');
+    setFiles(await droppedFiles(event.dataTransfer));
+  };
+  ui.render.onclick = startRender;
+  ui.cancel.onclick = cancelRender;
+  ui.downloadPng.onclick = () => download('png');
+  ui.downloadExr.onclick = () => download('exr');
+  startPool();
+  ui.render.disabled = false;
+  setStatus('idle', 'ready');
+}
+
+main().catch((error) => setStatus('error', `cannot start the renderer: ${error}`));

@@ -1,0 +1,330 @@
+//! Glint in the browser: the page's one door into glint-io and glint-render, compiled to
+//! `wasm32-unknown-unknown` and bound to JavaScript with wasm-bindgen (`web/`).
+//!
+//! - [`Files`] holds the files a user dropped (scene assets), by path;
+//! - [`load`] reads a scene from its text with those files and returns a [`Loaded`]: the scene,
+//!   or the located diagnostics exactly as the `glint` CLI prints them;
+//! - [`Loaded::render_tile`] renders one rectangle of the image with `RenderSettings::pixel_bounds`,
+//!   so tiles rendered by separate Web Workers are the pixels of the whole render;
+//! - [`encode`] turns the assembled film into PNG or EXR bytes with glint-io's own encoder, so the
+//!   page's files equal the CLI's byte for byte.
+//!
+//! Nothing here forks the renderer: the web has no threads, so `render` runs with
+//! `threads: None`, on rayon's global pool, which rayon (rayon-core >= 1.11) builds on the
+//! current thread when threads cannot be spawned, as on `wasm32-unknown-unknown`. Parallelism
+//! comes from the page: one worker per core, each with its own `Loaded`.
+
+#![forbid(unsafe_code)]
+
+use std::path::Path;
+
+use glint_io::{
+    Diagnostic, DisplayTransform, MemoryAssets, OutputFormat, PngEncoding, SceneError, Severity,
+    WriteOptions,
+};
+use glint_render::{
+    Color, Features, Film, IntegratorKind, PixelBounds, RenderSettings, Scene, Vec3,
+};
+use wasm_bindgen::prelude::*;
+
+/// The files of a scene (meshes, textures, environment maps), by path relative to the same
+/// root as the scene's own path.
+#[wasm_bindgen]
+#[derive(Debug, Default)]
+pub struct Files(MemoryAssets);
+
+#[wasm_bindgen]
+impl Files {
+    #[wasm_bindgen(constructor)]
+    pub fn new() -> Files {
+        Files::default()
+    }
+
+    /// Adds (or replaces) the file at `path`.
+    pub fn add(&mut self, path: &str, bytes: Vec<u8>) {
+        self.0.insert(path, bytes);
+    }
+}
+
+/// One diagnostic: where it is, and `text`, the lines the CLI prints for it.
+#[wasm_bindgen(getter_with_clone)]
+#[derive(Clone, Debug, PartialEq)]
+pub struct Message {
+    /// `error` or `warning`.
+    pub severity: String,
+    pub file: String,
+    /// 1-based; 0 when the message has no place in the file.
+    pub line: u32,
+    pub column: u32,
+    pub message: String,
+    /// The offending line and a caret under the column; empty when unknown.
+    pub excerpt: String,
+    /// What `glint render` prints on stderr: `error: file:line:col: message`, then the excerpt.
+    pub text: String,
+}
+
+impl Message {
+    fn from_diagnostic(diagnostic: &Diagnostic) -> Message {
+        let severity = match diagnostic.severity {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        };
+        Message {
+            severity: severity.to_owned(),
+            file: diagnostic.path.display().to_string(),
+            line: diagnostic.line,
+            column: diagnostic.column,
+            message: diagnostic.message.clone(),
+            excerpt: diagnostic.source_excerpt().unwrap_or_default(),
+            text: format!("{severity}: {}", located(diagnostic)),
+        }
+    }
+}
+
+/// `file:line:col: message`, then the offending line and a caret: the CLI's `run::located`,
+/// which the end-to-end test holds the page to.
+fn located(diagnostic: &Diagnostic) -> String {
+    let mut text = format!(
+        "{}:{}:{}: {}",
+        diagnostic.path.display(),
+        diagnostic.line,
+        diagnostic.column,
+        diagnostic.message
+    );
+    if let Some(excerpt) = diagnostic.source_excerpt() {
+        text.push('\n');
+        text.push_str(&excerpt);
+    }
+    text
+}
+
+/// A scene loaded (or not) from its text and files.
+#[wasm_bindgen]
+pub struct Loaded {
+    scene: Option<Scene>,
+    messages: Vec<Message>,
+}
+
+/// Loads the scene `text` named `path` (which locates its assets among `files`). Never throws:
+/// a scene that cannot be loaded gives a `Loaded` that is not `ok`, with the error first in
+/// `messages`.
+#[wasm_bindgen]
+pub fn load(text: &str, path: &str, files: &Files) -> Loaded {
+    match glint_io::load_scene_with_assets(text, Path::new(path), &files.0) {
+        Ok(loaded) => {
+            let mut messages: Vec<Message> = Vec::new();
+            for warning in &loaded.warnings {
+                let message = Message::from_diagnostic(warning);
+                // The CLI shows each distinct warning once.
+                if !messages.iter().any(|shown| shown.text == message.text) {
+                    messages.push(message);
+                }
+            }
+            Loaded {
+                scene: Some(Scene::new(loaded.parts)),
+                messages,
+            }
+        }
+        Err(SceneError::Invalid(diagnostic)) => Loaded {
+            scene: None,
+            messages: vec![Message::from_diagnostic(&diagnostic)],
+        },
+        Err(error) => Loaded {
+            scene: None,
+            messages: vec![Message {
+                severity: "error".to_owned(),
+                file: path.to_owned(),
+                line: 0,
+                column: 0,
+                message: error.to_string(),
+                excerpt: String::new(),
+                text: format!("error: {error}"),
+            }],
+        },
+    }
+}
+
+/// The PNG encoding `glint render` gives `integrator` without `--exposure`, `--tonemap` or
+/// `--transfer` (the CLI's `args::png_encoding`): the course's conversion for the course
+/// integrator and the data views, the display transform's defaults for the path tracer and
+/// the albedo view.
+fn png_encoding(integrator: IntegratorKind) -> PngEncoding {
+    match integrator {
+        IntegratorKind::Path | IntegratorKind::Albedo => {
+            PngEncoding::Display(DisplayTransform::default())
+        }
+        _ => PngEncoding::Course,
+    }
+}
+
+/// How to render: the CLI's options (`-w`, `-h`, `-r`, `-k`, `--seed`, `--integrator`).
+#[wasm_bindgen]
+#[derive(Clone, Debug)]
+pub struct Settings(RenderSettings);
+
+#[wasm_bindgen]
+impl Settings {
+    /// `integrator` is `course`, `path`, `normals`, `albedo` or `depth`; `max_depth` undefined
+    /// takes the integrator's default. `features` also computes the albedo, normal and depth
+    /// layers (what the CLI's EXR holds).
+    #[wasm_bindgen(constructor)]
+    pub fn new(
+        width: u32,
+        height: u32,
+        samples_per_pixel: u32,
+        integrator: &str,
+        seed: u64,
+        max_depth: Option<u32>,
+        features: bool,
+    ) -> Result<Settings, String> {
+        let integrator = integrator_named(integrator)?;
+        let settings = RenderSettings {
+            width,
+            height,
+            samples_per_pixel,
+            max_depth,
+            seed,
+            integrator,
+            features,
+            ..RenderSettings::default()
+        };
+        settings.validate()?;
+        Ok(Settings(settings))
+    }
+
+    /// The samples each pixel takes (N² on the course's grid).
+    #[wasm_bindgen(getter)]
+    pub fn samples_per_pixel(&self) -> u32 {
+        self.0.samples_per_pixel()
+    }
+}
+
+fn integrator_named(name: &str) -> Result<IntegratorKind, String> {
+    IntegratorKind::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = IntegratorKind::ALL.iter().map(|kind| kind.name()).collect();
+        format!("unknown integrator `{name}` (one of {})", names.join(", "))
+    })
+}
+
+/// One rendered rectangle: RGB floats row-major from its top-left, the same as 8-bit RGB as
+/// the CLI's PNG holds them (for the canvas), the feature layers when asked
+/// for (albedo and normal RGB, depth one float), and the rays it took.
+#[wasm_bindgen(getter_with_clone)]
+#[derive(Clone, Debug)]
+pub struct Tile {
+    pub pixels: Vec<f32>,
+    pub rgb8: Vec<u8>,
+    pub albedo: Vec<f32>,
+    pub normal: Vec<f32>,
+    pub depth: Vec<f32>,
+    pub rays: f64,
+    pub nonfinite_samples: f64,
+}
+
+#[wasm_bindgen]
+impl Loaded {
+    /// Whether the scene loaded (warnings allowed).
+    #[wasm_bindgen(getter)]
+    pub fn ok(&self) -> bool {
+        self.scene.is_some()
+    }
+
+    /// The error (first, when not `ok`) and the warnings.
+    #[wasm_bindgen(getter)]
+    pub fn messages(&self) -> Vec<Message> {
+        self.messages.clone()
+    }
+
+    /// Renders pixels `x0..x1` by `y0..y1` of the image `settings` describe: exactly those
+    /// pixels of the whole render.
+    pub fn render_tile(
+        &self,
+        settings: &Settings,
+        x0: u32,
+        y0: u32,
+        x1: u32,
+        y1: u32,
+    ) -> Result<Tile, String> {
+        let scene = self.scene.as_ref().ok_or("the scene did not load")?;
+        let settings = RenderSettings {
+            pixel_bounds: Some(PixelBounds { x0, x1, y0, y1 }),
+            threads: None,
+            ..settings.0.clone()
+        };
+        let (film, stats) =
+            glint_render::render(scene, &settings, &|_| true).map_err(|error| error.to_string())?;
+        let rgb8 = png_encoding(settings.integrator).to_rgb8(&film);
+        let (albedo, normal, depth) = match film.features {
+            Some(features) => (
+                flatten(&features.albedo),
+                flatten(&features.normal),
+                features.depth,
+            ),
+            None => Default::default(),
+        };
+        Ok(Tile {
+            pixels: flatten(&film.pixels),
+            rgb8,
+            albedo,
+            normal,
+            depth,
+            rays: stats.rays as f64,
+            nonfinite_samples: stats.nonfinite_samples as f64,
+        })
+    }
+}
+
+fn flatten(values: &[Vec3]) -> Vec<f32> {
+    values.iter().flat_map(|value| value.to_array()).collect()
+}
+
+fn unflatten(values: &[f32]) -> Vec<Color> {
+    values
+        .chunks_exact(3)
+        .map(|rgb| Color::new(rgb[0], rgb[1], rgb[2]))
+        .collect()
+}
+
+/// The bytes of the `width` x `height` image `pixels` (RGB floats, row-major from the top-left)
+/// rendered with `integrator`, as `format` (`png` or `exr`), by glint-io's encoder: what
+/// `glint render --integrator <integrator> -o out.<format>` writes. The feature layers go into
+/// an EXR when all three are given.
+#[allow(clippy::too_many_arguments)]
+#[wasm_bindgen]
+pub fn encode(
+    format: &str,
+    integrator: &str,
+    width: u32,
+    height: u32,
+    pixels: &[f32],
+    albedo: Option<Vec<f32>>,
+    normal: Option<Vec<f32>>,
+    depth: Option<Vec<f32>>,
+) -> Result<Vec<u8>, String> {
+    let format = match format {
+        "png" => OutputFormat::Png,
+        "exr" => OutputFormat::Exr,
+        other => return Err(format!("unknown image format `{other}` (png or exr)")),
+    };
+    let integrator = integrator_named(integrator)?;
+    let features = match (albedo, normal, depth) {
+        (Some(albedo), Some(normal), Some(depth)) => Some(Features {
+            albedo: unflatten(&albedo),
+            normal: unflatten(&normal),
+            depth,
+        }),
+        _ => None,
+    };
+    let film = Film {
+        width,
+        height,
+        pixels: unflatten(pixels),
+        origin: (0, 0),
+        full_size: (width, height),
+        features,
+    };
+    let options = WriteOptions {
+        png: png_encoding(integrator),
+    };
+    glint_io::encode_image(&film, format, &options).map_err(|error| error.to_string())
+}

@@ -1,0 +1,171 @@
+//! The page's API, natively: tiles rendered one by one and encoded here give the CLI's PNG and
+//! EXR byte for byte, and a broken scene gives the CLI's located error text.
+
+use std::path::Path;
+
+use glint_render::RenderSettings;
+use glint_wasm::{encode, load, Files, Settings};
+
+const WEB: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
+
+fn example_files() -> (String, Files) {
+    let root = Path::new(WEB).join("scenes");
+    let mut files = Files::new();
+    for asset in [
+        "textured/images/checker.png",
+        "textured/objFiles/pyramid.obj",
+    ] {
+        files.add(asset, std::fs::read(root.join(asset)).unwrap());
+    }
+    let text = std::fs::read_to_string(root.join("textured/textured.xml")).unwrap();
+    (text, files)
+}
+
+#[test]
+fn tiles_assembled_and_encoded_equal_the_cli_files() {
+    let (text, files) = example_files();
+    let loaded = load(&text, "textured/textured.xml", &files);
+    assert!(loaded.ok());
+    assert!(loaded.messages().is_empty());
+    let (width, height) = (70, 45); // not a multiple of the tile size
+    let settings = Settings::new(width, height, 4, "course", 3, None, true).unwrap();
+
+    let count = (width * height) as usize;
+    let (mut pixels, mut albedo, mut normal) = (
+        vec![0.0; count * 3],
+        vec![0.0; count * 3],
+        vec![0.0; count * 3],
+    );
+    let mut depth = vec![0.0; count];
+    let mut rays = 0.0;
+    let tile = 32;
+    for y0 in (0..height).step_by(tile) {
+        for x0 in (0..width).step_by(tile) {
+            let (x1, y1) = (
+                (x0 + tile as u32).min(width),
+                (y0 + tile as u32).min(height),
+            );
+            let result = loaded.render_tile(&settings, x0, y0, x1, y1).unwrap();
+            let tile_width = (x1 - x0) as usize;
+            assert_eq!(result.rgb8.len(), result.pixels.len());
+            for row in 0..(y1 - y0) as usize {
+                let to = (y0 as usize + row) * width as usize + x0 as usize;
+                let from = row * tile_width;
+                let copy = |target: &mut Vec<f32>, source: &[f32], n: usize| {
+                    target[to * n..(to + tile_width) * n]
+                        .copy_from_slice(&source[from * n..(from + tile_width) * n]);
+                };
+                copy(&mut pixels, &result.pixels, 3);
+                copy(&mut albedo, &result.albedo, 3);
+                copy(&mut normal, &result.normal, 3);
+                copy(&mut depth, &result.depth, 1);
+            }
+            rays += result.rays;
+        }
+    }
+    assert!(rays >= f64::from(width * height * 4));
+
+    // What `glint render textured/textured.xml -w 70 -h 45 -r 4 --seed 3 -o out.png` writes.
+    let scene_path = Path::new(WEB).join("scenes/textured/textured.xml");
+    let cli_loaded = glint_io::load_scene(&scene_path).unwrap();
+    let scene = glint_render::Scene::new(cli_loaded.parts);
+    let directory = tempfile::tempdir().unwrap();
+    for (format, features) in [("png", false), ("exr", true)] {
+        let cli_settings = RenderSettings {
+            width,
+            height,
+            samples_per_pixel: 4,
+            seed: 3,
+            features,
+            ..RenderSettings::default()
+        };
+        let (film, _) = glint_render::render(&scene, &cli_settings, &|_| true).unwrap();
+        let file = directory.path().join(format!("cli.{format}"));
+        glint_io::write_image(&file, &film).unwrap();
+        let page = encode(
+            format,
+            "course",
+            width,
+            height,
+            &pixels,
+            Some(albedo.clone()),
+            Some(normal.clone()),
+            Some(depth.clone()),
+        )
+        .unwrap();
+        assert!(
+            page == std::fs::read(&file).unwrap(),
+            "the page's {format} differs from the CLI's"
+        );
+    }
+}
+
+#[test]
+fn a_path_traced_png_gets_the_cli_display_transform() {
+    let (text, files) = example_files();
+    let loaded = load(&text, "textured/textured.xml", &files);
+    let (width, height) = (24, 16);
+    let settings = Settings::new(width, height, 2, "path", 0, None, false).unwrap();
+    let tile = loaded.render_tile(&settings, 0, 0, width, height).unwrap();
+    let page = encode("png", "path", width, height, &tile.pixels, None, None, None).unwrap();
+
+    // `glint render --integrator path` writes its PNG with the display transform's defaults.
+    let scene_path = Path::new(WEB).join("scenes/textured/textured.xml");
+    let scene = glint_render::Scene::new(glint_io::load_scene(&scene_path).unwrap().parts);
+    let cli_settings = RenderSettings {
+        width,
+        height,
+        samples_per_pixel: 2,
+        integrator: glint_render::IntegratorKind::Path,
+        ..RenderSettings::default()
+    };
+    let (film, _) = glint_render::render(&scene, &cli_settings, &|_| true).unwrap();
+    let options = glint_io::WriteOptions {
+        png: glint_io::PngEncoding::Display(glint_io::DisplayTransform::default()),
+    };
+    let directory = tempfile::tempdir().unwrap();
+    let file = directory.path().join("cli.png");
+    glint_io::write_image_with(&file, &film, &options).unwrap();
+    assert!(page == std::fs::read(&file).unwrap());
+    assert_eq!(tile.rgb8, options.png.to_rgb8(&film));
+}
+
+#[test]
+fn a_broken_scene_gives_the_located_error_text() {
+    let text = "<scene>\n  <shape type=\"sphere\" name=\"s\">\n    <radius>wide</radius>\n  </shape>\n</scene>\n";
+    let loaded = load(text, "broken.xml", &Files::new());
+    assert!(!loaded.ok());
+    let messages = loaded.messages();
+    let error = &messages[0];
+    assert_eq!(error.severity, "error");
+    assert_eq!((error.file.as_str(), error.line), ("broken.xml", 3));
+    assert!(
+        error.text.starts_with(&format!(
+            "error: broken.xml:3:{}: {}\n",
+            error.column, error.message
+        )),
+        "{}",
+        error.text
+    );
+    assert!(error.text.ends_with(&error.excerpt));
+    assert!(error.excerpt.contains("<radius>wide</radius>\n"));
+    assert!(loaded
+        .render_tile(
+            &Settings::new(4, 4, 1, "course", 0, None, false).unwrap(),
+            0,
+            0,
+            4,
+            4
+        )
+        .is_err());
+}
+
+#[test]
+fn bad_settings_and_formats_are_refused() {
+    assert!(Settings::new(0, 4, 1, "course", 0, None, false).is_err());
+    assert!(Settings::new(4, 4, 1, "photon", 0, None, false)
+        .unwrap_err()
+        .contains("course, path"));
+    assert!(encode("jpg", "course", 1, 1, &[0.0; 3], None, None, None).is_err());
+    assert!(encode("png", "course", 2, 1, &[0.0; 3], None, None, None).is_err());
+}

@@ -1,0 +1,288 @@
+// End to end in a real browser: Debian's Chromium driven by playwright-core, the page served
+// from web/ on localhost. The page's canvas and PNG must equal the CLI's (`glint render`, built
+// from this repository) bit for bit; a broken scene must show the CLI's located error; a render
+// must cancel. Figures (the comparison image, a screenshot, time to first pixel) go to
+// web/test-output/.
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync, spawnSync } from 'node:child_process';
+import fs from 'node:fs';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import { chromium } from 'playwright-core';
+import { PNG } from 'pngjs';
+import { serve } from '../serve.mjs';
+
+const web = path.dirname(path.dirname(fileURLToPath(import.meta.url)));
+const repo = path.dirname(web);
+const output = path.join(web, 'test-output');
+const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
+const targetDir = process.env.CARGO_TARGET_DIR ?? path.join(repo, 'target');
+const glint = path.join(targetDir, 'release', 'glint');
+
+let server;
+let browser;
+let url;
+
+before(async () => {
+  fs.rmSync(output, { recursive: true, force: true });
+  fs.mkdirSync(output, { recursive: true });
+  execFileSync('cargo', ['build', '--release', '-p', 'glint'], { cwd: repo, stdio: 'inherit' });
+  server = await serve(0);
+  url = `http://127.0.0.1:${server.address().port}/`;
+  browser = await chromium.launch({
+    executablePath: chromiumPath,
+    headless: true,
+    args: [
+      '--no-sandbox', '--disable-gpu', '--disable-quic', '--no-first-run',
+      '--disable-background-networking', '--disable-component-update', '--disable-sync',
+    ],
+  });
+});
+
+after(async () => {
+  await browser?.close();
+  server?.close();
+});
+
+/** Runs the CLI in `cwd`; returns its exit status and stderr. */
+function runGlint(args, cwd = repo) {
+  const result = spawnSync(glint, args, { cwd, encoding: 'utf8' });
+  return { status: result.status, stderr: result.stderr };
+}
+
+async function openPage(query = '') {
+  const context = await browser.newContext({ acceptsDownloads: true, viewport: { width: 1280, height: 900 } });
+  const page = await context.newPage();
+  const errors = [];
+  page.on('pageerror', (error) => errors.push(error));
+  await page.goto(url + query);
+  await page.waitForSelector('#status[data-state="idle"]');
+  return { page, context, errors };
+}
+
+async function setSettings(page, { width, height, spp }) {
+  await page.fill('#width', String(width));
+  await page.fill('#height', String(height));
+  await page.fill('#spp', String(spp));
+}
+
+async function chooseExample(page, index) {
+  await page.selectOption('#example', String(index));
+  await page.waitForSelector('#diagnostics[data-state]');
+}
+
+async function downloadBytes(page, button) {
+  const [download] = await Promise.all([page.waitForEvent('download'), page.click(button)]);
+  return fs.readFileSync(await download.path());
+}
+
+function decodePng(bytes) {
+  return PNG.sync.read(bytes);
+}
+
+/** [CLI | canvas | |difference| x 64], side by side, as a PNG. */
+function comparisonFigure(cli, canvas, width, height) {
+  const figure = new PNG({ width: width * 3, height });
+  let largest = 0;
+  let differing = 0;
+  for (let y = 0; y < height; y += 1) {
+    for (let x = 0; x < width; x += 1) {
+      const from = (y * width + x) * 4;
+      let pixelDiffers = false;
+      for (let c = 0; c < 3; c += 1) {
+        const a = cli[from + c];
+        const b = canvas[from + c];
+        const difference = Math.abs(a - b);
+        largest = Math.max(largest, difference);
+        pixelDiffers ||= difference > 0;
+        const row = (y * width * 3 + x) * 4;
+        figure.data[row + c] = a;
+        figure.data[row + width * 4 + c] = b;
+        figure.data[row + width * 8 + c] = Math.min(255, difference * 64);
+      }
+      if (pixelDiffers) differing += 1;
+      for (let panel = 0; panel < 3; panel += 1) {
+        figure.data[(y * width * 3 + x) * 4 + panel * width * 4 + 3] = 255;
+      }
+    }
+  }
+  return { figure: PNG.sync.write(figure), largest, differing };
+}
+
+test('the page renders the example scene with its assets exactly as the CLI', async () => {
+  const settings = { width: 200, height: 150, spp: 4 };
+  const scene = path.join(web, 'scenes', 'textured', 'textured.xml');
+  const cliPng = path.join(output, 'cli.png');
+  const cliExr = path.join(output, 'cli.exr');
+  for (const file of [cliPng, cliExr]) {
+    const run = runGlint(['render', scene, '-o', file, '-w', String(settings.width),
+      '-h', String(settings.height), '-r', String(settings.spp)]);
+    assert.equal(run.status, 0, run.stderr);
+  }
+
+  const { page, context, errors } = await openPage();
+  await chooseExample(page, 1);
+  assert.equal(await page.getAttribute('#diagnostics', 'data-state'), 'ok');
+  assert.equal(await page.textContent('#diagnostics'), '');
+  await setSettings(page, settings);
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 120_000 });
+  const firstPixelMs = Number(await page.getAttribute('#first-pixel', 'data-ms'));
+  const seconds = Number(await page.getAttribute('#elapsed', 'data-seconds'));
+  const workers = await page.textContent('#workers');
+
+  // The canvas, pixel for pixel, against the CLI's PNG.
+  const canvas = await page.evaluate(() => {
+    const element = document.getElementById('canvas');
+    const { data } = element.getContext('2d').getImageData(0, 0, element.width, element.height);
+    return Array.from(data);
+  });
+  const cli = decodePng(fs.readFileSync(cliPng));
+  assert.equal(cli.width, settings.width);
+  assert.equal(canvas.length, cli.data.length);
+  const { figure, largest, differing } = comparisonFigure(cli.data, canvas, settings.width, settings.height);
+  fs.writeFileSync(path.join(output, 'web-vs-cli.png'), figure);
+  await page.screenshot({ path: path.join(output, 'web.png') });
+  console.log(`# canvas vs CLI: largest difference ${largest}/255, ${differing} pixels differ; `
+    + `${workers} workers, ${seconds.toFixed(2)} s, first pixel after ${firstPixelMs.toFixed(0)} ms`);
+  fs.writeFileSync(path.join(output, 'figures.json'), JSON.stringify({
+    largestDifference: largest, differingPixels: differing, workers: Number(workers),
+    renderSeconds: seconds, firstPixelMs,
+  }, null, 2));
+  assert.equal(largest, 0, `${differing} pixels differ from the CLI's`);
+
+  // The downloaded files are the CLI's, byte for byte.
+  const png = await downloadBytes(page, '#download-png');
+  fs.writeFileSync(path.join(output, 'page.png'), png);
+  assert.ok(png.equals(fs.readFileSync(cliPng)), 'the downloaded PNG differs from the CLI\'s');
+  // The EXR holds the floats themselves, which differ from native ones in the last bits where
+  // wasm's libm (sin, pow, atan2...) and scalar traversal round differently from glibc's and
+  // the AVX2 kernels: same encoder (tested natively in glint-wasm/tests/page_api.rs), same
+  // layout, not always the same bytes. Here: an EXR of the same channels and about the same size.
+  const exr = await downloadBytes(page, '#download-exr');
+  fs.writeFileSync(path.join(output, 'page.exr'), exr);
+  const cliExrBytes = fs.readFileSync(cliExr);
+  assert.equal(exr.readUInt32LE(0), 20000630, 'not an OpenEXR file');
+  for (const channel of ['Denoising Albedo.R', 'Denoising Normal.X', 'Depth.Z', 'R\0']) {
+    assert.ok(exr.includes(channel), `no channel ${channel}`);
+  }
+  assert.ok(Math.abs(exr.length - cliExrBytes.length) < cliExrBytes.length / 100);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('the path tracer\'s PNG on the page is the CLI\'s, display transform included', async () => {
+  const settings = { width: 64, height: 48, spp: 4 };
+  const cliPng = path.join(output, 'cli-path.png');
+  const run = runGlint(['render', path.join(web, 'scenes', 'three_spheres.xml'), '-o', cliPng,
+    '--integrator', 'path', '-w', String(settings.width), '-h', String(settings.height),
+    '-r', String(settings.spp)]);
+  assert.equal(run.status, 0, run.stderr);
+
+  const { page, context, errors } = await openPage();
+  await chooseExample(page, 0);
+  await setSettings(page, settings);
+  await page.selectOption('#integrator', 'path');
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 120_000 });
+  const png = await downloadBytes(page, '#download-png');
+  fs.writeFileSync(path.join(output, 'page-path.png'), png);
+  const cli = decodePng(fs.readFileSync(cliPng));
+  const ours = decodePng(png);
+  let largest = 0;
+  let differing = 0;
+  for (let i = 0; i < cli.data.length; i += 1) {
+    const difference = Math.abs(cli.data[i] - ours.data[i]);
+    largest = Math.max(largest, difference);
+    if (difference) differing += 1;
+  }
+  console.log(`# path tracer, page PNG vs CLI PNG: largest difference ${largest}/255 in ${differing} channels`
+    + `; bytes ${png.equals(fs.readFileSync(cliPng)) ? 'equal' : 'differ'}`);
+  // The same encoder and transform; wasm's libm may round a float differently in the last bit,
+  // which can move an 8-bit value by one level and no more.
+  assert.ok(largest <= 1, `largest difference ${largest}/255`);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('a dropped broken scene shows the CLI\'s located error under the text', async () => {
+  const folder = path.join(output, 'broken');
+  fs.mkdirSync(folder, { recursive: true });
+  const good = fs.readFileSync(path.join(web, 'scenes', 'three_spheres.xml'), 'utf8');
+  const broken = good.replace('<radius>0.8</radius>', '<radius>0.8 wide</radius>');
+  assert.notEqual(broken, good);
+  fs.writeFileSync(path.join(folder, 'broken.xml'), broken);
+  const cli = runGlint(['render', 'broken.xml', '-o', 'broken.png', '-w', '8', '-h', '8'], folder);
+  assert.equal(cli.status, 2);
+  const expected = cli.stderr.trimEnd();
+  assert.match(expected, /^error: broken\.xml:\d+:\d+: /);
+
+  const { page, context, errors } = await openPage();
+  await page.evaluate((text) => {
+    const transfer = new DataTransfer();
+    transfer.items.add(new File([text], 'broken.xml', { type: 'text/xml' }));
+    const zone = document.getElementById('drop-zone');
+    zone.dispatchEvent(new DragEvent('drop', { dataTransfer: transfer, bubbles: true, cancelable: true }));
+  }, broken);
+  await page.waitForSelector('#diagnostics[data-state="error"]');
+  assert.equal(await page.textContent('#diagnostics'), expected);
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="error"]');
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('a scene opened without its assets names each missing file, as the CLI does', async () => {
+  const folder = path.join(output, 'missing');
+  fs.mkdirSync(folder, { recursive: true });
+  fs.copyFileSync(path.join(web, 'scenes', 'textured', 'textured.xml'), path.join(folder, 'textured.xml'));
+  const cli = runGlint(['render', 'textured.xml', '-o', 'out.png', '-w', '8', '-h', '8'], folder);
+  assert.equal(cli.status, 0, cli.stderr);
+  const expected = cli.stderr.split('\n').filter((line) => !line.startsWith('rendered ')).join('\n').trimEnd();
+  assert.match(expected, /objFiles\/pyramid\.obj/);
+  assert.match(expected, /images\/checker\.png/);
+
+  const { page, context, errors } = await openPage();
+  await page.setInputFiles('#open-files', path.join(folder, 'textured.xml'));
+  await page.waitForSelector('#diagnostics[data-state="ok"]');
+  // The same text, but for the cause: the CLI's operating system has no such file, the page has
+  // not been given one.
+  const cause = 'No such file or directory (os error 2)';
+  assert.ok(expected.includes(cause));
+  assert.equal(
+    await page.textContent('#diagnostics'),
+    expected.replaceAll(cause, 'no such file among the files given'),
+  );
+
+  // The same scene opened as a folder finds its assets: no warnings.
+  await page.setInputFiles('#open-folder', path.join(web, 'scenes', 'textured'));
+  await page.waitForFunction(() => document.getElementById('scene-file').value === 'textured/textured.xml');
+  assert.equal(await page.textContent('#diagnostics'), '');
+  assert.match(await page.textContent('#asset-list'), /textured\/objFiles\/pyramid\.obj/);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('Cancel stops a render, and the next render runs', async () => {
+  const { page, context, errors } = await openPage();
+  await chooseExample(page, 0);
+  await setSettings(page, { width: 1200, height: 900, spp: 64 });
+  await page.click('#render');
+  await page.waitForSelector('#first-pixel[data-ms]', { timeout: 60_000 });
+  await page.click('#cancel');
+  await page.waitForSelector('#status[data-state="cancelled"]');
+  const tiles = await page.textContent('#tiles');
+  const [done, total] = tiles.split(' / ').map(Number);
+  assert.ok(done >= 1 && done < total, tiles);
+  await page.waitForTimeout(1500);
+  assert.equal(await page.textContent('#tiles'), tiles, 'tiles kept arriving after Cancel');
+  assert.ok(await page.isDisabled('#download-png'));
+
+  await setSettings(page, { width: 64, height: 48, spp: 1 });
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 60_000 });
+  assert.equal(await page.textContent('#tiles'), '4 / 4');
+  assert.deepEqual(errors, []);
+  await context.close();
+});

@@ -1,0 +1,66 @@
+// One render worker: loads the scene into its own copy of the renderer, then renders the tiles
+// the page hands it, one at a time, until the page terminates it.
+import init, { Files, Settings, load } from './pkg/glint_wasm.js';
+
+const ready = init();
+let current = null; // { job, loaded, settings }
+
+function release() {
+  if (current) {
+    current.loaded.free();
+    current.settings.free();
+    current = null;
+  }
+}
+
+function startJob({ job, text, path, files, settings }) {
+  release();
+  const assets = new Files();
+  for (const [name, bytes] of files) assets.add(name, bytes);
+  const loaded = load(text, path, assets);
+  assets.free();
+  if (!loaded.ok) {
+    const error = loaded.messages[0]?.text ?? 'the scene did not load';
+    loaded.free();
+    return { type: 'failed', job, error };
+  }
+  const s = settings;
+  const renderSettings = new Settings(
+    s.width, s.height, s.spp, s.integrator, BigInt(s.seed), s.maxDepth, s.features,
+  );
+  current = { job, loaded, settings: renderSettings };
+  return { type: 'ready', job };
+}
+
+function renderTile({ job, tile }) {
+  if (!current || current.job !== job) return { type: 'failed', job, error: 'no scene loaded' };
+  const result = current.loaded.render_tile(current.settings, tile.x0, tile.y0, tile.x1, tile.y1);
+  const message = {
+    type: 'tile',
+    job,
+    tile,
+    rgb8: result.rgb8,
+    pixels: result.pixels,
+    albedo: result.albedo,
+    normal: result.normal,
+    depth: result.depth,
+    rays: result.rays,
+    nonfinite: result.nonfinite_samples,
+  };
+  result.free();
+  return message;
+}
+
+self.onmessage = async ({ data }) => {
+  await ready;
+  let reply;
+  try {
+    reply = data.type === 'job' ? startJob(data) : renderTile(data);
+  } catch (error) {
+    reply = { type: 'failed', job: data.job, error: String(error) };
+  }
+  const transfer = reply.type === 'tile'
+    ? [reply.rgb8, reply.pixels, reply.albedo, reply.normal, reply.depth].map((a) => a.buffer)
+    : [];
+  self.postMessage(reply, transfer);
+};
