@@ -614,9 +614,8 @@ pub fn png_encoding(
     tonemap: Option<ToneMapArg>,
     transfer: Option<TransferArg>,
 ) -> PngEncoding {
-    let display_by_default = matches!(integrator, IntegratorArg::Path | IntegratorArg::Albedo);
-    if !display_by_default && exposure.is_none() && tonemap.is_none() && transfer.is_none() {
-        return PngEncoding::Course;
+    if exposure.is_none() && tonemap.is_none() && transfer.is_none() {
+        return PngEncoding::default_for(integrator.into());
     }
     let defaults = DisplayTransform::default();
     PngEncoding::Display(DisplayTransform {

@@ -3,7 +3,7 @@
 //!
 //! EXR output never goes through this: it keeps the film's linear values as they are.
 
-use glint_render::{Color, Film};
+use glint_render::{Color, Film, IntegratorKind};
 
 /// How `write_image_with` turns linear values into a PNG's 8-bit values.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -16,6 +16,23 @@ pub enum PngEncoding {
     /// For viewing on a display: exposure, a tone curve, then a transfer function, rounded to
     /// the nearest 8-bit level.
     Display(DisplayTransform),
+}
+
+impl PngEncoding {
+    /// Each integrator's PNG when the user asks for nothing else, the one rule every front end
+    /// follows: the course integrator and the data views (`normals`, `depth`) keep the course's
+    /// conversion, which the instructor's references depend on; the path tracer and the
+    /// `albedo` view get the default display transform (clamp, sRGB), as pbrt and Mitsuba write.
+    pub fn default_for(integrator: IntegratorKind) -> PngEncoding {
+        match integrator {
+            IntegratorKind::Path | IntegratorKind::Albedo => {
+                PngEncoding::Display(DisplayTransform::default())
+            }
+            IntegratorKind::Course | IntegratorKind::Normals | IntegratorKind::Depth => {
+                PngEncoding::Course
+            }
+        }
+    }
 }
 
 /// Exposure, tone curve and transfer function, applied in that order.

@@ -19,8 +19,7 @@
 use std::path::Path;
 
 use glint_io::{
-    Diagnostic, DisplayTransform, MemoryAssets, OutputFormat, PngEncoding, SceneError, Severity,
-    WriteOptions,
+    Diagnostic, MemoryAssets, OutputFormat, PngEncoding, SceneError, Severity, WriteOptions,
 };
 use glint_render::{
     Color, Features, Film, IntegratorKind, PixelBounds, RenderSettings, Scene, Vec3,
@@ -144,19 +143,6 @@ pub fn load(text: &str, path: &str, files: &Files) -> Loaded {
     }
 }
 
-/// The PNG encoding `glint render` gives `integrator` without `--exposure`, `--tonemap` or
-/// `--transfer` (the CLI's `args::png_encoding`): the course's conversion for the course
-/// integrator and the data views, the display transform's defaults for the path tracer and
-/// the albedo view.
-fn png_encoding(integrator: IntegratorKind) -> PngEncoding {
-    match integrator {
-        IntegratorKind::Path | IntegratorKind::Albedo => {
-            PngEncoding::Display(DisplayTransform::default())
-        }
-        _ => PngEncoding::Course,
-    }
-}
-
 /// How to render: the CLI's options (`-w`, `-h`, `-r`, `-k`, `--seed`, `--integrator`).
 #[wasm_bindgen]
 #[derive(Clone, Debug)]
@@ -253,7 +239,7 @@ impl Loaded {
         };
         let (film, stats) =
             glint_render::render(scene, &settings, &|_| true).map_err(|error| error.to_string())?;
-        let rgb8 = png_encoding(settings.integrator).to_rgb8(&film);
+        let rgb8 = PngEncoding::default_for(settings.integrator).to_rgb8(&film);
         let (albedo, normal, depth) = match film.features {
             Some(features) => (
                 flatten(&features.albedo),
@@ -324,7 +310,7 @@ pub fn encode(
         features,
     };
     let options = WriteOptions {
-        png: png_encoding(integrator),
+        png: PngEncoding::default_for(integrator),
     };
     glint_io::encode_image(&film, format, &options).map_err(|error| error.to_string())
 }
