@@ -7,6 +7,10 @@
 
 mod args;
 mod bench;
+mod checkpoint;
+mod farm;
+mod merge;
+mod report;
 mod run;
 
 use std::io::IsTerminal;
@@ -32,6 +36,15 @@ fn main() -> ExitCode {
                 eprintln!("error: {message}");
                 ExitCode::FAILURE
             }
+        };
+    }
+    if matches!(cli.command, Some(crate::args::Command::Merge(_))) {
+        let Some(crate::args::Command::Merge(args)) = cli.command.take() else {
+            unreachable!("matched just above");
+        };
+        return match merge::run(&args, &mut std::io::stderr()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(failure) => fail(&failure),
         };
     }
     let available = std::thread::available_parallelism().map_or(1, |n| n.get());

@@ -174,6 +174,20 @@ pub fn output_format(path: &Path) -> Result<OutputFormat, ImageWriteError> {
 /// feature layers, when it has them, as channels `albedo.R/G/B`, `normal.R/G/B` (what
 /// denoisers take) and `depth.Y`. A PNG holds the beauty alone.
 pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
+    write_image_with_metadata(path, film, &[])
+}
+
+/// `write_image`, with `metadata` (key, value pairs, in order) in the file: PNG `tEXt` chunks,
+/// EXR string attributes in the header. The EXR's display window is the whole image
+/// (`Film::full_size`) and its data window the film's rectangle (`Film::origin`, width x
+/// height), so a crop or farm tile keeps its place; a film with `Film::sums` (a sample range)
+/// also gets channels `sum.R/G/B` (f32) and `count` (u32). Keys must be 1 to 79 printable
+/// Latin-1 characters (PNG's rule), values Latin-1 text.
+pub fn write_image_with_metadata(
+    path: &Path,
+    film: &Film,
+    metadata: &[(String, String)],
+) -> Result<(), ImageWriteError> {
     let format = output_format(path)?;
     let expected_pixels = film.width as usize * film.height as usize;
     let features_fit = film.features.as_ref().is_none_or(|features| {
@@ -181,7 +195,18 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
             && features.normal.len() == expected_pixels
             && features.depth.len() == expected_pixels
     });
-    if film.pixels.len() != expected_pixels || expected_pixels == 0 || !features_fit {
+    let sums_fit = film.sums.as_ref().is_none_or(|sums| {
+        sums.radiance.len() == expected_pixels && sums.counts.len() == expected_pixels
+    });
+    let window_fits = u64::from(film.origin.0) + u64::from(film.width)
+        <= u64::from(film.full_size.0)
+        && u64::from(film.origin.1) + u64::from(film.height) <= u64::from(film.full_size.1);
+    if film.pixels.len() != expected_pixels
+        || expected_pixels == 0
+        || !features_fit
+        || !sums_fit
+        || !window_fits
+    {
         return Err(ImageWriteError::InvalidFilm {
             path: path.to_path_buf(),
             width: film.width,
@@ -205,8 +230,8 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
     {
         let mut writer = BufWriter::new(temporary.as_file_mut());
         match format {
-            OutputFormat::Png => encode_png(film, &mut writer),
-            OutputFormat::Exr => encode_exr(film, &mut writer),
+            OutputFormat::Png => encode_png(film, metadata, &mut writer),
+            OutputFormat::Exr => encode_exr(film, metadata, &mut writer),
         }
         .map_err(|source| ImageWriteError::Encode {
             path: path.to_path_buf(),
@@ -223,19 +248,41 @@ pub fn write_image(path: &Path, film: &Film) -> Result<(), ImageWriteError> {
     Ok(())
 }
 
-fn encode_png(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), EncodeError> {
-    let buffer = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8_course())
-        .ok_or("film size does not match its pixels")?;
-    buffer.write_to(writer, image::ImageFormat::Png)?;
+fn encode_png(
+    film: &Film,
+    metadata: &[(String, String)],
+    writer: &mut BufWriter<&mut File>,
+) -> Result<(), EncodeError> {
+    if metadata.is_empty() {
+        let buffer = image::RgbImage::from_raw(film.width, film.height, film.to_rgb8_course())
+            .ok_or("film size does not match its pixels")?;
+        buffer.write_to(writer, image::ImageFormat::Png)?;
+        return Ok(());
+    }
+    // The `png` crate directly: `image`'s encoder cannot add text chunks.
+    let mut encoder = png::Encoder::new(writer, film.width, film.height);
+    encoder.set_color(png::ColorType::Rgb);
+    encoder.set_depth(png::BitDepth::Eight);
+    for (key, value) in metadata {
+        encoder.add_text_chunk(key.clone(), value.clone())?;
+    }
+    let mut png_writer = encoder.write_header()?;
+    png_writer.write_image_data(&film.to_rgb8_course())?;
+    png_writer.finish()?;
     Ok(())
 }
 
-/// One EXR part with f32 channels R, G, B (the beauty) and the feature layers' channels, rows
-/// from the top, as the `exr` crate stores them.
-fn encode_exr(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), EncodeError> {
+/// One EXR part with f32 channels R, G, B (the beauty), the feature layers' channels and the
+/// sample sums, rows from the top, as the `exr` crate stores them; the display window is the
+/// whole image, the data window the film's rectangle.
+fn encode_exr(
+    film: &Film,
+    metadata: &[(String, String)],
+    writer: &mut BufWriter<&mut File>,
+) -> Result<(), EncodeError> {
     use exr::prelude::{
-        AnyChannel, AnyChannels, Encoding, FlatSamples, Image as ExrImage, Layer, LayerAttributes,
-        WritableImage,
+        AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image as ExrImage,
+        ImageAttributes, IntegerBounds, Layer, LayerAttributes, Text, Vec2, WritableImage,
     };
     let rgb = |prefix: &str,
                values: &[Vec3],
@@ -258,14 +305,158 @@ fn encode_exr(film: &Film, writer: &mut BufWriter<&mut File>) -> Result<(), Enco
             FlatSamples::F32(features.depth.clone()),
         ));
     }
+    if let Some(sums) = &film.sums {
+        rgb("sum.", &sums.radiance, &mut channels);
+        channels.push(AnyChannel::new(
+            "count",
+            FlatSamples::U32(sums.counts.clone()),
+        ));
+    }
+    let position = Vec2(i32::try_from(film.origin.0)?, i32::try_from(film.origin.1)?);
     let layer = Layer::new(
         (film.width as usize, film.height as usize),
-        LayerAttributes::default(),
+        LayerAttributes {
+            layer_position: position,
+            ..LayerAttributes::default()
+        },
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(channels),
     );
-    ExrImage::from_layer(layer).write().to_buffered(writer)?;
+    let mut attributes = ImageAttributes::new(IntegerBounds::new(
+        (0, 0),
+        (film.full_size.0 as usize, film.full_size.1 as usize),
+    ));
+    for (key, value) in metadata {
+        let text = |text: &str| {
+            Text::new_or_none(text).ok_or_else(|| format!("`{text}` is not Latin-1 text"))
+        };
+        attributes
+            .other
+            .insert(text(key)?, AttributeValue::Text(text(value)?));
+    }
+    ExrImage::new(attributes, layer)
+        .write()
+        .to_buffered(writer)?;
     Ok(())
+}
+
+/// Why an EXR could not be read back.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot read {}: {message}", path.display())]
+pub struct ImageReadError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+/// An EXR read back: the film (with its window, feature layers and sample sums, as
+/// `write_image_with_metadata` wrote them) and its string attributes, sorted by key.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrFile {
+    pub film: Film,
+    pub metadata: Vec<(String, String)>,
+}
+
+/// Reads an EXR that `write_image_with_metadata` wrote (a farm part, a crop, a whole image):
+/// the first layer's channels R, G, B, and when present `albedo.R/G/B`, `normal.R/G/B`,
+/// `depth.Y`, `sum.R/G/B` and `count`. The display window must start at (0, 0).
+pub fn read_exr(path: &Path) -> Result<ExrFile, ImageReadError> {
+    let error = |message: String| ImageReadError {
+        path: path.to_path_buf(),
+        message,
+    };
+    let image =
+        exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| error(e.to_string()))?;
+    let display = image.attributes.display_window;
+    if display.position.0 != 0 || display.position.1 != 0 {
+        return Err(error(format!(
+            "the display window starts at ({}, {}), not (0, 0)",
+            display.position.0, display.position.1
+        )));
+    }
+    let layer = &image.layer_data;
+    let (x, y) = (
+        layer.attributes.layer_position.0,
+        layer.attributes.layer_position.1,
+    );
+    let (width, height) = (layer.size.0, layer.size.1);
+    let origin = (
+        u32::try_from(x).map_err(|_| error(format!("the data window starts at x = {x}")))?,
+        u32::try_from(y).map_err(|_| error(format!("the data window starts at y = {y}")))?,
+    );
+    let size = |n: usize| u32::try_from(n).map_err(|_| error(format!("{n} pixels is too large")));
+    let mut film = Film {
+        origin,
+        full_size: (size(display.size.0)?, size(display.size.1)?),
+        ..Film::new(size(width)?, size(height)?)
+    };
+    let channel = |name: &str| {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|channel| channel.name.eq(name))
+            .map(|channel| &channel.sample_data)
+    };
+    let floats = |name: &str| -> Result<Option<Vec<f32>>, ImageReadError> {
+        match channel(name) {
+            None => Ok(None),
+            Some(exr::prelude::FlatSamples::F32(values)) => Ok(Some(values.clone())),
+            Some(_) => Err(error(format!("channel {name} is not 32-bit float"))),
+        }
+    };
+    let colors = |prefix: &str| -> Result<Option<Vec<Vec3>>, ImageReadError> {
+        let [r, g, b] = ["R", "G", "B"].map(|c| floats(&format!("{prefix}{c}")));
+        match (r?, g?, b?) {
+            (Some(r), Some(g), Some(b)) => Ok(Some(
+                r.iter()
+                    .zip(&g)
+                    .zip(&b)
+                    .map(|((&r, &g), &b)| Vec3::new(r, g, b))
+                    .collect(),
+            )),
+            (None, None, None) => Ok(None),
+            _ => Err(error(format!("channels {prefix}R/G/B are incomplete"))),
+        }
+    };
+    film.pixels = colors("")?.ok_or_else(|| error("there are no R, G, B channels".into()))?;
+    let albedo = colors("albedo.")?;
+    let normal = colors("normal.")?;
+    let depth = floats("depth.Y")?;
+    film.features = match (albedo, normal, depth) {
+        (Some(albedo), Some(normal), Some(depth)) => Some(glint_render::Features {
+            albedo,
+            normal,
+            depth,
+        }),
+        (None, None, None) => None,
+        _ => return Err(error("the feature layers are incomplete".into())),
+    };
+    let counts = match channel("count") {
+        None => None,
+        Some(exr::prelude::FlatSamples::U32(values)) => Some(values.clone()),
+        Some(_) => return Err(error("channel count is not 32-bit unsigned".into())),
+    };
+    film.sums = match (colors("sum.")?, counts) {
+        (Some(radiance), Some(counts)) => Some(glint_render::SampleSums { radiance, counts }),
+        (None, None) => None,
+        _ => {
+            return Err(error(
+                "the sample sums need channels sum.R/G/B and count".into(),
+            ))
+        }
+    };
+    let mut metadata: Vec<(String, String)> = image
+        .attributes
+        .other
+        .iter()
+        .chain(&layer.attributes.other)
+        .filter_map(|(key, value)| match value {
+            exr::prelude::AttributeValue::Text(text) => Some((key.to_string(), text.to_string())),
+            _ => None,
+        })
+        .collect();
+    metadata.sort();
+    Ok(ExrFile { film, metadata })
 }
 
 /// Temporary files are created private (0600); the output should get the permissions of the file

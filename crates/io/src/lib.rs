@@ -58,7 +58,10 @@ mod xml;
 use std::path::Path;
 
 pub use diagnostic::{Diagnostic, SceneError, Severity};
-pub use image_io::{output_format, write_image, EncodeError, ImageWriteError, OutputFormat};
+pub use image_io::{
+    output_format, read_exr, write_image, write_image_with_metadata, EncodeError, ExrFile,
+    ImageReadError, ImageWriteError, OutputFormat,
+};
 pub use mesh::{load_mesh, Mesh, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
 

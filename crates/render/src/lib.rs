@@ -94,7 +94,7 @@ pub use scene::{Background, GeometryDesc, Instance, Scene, SceneParts};
 pub use texture::{ColorSource, CubeMap, Image, TextureId};
 
 // Rendering it.
-pub use film::{Features, Film};
+pub use film::{Features, Film, SampleSums};
 pub use pipeline::{
     render, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings, RenderStats,
     TILE_SIZE,
