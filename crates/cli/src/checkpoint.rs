@@ -194,10 +194,11 @@ pub fn render(
         interrupt.set_phase(Phase::Rendering);
         result.map_err(Failure::Write)
     };
-    for band in bands(bounds, threads)
-        .into_iter()
-        .filter(|band| band.y0 >= done_to)
-    {
+    let remaining = PixelBounds {
+        y0: done_to,
+        ..bounds
+    };
+    for band in bands(remaining, threads) {
         let band_settings = RenderSettings {
             pixel_bounds: Some(band),
             threads: None,

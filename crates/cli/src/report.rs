@@ -62,13 +62,16 @@ impl ProgressLog {
 
     /// Records a finished tile of `pixels` pixels and `rays` rays; prints a line when due.
     pub fn tile(&self, pixels: u64, rays: u64) {
-        let done = self.pixels.fetch_add(pixels, Ordering::Relaxed) + pixels;
-        let rays = self.rays.fetch_add(rays, Ordering::Relaxed) + rays;
+        self.pixels.fetch_add(pixels, Ordering::SeqCst);
+        self.rays.fetch_add(rays, Ordering::SeqCst);
         let Ok(mut last) = self.last.lock() else {
             return;
         };
         if last.elapsed() >= self.every {
             *last = Instant::now();
+            // Read under the lock, so that the lines' figures never go backwards.
+            let done = self.pixels.load(Ordering::SeqCst);
+            let rays = self.rays.load(Ordering::SeqCst);
             let line = progress_line(
                 done as f64 / self.total_pixels as f64,
                 self.start.elapsed(),
