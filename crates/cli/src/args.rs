@@ -174,10 +174,12 @@ pub struct Options {
     #[arg(long, value_name = "I/N", value_parser = farm::parse_tile, help_heading = FARM)]
     pub tile: Option<farm::TileSpec>,
 
-    /// Take only samples A..B-1 of each pixel; the EXR then also keeps each pixel's sum and
-    /// sample count, so that `glint merge` can add ranges up. Needs an .exr output.
-    #[arg(long, value_name = "A..B", value_parser = farm::parse_sample_range, help_heading = FARM)]
-    pub sample_range: Option<std::ops::Range<u32>>,
+    /// Take only samples A..B-1 of each pixel, or part I (from 0) of N balanced ranges of
+    /// them; the EXR then also keeps each pixel's sum and sample count, so that `glint merge`
+    /// can add ranges up. Needs an .exr output.
+    #[arg(long, value_name = "A..B|I/N", value_parser = farm::parse_sample_range_arg,
+          help_heading = FARM)]
+    pub sample_range: Option<farm::SampleRangeArg>,
 
     /// Keep the finished part of the render in FILE (an EXR, written atomically) every
     /// --checkpoint-every seconds and on Ctrl-C / SIGTERM; removed once the image is written.
@@ -413,7 +415,13 @@ impl Options {
             (_, _, Some(tile)) => Some(tile.pixel_bounds(self.width, self.height)?),
             _ => None,
         };
-        if self.sample_range.is_some() && !output_is_exr(&output) {
+        let integrator = IntegratorKind::from(self.integrator);
+        let sample_range = self
+            .sample_range
+            .as_ref()
+            .map(|range| range.resolve(integrator.samples_per_pixel(self.rpp)))
+            .transpose()?;
+        if sample_range.is_some() && !output_is_exr(&output) {
             return Err(UsageError(format!(
                 "--sample-range needs an .exr output (it keeps each pixel's sum and sample \
                  count for `glint merge`), not '{}'",
@@ -427,12 +435,12 @@ impl Options {
             max_depth: self.recursion_depth,
             aspect: self.aspect,
             seed: self.seed,
-            integrator: self.integrator.into(),
+            integrator,
             // Feature layers cost a first-hit ray per sample; only an EXR keeps them, and
             // only a whole range of samples averages them (merge cannot add them up).
-            features: output_is_exr(&output) && self.sample_range.is_none(),
+            features: output_is_exr(&output) && sample_range.is_none(),
             pixel_bounds,
-            sample_range: self.sample_range,
+            sample_range,
             ..RenderSettings::default()
         };
         settings.validate().map_err(UsageError)?;

@@ -140,6 +140,40 @@ pub fn parse_sample_range(text: &str) -> Result<Range<u32>, String> {
     Ok(a..b)
 }
 
+/// `--sample-range`: samples `A..B`, or part `I/N` of N balanced ranges.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum SampleRangeArg {
+    Range(Range<u32>),
+    Part(TileSpec),
+}
+
+/// Parses `A..B` or `I/N`.
+pub fn parse_sample_range_arg(text: &str) -> Result<SampleRangeArg, String> {
+    if text.contains('/') {
+        parse_tile(text).map(SampleRangeArg::Part)
+    } else {
+        parse_sample_range(text).map(SampleRangeArg::Range)
+    }
+}
+
+impl SampleRangeArg {
+    /// The samples, of `samples` per pixel: part I of N is `I*S/N .. (I+1)*S/N`.
+    pub fn resolve(&self, samples: u32) -> Result<Range<u32>, String> {
+        match self {
+            SampleRangeArg::Range(range) => Ok(range.clone()),
+            SampleRangeArg::Part(TileSpec { index, count }) => {
+                if *count > samples {
+                    return Err(format!(
+                        "cannot cut {samples} samples per pixel into {count} sample ranges"
+                    ));
+                }
+                let edge = |i: u32| (u64::from(i) * u64::from(samples) / u64::from(*count)) as u32;
+                Ok(edge(*index)..edge(index + 1))
+            }
+        }
+    }
+}
+
 /// Four comma-separated values `X0,X1,Y0,Y1`.
 fn four<T: std::str::FromStr>(text: &str, what: &str) -> Result<[T; 4], String> {
     let parts: Vec<&str> = text.split(',').map(str::trim).collect();
@@ -327,6 +361,11 @@ mod tests {
         assert_eq!(parse_sample_range("4..16"), Ok(4..16));
         assert!(parse_sample_range("16..4").is_err());
         assert!(parse_sample_range("4-16").is_err());
+        let part = |text: &str, samples| parse_sample_range_arg(text).unwrap().resolve(samples);
+        assert_eq!(part("0/3", 16), Ok(0..5));
+        assert_eq!(part("2/3", 16), Ok(10..16));
+        assert_eq!(part("2..5", 16), Ok(2..5));
+        assert!(part("0/17", 16).is_err());
         assert_eq!(parse_tile("3/4"), Ok(TileSpec { index: 3, count: 4 }));
         assert!(parse_tile("4/4").is_err());
         assert!(parse_tile("1/0").is_err());
