@@ -295,7 +295,7 @@ impl TileSpec {
 /// The `columns x rows = count` grid whose tiles are closest to square and at least one pixel.
 fn tile_grid(count: u32, width: u32, height: u32) -> Option<(u32, u32)> {
     (1..=count)
-        .filter(|columns| count % columns == 0)
+        .filter(|&columns| (count / columns) * columns == count)
         .map(|columns| (columns, count / columns))
         .filter(|&(columns, rows)| columns <= width && rows <= height)
         .min_by(|a, b| {
