@@ -224,10 +224,11 @@ pub fn parse_crop_window(text: &str) -> Result<CropWindow, String> {
 
 impl CropWindow {
     /// The pixels of a `width` x `height` image it covers, as pbrt-v4 computes them
-    /// (`ceil(size * fraction)` on both ends), or an error when that is no pixel.
+    /// (`ceil(size * fraction)` on both ends, in f32), or an error when that is no pixel.
     pub fn pixel_bounds(self, width: u32, height: u32) -> Result<PixelBounds, String> {
         let [x0, x1, y0, y1] = self.0;
-        let at = |fraction: f32, size: u32| (f64::from(size) * f64::from(fraction)).ceil() as u32;
+        // In f32, as pbrt-v4 computes it (its `Float`): 10 x 0.3 is 3 there, not 3.0000001.
+        let at = |fraction: f32, size: u32| (size as f32 * fraction).ceil() as u32;
         let bounds = PixelBounds {
             x0: at(x0, width),
             x1: at(x1, width),
