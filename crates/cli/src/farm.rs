@@ -6,15 +6,14 @@
 //! that a sample of a range is exactly that sample of the whole render (glint-render's
 //! pipeline); this module only names the parts and labels them.
 
-use std::fmt::Write as _;
 use std::ops::Range;
 
-use glint_render::{PixelBounds, RenderSettings, RenderStats, SceneParts};
-use sha2::{Digest, Sha256};
+use glint_render::{PixelBounds, RenderSettings, RenderStats};
 
 /// Metadata keys (EXR string attributes, PNG `tEXt` keywords).
 pub mod key {
-    /// SHA-256 of the loaded scene: its content and every asset it loaded (see `scene_hash`).
+    /// XXH3-128 of the loaded scene: its content and every asset it loaded
+    /// (`glint_io::scene_hash`).
     pub const SCENE_HASH: &str = "glint.scene_hash";
     pub const SEED: &str = "glint.seed";
     pub const INTEGRATOR: &str = "glint.integrator";
@@ -48,31 +47,6 @@ pub const IDENTITY_KEYS: [&str; 8] = [
 
 /// Glint's version, as the metadata names it.
 pub const VERSION: &str = env!("CARGO_PKG_VERSION");
-
-/// A hex SHA-256 of the loaded scene (after `--background`): its `Debug` form, which holds
-/// every value the renderer is given, meshes' vertices and textures' texels included. It
-/// names the scene by content, not by path: moving the folder keeps it, editing the file or
-/// any asset changes it.
-pub fn scene_hash(parts: &SceneParts) -> String {
-    struct Hasher(Sha256);
-    impl std::fmt::Write for Hasher {
-        fn write_str(&mut self, text: &str) -> std::fmt::Result {
-            self.0.update(text.as_bytes());
-            Ok(())
-        }
-    }
-    let mut hasher = Hasher(Sha256::new());
-    // Writing to a hasher cannot fail.
-    let _ = write!(hasher, "{parts:?}");
-    hasher
-        .0
-        .finalize()
-        .iter()
-        .fold(String::with_capacity(64), |mut hex, byte| {
-            let _ = write!(hex, "{byte:02x}");
-            hex
-        })
-}
 
 /// The metadata of an image rendered with `settings` from a scene hashing to `scene_hash`.
 pub fn metadata(

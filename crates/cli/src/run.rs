@@ -209,7 +209,7 @@ pub fn run(
     }
     let load_time = load_start.elapsed();
     let hash_start = Instant::now();
-    let scene_hash = farm::scene_hash(&parts);
+    let scene_hash = glint_io::scene_hash(&parts);
     let hash_time = hash_start.elapsed();
     let build_start = Instant::now();
     let scene = pool.install(|| Scene::new(parts));

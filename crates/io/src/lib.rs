@@ -51,6 +51,7 @@ mod obj;
 mod ply;
 mod rays;
 mod read;
+mod scene_hash;
 mod tree;
 mod values;
 mod xml;
@@ -64,6 +65,7 @@ pub use image_io::{
 };
 pub use mesh::{load_mesh, Mesh, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
+pub use scene_hash::scene_hash;
 
 use diagnostic::Diagnostics;
 use read::Format;
