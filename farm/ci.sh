@@ -4,6 +4,7 @@
 #   farm/ci.sh test      start munged, slurmctld and slurmd in a temporary folder, submit a
 #                        4-task array plus the merge job (farm/slurm/submit.sh), wait, compare
 #                        the merged image with a single render bit for bit, stop the daemons.
+#                        GLINT picks the binary (default: a debug build made here).
 # Without Slurm the test is SKIPPED with a message, but under CI=1 that is a failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -41,7 +42,7 @@ test_suite() {
   done
   cargo build --quiet -p glint --example exr_compare
   cargo build --quiet -p glint
-  glint="$repo/target/debug/glint"
+  glint=${GLINT:-$repo/target/debug/glint}
   compare="$repo/target/debug/examples/exr_compare"
 
   work=$(mktemp -d /tmp/glint-slurm.XXXXXX)
@@ -107,8 +108,9 @@ CONF
   echo "slurm: one node up ($(sinfo -h -o '%N %c CPUs %T'))"
 
   # One scene, split two ways: 4 tiles, and 4 sample ranges.
-  scene="$repo/scenes/three_spheres.xml"
-  args=(-w 320 -h 240 -r 36)
+  # FARM_CI_SCENE and FARM_CI_ARGS pick another render (e.g. a longer one to time).
+  scene=$(realpath "${FARM_CI_SCENE:-$repo/scenes/three_spheres.xml}")
+  read -r -a args <<< "${FARM_CI_ARGS:--w 320 -h 240 -r 36}"
   start=$(date +%s.%N)
   "$glint" render "$scene" "${args[@]}" -n 2 -o "$work/out/single.exr" 2> "$work/single.log"
   single_time=$(awk "BEGIN { print $(date +%s.%N) - $start }")
