@@ -590,6 +590,7 @@ fn write_image(
         origin: (0, 0),
         full_size: (width as u32, height as u32),
         features,
+        sums: None,
     };
     let written = py.detach(|| glint_io::write_image(&path, &film));
     written.map_err(|error| match &error {

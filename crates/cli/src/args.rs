@@ -19,9 +19,13 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use std::time::Duration;
+
 use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
 use glint_io::{DisplayTransform, PngEncoding, ToneMap, Transfer};
 use glint_render::{Color, IntegratorKind, RenderSettings, SplitMethod};
+
+use crate::farm;
 
 /// Largest accepted image side. Pixel indices are computed in `u32` in places, and a bigger
 /// image would not fit in memory anyway.
@@ -79,7 +83,7 @@ pub enum Command {
         scene: PathBuf,
 
         #[command(flatten)]
-        options: Options,
+        options: Box<Options>,
     },
     /// Measure the ray engine: `glint bench table`, `glint bench rays`, `glint bench make-rays`.
     Bench(crate::bench::BenchArgs),
@@ -101,6 +105,23 @@ pub enum Command {
         #[arg(short = '?', long, action = ArgAction::Help)]
         help: Option<bool>,
     },
+    /// Assemble farm parts (tiles, sample ranges: EXRs written by `glint render`) into one
+    /// image, refusing parts that do not fit together.
+    #[command(after_help = crate::merge::AFTER_HELP)]
+    Merge(MergeArgs),
+}
+
+/// `glint merge -o OUT PART...`
+#[derive(Args, Debug, Clone)]
+pub struct MergeArgs {
+    /// The merged image, .exr or .png.
+    #[arg(short = 'o', long = "outputfile", value_name = "FILE", required = true)]
+    pub output: PathBuf,
+
+    /// The parts: EXRs written by `glint render` with --tile, --pixel-bounds, --crop-window
+    /// and/or --sample-range.
+    #[arg(value_name = "PART", required = true, num_args = 1..)]
+    pub parts: Vec<PathBuf>,
 }
 
 /// How strict a load is and what it may take: shared by rendering and `glint check`.
@@ -265,6 +286,48 @@ pub struct Options {
     #[arg(short = 'v', long, action = ArgAction::SetTrue)]
     pub verbose: bool,
 
+    /// Render only this part of the image, in fractions of it (pbrt's convention:
+    /// pixels ceil(X0*W)..ceil(X1*W), ceil(Y0*H)..ceil(Y1*H)). Y counts from the top.
+    #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = farm::parse_crop_window,
+          conflicts_with_all = ["pixel_bounds", "tile"], help_heading = FARM)]
+    pub crop_window: Option<farm::CropWindow>,
+
+    /// Render only pixels X0..X1-1, Y0..Y1-1 (from the top-left).
+    #[arg(long, value_name = "X0,X1,Y0,Y1", value_parser = farm::parse_pixel_bounds,
+          conflicts_with = "tile", help_heading = FARM)]
+    pub pixel_bounds: Option<glint_render::PixelBounds>,
+
+    /// Render only tile I (from 0) of N balanced tiles (a grid of near-square tiles whose
+    /// sides differ by at most one pixel).
+    #[arg(long, value_name = "I/N", value_parser = farm::parse_tile, help_heading = FARM)]
+    pub tile: Option<farm::TileSpec>,
+
+    /// Take only samples A..B-1 of each pixel, or part I (from 0) of N balanced ranges of
+    /// them; the EXR then also keeps each pixel's sum and sample count, so that `glint merge`
+    /// can add ranges up. Needs an .exr output.
+    #[arg(long, value_name = "A..B|I/N", value_parser = farm::parse_sample_range_arg,
+          help_heading = FARM)]
+    pub sample_range: Option<farm::SampleRangeArg>,
+
+    /// Keep the finished part of the render in FILE (an EXR, written atomically) every
+    /// --checkpoint-every seconds and on Ctrl-C / SIGTERM; removed once the image is written.
+    #[arg(long, value_name = "FILE", help_heading = FARM)]
+    pub checkpoint: Option<PathBuf>,
+
+    /// Seconds between checkpoints.
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0,
+          value_parser = parse_seconds, help_heading = FARM)]
+    pub checkpoint_every: f64,
+
+    /// Continue the render checkpointed in FILE (same scene and options), checkpointing to it.
+    #[arg(long, value_name = "FILE", conflicts_with = "checkpoint", help_heading = FARM)]
+    pub resume: Option<PathBuf>,
+
+    /// Seconds between progress lines when stderr is not a terminal (see README: progress).
+    #[arg(long, value_name = "SECONDS", default_value_t = 5.0,
+          value_parser = parse_seconds, help_heading = FARM)]
+    pub progress_every: f64,
+
     /// Print help.
     #[arg(short = '?', long, action = ArgAction::Help)]
     pub help: Option<bool>,
@@ -284,8 +347,9 @@ pub struct Options {
           value_parser = parse_split)]
     pub split: SplitMethod,
 
-    /// After the render, print the BVH's build time, nodes, depth, SAH cost and the nodes a
-    /// camera ray visits (a separate counting pass).
+    /// After the render, print time per stage (load, build, render, write), rays by kind, peak
+    /// memory, and the BVH's build time, nodes, depth, SAH cost and the nodes a camera ray
+    /// visits (a separate counting pass).
     #[arg(long, action = ArgAction::SetTrue)]
     pub stats: bool,
 
@@ -339,6 +403,16 @@ pub fn parse_exposure(text: &str) -> Result<f32, String> {
     Ok(value)
 }
 
+const FARM: &str = "Render farms (see README: render farms)";
+
+/// Parses a duration in seconds: a finite number >= 0.
+pub fn parse_seconds(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(value) if value.is_finite() && value >= 0.0 => Ok(value),
+        _ => Err(format!("expected a number of seconds >= 0, got '{text}'")),
+    }
+}
+
 /// `--integrator` / `--shader` values.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
 pub enum IntegratorArg {
@@ -348,6 +422,12 @@ pub enum IntegratorArg {
     Normals,
     Albedo,
     Depth,
+}
+
+impl From<String> for UsageError {
+    fn from(message: String) -> UsageError {
+        UsageError(message)
+    }
 }
 
 impl From<IntegratorArg> for IntegratorKind {
@@ -489,6 +569,19 @@ pub struct Job {
     pub limits: glint_io::Limits,
     /// The memory estimate's budget, in bytes.
     pub max_memory: u64,
+    /// `--checkpoint` / `--resume`.
+    pub checkpoint: Option<Checkpointing>,
+    /// Between progress lines when stderr is not a terminal.
+    pub progress_every: Duration,
+}
+
+/// Where and how often a render keeps its finished part.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Checkpointing {
+    pub file: PathBuf,
+    pub every: Duration,
+    /// `--resume`: the file must exist and is continued.
+    pub resume: bool,
 }
 
 impl Cli {
@@ -496,7 +589,7 @@ impl Cli {
     pub fn into_job(self, available_threads: usize) -> Result<Job, UsageError> {
         let (scene, options) =
             match self.command {
-                Some(Command::Render { scene, options }) => (scene, options),
+                Some(Command::Render { scene, options }) => (scene, *options),
                 Some(Command::Bench(_)) | Some(Command::Check { .. }) => {
                     return Err(UsageError(
                         "`glint bench` and `glint check` do not render".into(),
@@ -504,6 +597,9 @@ impl Cli {
                 }
                 Some(Command::Diff(_)) => {
                     return Err(UsageError("`glint diff` is not a render".to_string()))
+                }
+                Some(Command::Merge(_)) => {
+                    return Err(UsageError("`glint merge` is not a render".to_string()))
                 }
                 None => match self.input {
                     Some(scene) if !scene.as_os_str().is_empty() => (scene, self.options),
@@ -554,6 +650,25 @@ impl Options {
             (None, Some(h)) => Some((scaled(h, self.height, self.width), h)),
             (None, None) => None,
         };
+        let pixel_bounds = match (self.crop_window, self.pixel_bounds, self.tile) {
+            (Some(crop), _, _) => Some(crop.pixel_bounds(self.width, self.height)?),
+            (_, Some(bounds), _) => Some(bounds),
+            (_, _, Some(tile)) => Some(tile.pixel_bounds(self.width, self.height)?),
+            _ => None,
+        };
+        let integrator = IntegratorKind::from(self.integrator);
+        let sample_range = self
+            .sample_range
+            .as_ref()
+            .map(|range| range.resolve(integrator.samples_per_pixel(self.rpp)))
+            .transpose()?;
+        if sample_range.is_some() && !output_is_exr(&output) {
+            return Err(UsageError(format!(
+                "--sample-range needs an .exr output (it keeps each pixel's sum and sample \
+                 count for `glint merge`), not '{}'",
+                output.display()
+            )));
+        }
         let settings = RenderSettings {
             width: self.width,
             height: self.height,
@@ -561,11 +676,41 @@ impl Options {
             max_depth: self.recursion_depth,
             aspect: self.aspect,
             seed: self.seed,
-            integrator: self.integrator.into(),
-            // Feature layers cost a first-hit ray per sample; only an EXR keeps them.
-            features: output_is_exr(&output),
+            integrator,
+            // Feature layers cost a first-hit ray per sample; only an EXR keeps them, and
+            // only a whole range of samples averages them (merge cannot add them up).
+            features: output_is_exr(&output) && sample_range.is_none(),
+            pixel_bounds,
+            sample_range,
             ..RenderSettings::default()
         };
+        settings.validate().map_err(UsageError)?;
+        let checkpoint = match (self.checkpoint, self.resume) {
+            (Some(file), _) => Some((file, false)),
+            (_, Some(file)) => Some((file, true)),
+            _ => None,
+        }
+        .map(|(file, resume)| Checkpointing {
+            file,
+            every: Duration::from_secs_f64(self.checkpoint_every),
+            resume,
+        });
+        if let Some(checkpoint) = &checkpoint {
+            if checkpoint.file == output {
+                return Err(UsageError(format!(
+                    "the checkpoint file and the output are both '{}'",
+                    output.display()
+                )));
+            }
+            if !glint_io::output_format(&checkpoint.file)
+                .is_ok_and(|f| f == glint_io::OutputFormat::Exr)
+            {
+                return Err(UsageError(format!(
+                    "the checkpoint file '{}' must end in .exr",
+                    checkpoint.file.display()
+                )));
+            }
+        }
         // The path tracer takes exactly RPP samples; the course's grid takes N².
         let taken = settings.samples_per_pixel();
         if taken != self.rpp {
@@ -599,6 +744,8 @@ impl Options {
             preview,
             preview_close: self.preview_close,
             notes,
+            checkpoint,
+            progress_every: Duration::from_secs_f64(self.progress_every),
         })
     }
 }

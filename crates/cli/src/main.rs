@@ -7,9 +7,13 @@
 
 mod args;
 mod bench;
+mod checkpoint;
 mod diff;
+mod farm;
 mod gpu;
+mod merge;
 mod preview;
+mod report;
 mod run;
 
 use std::io::IsTerminal;
@@ -45,6 +49,15 @@ fn main() -> ExitCode {
         let (resolved, _) = limits.resolve();
         let status = run::check(scenes, &resolved, limits.strict, &mut std::io::stderr());
         return ExitCode::from(status);
+    }
+    if matches!(cli.command, Some(crate::args::Command::Merge(_))) {
+        let Some(crate::args::Command::Merge(args)) = cli.command.take() else {
+            unreachable!("matched just above");
+        };
+        return match merge::run(&args, &mut std::io::stderr()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(failure) => fail(&failure),
+        };
     }
     let available = std::thread::available_parallelism().map_or(1, |n| n.get());
     let job = match cli.into_job(available) {

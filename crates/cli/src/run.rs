@@ -10,12 +10,16 @@ use std::time::{Duration, Instant};
 
 use glint_io::{Diagnostic, ImageWriteError, SceneError};
 use glint_render::{
-    Background, Progress, RenderError, RenderSettings, RenderStats, Scene, SceneOptions, ThinLens,
+    Background, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings, RenderStats,
+    Scene, SceneOptions, ThinLens,
 };
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::{DeviceArg, Job, UsageError};
+use crate::checkpoint;
+use crate::farm;
 use crate::preview::TileSink;
+use crate::report::{peak_rss, seconds, ProgressLog, Stats};
 
 /// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).
 pub const EXIT_INTERRUPTED: u8 = 130;
@@ -42,6 +46,8 @@ pub enum Failure {
     Strict { scene: PathBuf, warnings: usize },
     /// The render would need more memory than `--max-memory` allows (exit 2).
     Memory(String),
+    /// Ctrl-C or SIGTERM with `--checkpoint` (exit 130): the finished rows are in the file.
+    InterruptedWithCheckpoint(std::path::PathBuf),
 }
 
 impl Failure {
@@ -53,7 +59,7 @@ impl Failure {
             | Failure::Memory(_)
             | Failure::GpuUnsupported(_) => 2,
             Failure::Write(_) | Failure::ThreadPool(_) | Failure::Gpu(_) => 1,
-            Failure::Interrupted => EXIT_INTERRUPTED,
+            Failure::Interrupted | Failure::InterruptedWithCheckpoint(_) => EXIT_INTERRUPTED,
         }
     }
 }
@@ -82,6 +88,11 @@ impl fmt::Display for Failure {
                 plural(*warnings as u64)
             ),
             Failure::Memory(why) => f.write_str(why),
+            Failure::InterruptedWithCheckpoint(file) => write!(
+                f,
+                "interrupted: the finished rows are in {0}; continue with --resume {0}",
+                file.display()
+            ),
         }
     }
 }
@@ -263,9 +274,14 @@ pub fn run(
     if job.device == DeviceArg::Gpu {
         return crate::gpu::run(job, &parts, interrupt, err, progress_bar);
     }
+    let load_time = load_start.elapsed();
+    let hash_start = Instant::now();
+    let scene_hash = glint_io::scene_hash(&parts);
+    let hash_time = hash_start.elapsed();
+    let build_start = Instant::now();
     let options = SceneOptions { split: job.split };
     let scene = pool.install(|| Scene::with_options(parts, options));
-    let load_time = load_start.elapsed();
+    let build_time = build_start.elapsed();
 
     let settings = &job.settings;
     if job.verbose {
@@ -275,7 +291,7 @@ pub fn run(
             "loaded {} in {:.2} s ({} BVH)\nrendering {}x{}, {} samples per pixel, {depth}, seed \
              {}, {} integrator{}, {} -> {}",
             job.scene.display(),
-            load_time.as_secs_f64(),
+            (load_time + build_time).as_secs_f64(),
             job.split.name(),
             settings.width,
             settings.height,
@@ -290,31 +306,100 @@ pub fn run(
             job.output.display()
         );
     }
+    let metadata = |rays: u64, render_seconds: f64| {
+        let stats = RenderStats {
+            rays,
+            ..RenderStats::default()
+        };
+        farm::metadata(settings, &scene_hash, &stats, render_seconds)
+    };
+    let resumed = match &job.checkpoint {
+        Some(checkpoint) if checkpoint.resume => {
+            let resumed = checkpoint::load(&checkpoint.file, settings, &metadata(0, 0.0))?;
+            let _ = match &resumed {
+                Some(resumed) => writeln!(
+                    err,
+                    "note: resuming {}: {} of {} rows done",
+                    checkpoint.file.display(),
+                    resumed.film.height,
+                    settings.bounds().height()
+                ),
+                None => writeln!(
+                    err,
+                    "note: {} does not exist yet: starting from the first row",
+                    checkpoint.file.display()
+                ),
+            };
+            resumed
+        }
+        _ => None,
+    };
 
-    let bar = progress_bar.then(|| new_progress_bar(settings.width, settings.height));
+    let bounds = settings.bounds();
+    let done_pixels = resumed
+        .as_ref()
+        .map_or(0, |r| u64::from(r.film.width) * u64::from(r.film.height));
+    let total_tiles: u64 = match &job.checkpoint {
+        Some(_) => checkpoint::bands(bounds, job.threads)
+            .iter()
+            .map(|band| tile_count(*band))
+            .sum(),
+        None => tile_count(bounds),
+    };
+    let bar = progress_bar.then(|| new_progress_bar(total_tiles));
+    let log = (!progress_bar).then(|| {
+        ProgressLog::new(
+            job.progress_every,
+            u64::from(bounds.width()) * u64::from(bounds.height()),
+            done_pixels,
+        )
+    });
     let progress = |report: &Progress| {
         if let Some(preview) = preview {
             preview.send(report);
         }
         if let Some(bar) = &bar {
-            bar.set_length(report.tiles_total as u64);
             bar.inc(1);
+        }
+        if let Some(log) = &log {
+            let area = u64::from(report.tile.width()) * u64::from(report.tile.height());
+            log.tile(area, report.rays);
         }
         !interrupt.requested()
     };
     interrupt.set_phase(Phase::Rendering);
     let render_start = Instant::now();
-    let result = pool.install(|| glint_render::render(&scene, settings, &progress));
+    let rendered = match &job.checkpoint {
+        Some(checkpointing) => checkpoint::render(
+            &pool,
+            &scene,
+            settings,
+            job.threads,
+            checkpointing,
+            resumed,
+            &metadata,
+            &progress,
+            interrupt,
+        )
+        .map(|banded| (banded.film, banded.stats, banded.render_seconds)),
+        None => match pool.install(|| glint_render::render(&scene, settings, &progress)) {
+            Ok((film, stats)) => Ok((film, stats, render_start.elapsed().as_secs_f64())),
+            Err(RenderError::Invalid(why)) => Err(Failure::Usage(UsageError(why))),
+            Err(RenderError::Cancelled) => Err(Failure::Interrupted),
+        },
+    };
     let render_time = render_start.elapsed();
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
     // From here on Ctrl-C no longer stops anything; one that came in before is honoured.
     interrupt.set_phase(Phase::Writing);
-    let (film, stats) = match result {
-        Ok(rendered) if !interrupt.requested() => rendered,
-        Err(RenderError::Invalid(why)) => return Err(Failure::Usage(UsageError(why))),
-        _ => return Err(Failure::Interrupted),
+    let (film, stats, render_seconds) = match rendered {
+        Ok(_) if interrupt.requested() && job.checkpoint.is_none() => {
+            return Err(Failure::Interrupted)
+        }
+        Ok(rendered) => rendered,
+        Err(failure) => return Err(failure),
     };
 
     if stats.nonfinite_samples > 0 {
@@ -336,12 +421,49 @@ pub fn run(
         );
     }
 
+    let write_start = Instant::now();
     let options = glint_io::WriteOptions { png: job.png };
-    let write = glint_io::write_image_with(&job.output, &film, &options);
-    write.map_err(Failure::Write)?;
+    glint_io::write_image_with_metadata(
+        &job.output,
+        &film,
+        &options,
+        &metadata(stats.rays, render_seconds),
+    )
+    .map_err(Failure::Write)?;
+    if let Some(checkpoint) = &job.checkpoint {
+        // The image is complete: the checkpoint is stale now.
+        match std::fs::remove_file(&checkpoint.file) {
+            Err(error) if error.kind() != std::io::ErrorKind::NotFound => {
+                let _ = writeln!(
+                    err,
+                    "warning: cannot remove the checkpoint {}: {error}",
+                    checkpoint.file.display()
+                );
+            }
+            _ => {}
+        }
+    }
+    let write_time = write_start.elapsed();
 
     let _ = writeln!(err, "{}", closing_line(job, &stats, render_time));
     if job.stats {
+        let mut report = Stats::default();
+        report
+            .section("time")
+            .row("load", seconds(load_time))
+            .row("hash", seconds(hash_time))
+            .row("build", seconds(build_time))
+            .row("render", seconds(render_time))
+            .row("write", seconds(write_time));
+        rays_section(&mut report, settings, &stats);
+        report.section("memory").row(
+            "peak resident",
+            peak_rss().map_or_else(
+                || "unknown".to_string(),
+                |bytes| format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0)),
+            ),
+        );
+        let _ = write!(err, "{}", report.render());
         let _ = write!(err, "{}", pool.install(|| bvh_stats(&scene, settings)));
     }
     Ok(Summary {
@@ -556,9 +678,39 @@ fn check_memory(film: u64, textures: u64, shapes: u64, budget: u64) -> Result<()
     )))
 }
 
-fn new_progress_bar(width: u32, height: u32) -> ProgressBar {
+/// Rays by kind: every sample of every rendered pixel starts with one camera ray, and the
+/// course family traces one more per sample for the feature layers; the rest are the
+/// secondary (reflection, refraction, bounce) and shadow rays.
+fn rays_section(report: &mut Stats, settings: &RenderSettings, stats: &RenderStats) {
+    let bounds = settings.bounds();
+    let camera = u64::from(bounds.width())
+        * u64::from(bounds.height())
+        * u64::from(settings.samples().len() as u32);
+    let features = if settings.features && settings.integrator != IntegratorKind::Path {
+        camera
+    } else {
+        0
+    };
+    let mut section = report.section("rays");
+    section.row("camera", camera);
+    if features > 0 {
+        section.row("feature layers", features);
+    }
+    section
+        .row(
+            "secondary and shadow",
+            stats.rays.saturating_sub(camera + features),
+        )
+        .row("total", stats.rays);
+}
+
+/// Tiles of `TILE_SIZE` the render of `bounds` runs.
+fn tile_count(bounds: PixelBounds) -> u64 {
     let tile = glint_render::TILE_SIZE;
-    let tiles = u64::from(width.div_ceil(tile)) * u64::from(height.div_ceil(tile));
+    u64::from(bounds.width().div_ceil(tile)) * u64::from(bounds.height().div_ceil(tile))
+}
+
+fn new_progress_bar(tiles: u64) -> ProgressBar {
     let bar = ProgressBar::with_draw_target(Some(tiles), ProgressDrawTarget::stderr());
     let style = ProgressStyle::with_template(
         "{elapsed_precise} [{wide_bar}] {percent:>3}% of {len} tiles, ETA {eta}",
@@ -671,6 +823,8 @@ mod tests {
             strict: false,
             limits: glint_io::Limits::default(),
             max_memory: 1 << 30,
+            checkpoint: None,
+            progress_every: Duration::from_secs(5),
         };
         let stats = RenderStats {
             rays: 4_500_000,

@@ -315,6 +315,21 @@ pub fn write_image_with(
     film: &Film,
     options: &WriteOptions,
 ) -> Result<(), ImageWriteError> {
+    write_image_with_metadata(path, film, options, &[])
+}
+
+/// `write_image_with`, with `metadata` (key, value pairs, in order) in the file: PNG `tEXt`
+/// chunks, EXR string attributes in the header. The EXR's display window is the whole image
+/// (`Film::full_size`) and its data window the film's rectangle (`Film::origin`, width x
+/// height), so a crop or farm tile keeps its place; a film with `Film::sums` (a sample range)
+/// also gets channels `sum.R/G/B` (f32) and `count` (u32). Keys must be 1 to 79 printable
+/// Latin-1 characters (PNG's rule), values Latin-1 text.
+pub fn write_image_with_metadata(
+    path: &Path,
+    film: &Film,
+    options: &WriteOptions,
+    metadata: &[(String, String)],
+) -> Result<(), ImageWriteError> {
     let format = output_format(path)?;
     if !film_is_whole(film) {
         return Err(ImageWriteError::InvalidFilm {
@@ -335,7 +350,7 @@ pub fn write_image_with(
     // Encoded in memory first, so the temporary file exists only for the write and rename:
     // a process killed while encoding leaves nothing behind.
     let mut encoded = std::io::Cursor::new(Vec::new());
-    encode_to(film, format, &options.png, &mut encoded).map_err(|source| {
+    encode_to(film, format, &options.png, metadata, &mut encoded).map_err(|source| {
         ImageWriteError::Encode {
             path: path.to_path_buf(),
             source,
@@ -450,11 +465,12 @@ pub fn encode_image(
         .into());
     }
     let mut bytes = std::io::Cursor::new(Vec::new());
-    encode_to(film, format, &options.png, &mut bytes)?;
+    encode_to(film, format, &options.png, &[], &mut bytes)?;
     Ok(bytes.into_inner())
 }
 
-/// Whether the film has pixels and as many of them (and of each feature layer) as its size says.
+/// Whether the film has pixels and as many of them (and of each feature layer and sum) as its
+/// size says, and its rectangle lies in its whole image.
 fn film_is_whole(film: &Film) -> bool {
     let expected_pixels = film.width as usize * film.height as usize;
     let features_fit = film.features.as_ref().is_none_or(|features| {
@@ -462,24 +478,36 @@ fn film_is_whole(film: &Film) -> bool {
             && features.normal.len() == expected_pixels
             && features.depth.len() == expected_pixels
     });
-    film.pixels.len() == expected_pixels && expected_pixels != 0 && features_fit
+    let sums_fit = film.sums.as_ref().is_none_or(|sums| {
+        sums.radiance.len() == expected_pixels && sums.counts.len() == expected_pixels
+    });
+    let window_fits = u64::from(film.origin.0) + u64::from(film.width)
+        <= u64::from(film.full_size.0)
+        && u64::from(film.origin.1) + u64::from(film.height) <= u64::from(film.full_size.1);
+    film.pixels.len() == expected_pixels
+        && expected_pixels != 0
+        && features_fit
+        && sums_fit
+        && window_fits
 }
 
 fn encode_to(
     film: &Film,
     format: OutputFormat,
     png: &PngEncoding,
+    metadata: &[(String, String)],
     writer: &mut (impl Write + std::io::Seek),
 ) -> Result<(), EncodeError> {
     match format {
-        OutputFormat::Png => encode_png(film, png, writer),
-        OutputFormat::Exr => encode_exr(film, writer),
+        OutputFormat::Png => encode_png(film, png, metadata, writer),
+        OutputFormat::Exr => encode_exr(film, metadata, writer),
     }
 }
 
 fn encode_png(
     film: &Film,
     encoding: &PngEncoding,
+    metadata: &[(String, String)],
     writer: &mut impl Write,
 ) -> Result<(), EncodeError> {
     let mut encoder = png::Encoder::new(writer, film.width, film.height);
@@ -498,6 +526,9 @@ fn encode_png(
         Transfer::Linear => "linear",
     };
     encoder.add_text_chunk(TRANSFER_KEYWORD.to_owned(), transfer.to_owned())?;
+    for (key, value) in metadata {
+        encoder.add_text_chunk(key.clone(), value.clone())?;
+    }
     let mut png = encoder.write_header()?;
     png.write_image_data(&encoding.to_rgb8(film))?;
     png.finish()?;
@@ -511,12 +542,17 @@ pub const NORMAL_LAYER: &str = "Denoising Normal.";
 /// The EXR channel of the depth layer (Blender's `Depth` pass, channel `Z`).
 pub const DEPTH_CHANNEL: &str = "Depth.Z";
 
-/// One EXR part with f32 channels R, G, B (the beauty) and the feature layers' channels, rows
-/// from the top, as the `exr` crate stores them.
-fn encode_exr(film: &Film, writer: &mut (impl Write + std::io::Seek)) -> Result<(), EncodeError> {
+/// One EXR part with f32 channels R, G, B (the beauty), the feature layers' channels and the
+/// sample sums, rows from the top, as the `exr` crate stores them; the display window is the
+/// whole image, the data window the film's rectangle.
+fn encode_exr(
+    film: &Film,
+    metadata: &[(String, String)],
+    writer: &mut (impl Write + std::io::Seek),
+) -> Result<(), EncodeError> {
     use exr::prelude::{
-        AnyChannel, AnyChannels, Encoding, FlatSamples, Image as ExrImage, Layer, LayerAttributes,
-        WritableImage,
+        AnyChannel, AnyChannels, AttributeValue, Encoding, FlatSamples, Image as ExrImage,
+        ImageAttributes, IntegerBounds, Layer, LayerAttributes, Text, Vec2, WritableImage,
     };
     let rgb = |prefix: &str,
                suffixes: [&str; 3],
@@ -550,14 +586,159 @@ fn encode_exr(film: &Film, writer: &mut (impl Write + std::io::Seek)) -> Result<
             FlatSamples::F32(features.depth.clone()),
         ));
     }
+    if let Some(sums) = &film.sums {
+        rgb("sum.", ["R", "G", "B"], &sums.radiance, &mut channels);
+        channels.push(AnyChannel::new(
+            "count",
+            FlatSamples::U32(sums.counts.clone()),
+        ));
+    }
+    let position = Vec2(i32::try_from(film.origin.0)?, i32::try_from(film.origin.1)?);
     let layer = Layer::new(
         (film.width as usize, film.height as usize),
-        LayerAttributes::default(),
+        LayerAttributes {
+            layer_position: position,
+            ..LayerAttributes::default()
+        },
         Encoding::SMALL_LOSSLESS,
         AnyChannels::sort(channels),
     );
-    ExrImage::from_layer(layer).write().to_buffered(writer)?;
+    let mut attributes = ImageAttributes::new(IntegerBounds::new(
+        (0, 0),
+        (film.full_size.0 as usize, film.full_size.1 as usize),
+    ));
+    for (key, value) in metadata {
+        let text = |text: &str| {
+            Text::new_or_none(text).ok_or_else(|| format!("`{text}` is not Latin-1 text"))
+        };
+        attributes
+            .other
+            .insert(text(key)?, AttributeValue::Text(text(value)?));
+    }
+    ExrImage::new(attributes, layer)
+        .write()
+        .to_buffered(writer)?;
     Ok(())
+}
+
+/// Why an EXR could not be read back.
+#[derive(Debug, thiserror::Error)]
+#[error("cannot read {}: {message}", path.display())]
+pub struct ImageReadError {
+    pub path: PathBuf,
+    pub message: String,
+}
+
+/// An EXR read back: the film (with its window, feature layers and sample sums, as
+/// `write_image_with_metadata` wrote them) and its string attributes, sorted by key.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrFile {
+    pub film: Film,
+    pub metadata: Vec<(String, String)>,
+}
+
+/// Reads an EXR that `write_image_with_metadata` wrote (a farm part, a crop, a whole image):
+/// the first layer's channels R, G, B, and when present the feature layers (`ALBEDO_LAYER`,
+/// `NORMAL_LAYER`, `DEPTH_CHANNEL`), `sum.R/G/B` and `count`. The display window must start at (0, 0).
+pub fn read_exr(path: &Path) -> Result<ExrFile, ImageReadError> {
+    let error = |message: String| ImageReadError {
+        path: path.to_path_buf(),
+        message,
+    };
+    let image =
+        exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| error(e.to_string()))?;
+    let display = image.attributes.display_window;
+    if display.position.0 != 0 || display.position.1 != 0 {
+        return Err(error(format!(
+            "the display window starts at ({}, {}), not (0, 0)",
+            display.position.0, display.position.1
+        )));
+    }
+    let layer = &image.layer_data;
+    let (x, y) = (
+        layer.attributes.layer_position.0,
+        layer.attributes.layer_position.1,
+    );
+    let (width, height) = (layer.size.0, layer.size.1);
+    let origin = (
+        u32::try_from(x).map_err(|_| error(format!("the data window starts at x = {x}")))?,
+        u32::try_from(y).map_err(|_| error(format!("the data window starts at y = {y}")))?,
+    );
+    let size = |n: usize| u32::try_from(n).map_err(|_| error(format!("{n} pixels is too large")));
+    let mut film = Film {
+        origin,
+        full_size: (size(display.size.0)?, size(display.size.1)?),
+        ..Film::new(size(width)?, size(height)?)
+    };
+    let channel = |name: &str| {
+        layer
+            .channel_data
+            .list
+            .iter()
+            .find(|channel| channel.name.eq(name))
+            .map(|channel| &channel.sample_data)
+    };
+    let floats = |name: &str| -> Result<Option<Vec<f32>>, ImageReadError> {
+        match channel(name) {
+            None => Ok(None),
+            Some(exr::prelude::FlatSamples::F32(values)) => Ok(Some(values.clone())),
+            Some(_) => Err(error(format!("channel {name} is not 32-bit float"))),
+        }
+    };
+    let colors = |prefix: &str, suffixes: [&str; 3]| -> Result<Option<Vec<Vec3>>, ImageReadError> {
+        let [r, g, b] = suffixes.map(|c| floats(&format!("{prefix}{c}")));
+        match (r?, g?, b?) {
+            (Some(r), Some(g), Some(b)) => Ok(Some(
+                r.iter()
+                    .zip(&g)
+                    .zip(&b)
+                    .map(|((&r, &g), &b)| Vec3::new(r, g, b))
+                    .collect(),
+            )),
+            (None, None, None) => Ok(None),
+            _ => Err(error(format!("the channels {prefix}* are incomplete"))),
+        }
+    };
+    film.pixels = colors("", ["R", "G", "B"])?
+        .ok_or_else(|| error("there are no R, G, B channels".into()))?;
+    let albedo = colors(ALBEDO_LAYER, ["R", "G", "B"])?;
+    let normal = colors(NORMAL_LAYER, ["X", "Y", "Z"])?;
+    let depth = floats(DEPTH_CHANNEL)?;
+    film.features = match (albedo, normal, depth) {
+        (Some(albedo), Some(normal), Some(depth)) => Some(glint_render::Features {
+            albedo,
+            normal,
+            depth,
+        }),
+        (None, None, None) => None,
+        _ => return Err(error("the feature layers are incomplete".into())),
+    };
+    let counts = match channel("count") {
+        None => None,
+        Some(exr::prelude::FlatSamples::U32(values)) => Some(values.clone()),
+        Some(_) => return Err(error("channel count is not 32-bit unsigned".into())),
+    };
+    film.sums = match (colors("sum.", ["R", "G", "B"])?, counts) {
+        (Some(radiance), Some(counts)) => Some(glint_render::SampleSums { radiance, counts }),
+        (None, None) => None,
+        _ => {
+            return Err(error(
+                "the sample sums need channels sum.R/G/B and count".into(),
+            ))
+        }
+    };
+    let mut metadata: Vec<(String, String)> = image
+        .attributes
+        .other
+        .iter()
+        .chain(&layer.attributes.other)
+        .filter_map(|(key, value)| match value {
+            exr::prelude::AttributeValue::Text(text) => Some((key.to_string(), text.to_string())),
+            _ => None,
+        })
+        .collect();
+    metadata.sort();
+    Ok(ExrFile { film, metadata })
 }
 
 /// Temporary files are created private (0600); the output should get the permissions of the file

@@ -55,6 +55,7 @@ mod obj;
 mod ply;
 mod rays;
 mod read;
+mod scene_hash;
 mod tree;
 mod values;
 mod xml;
@@ -67,12 +68,14 @@ pub use display::{
     DisplayTransform, PngEncoding, ToneMap, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD,
 };
 pub use image_io::{
-    encode_image, output_format, remove_stale_partials, write_image, write_image_with, EncodeError,
-    ImageWriteError, OutputFormat, WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
+    encode_image, output_format, read_exr, remove_stale_partials, write_image, write_image_with,
+    write_image_with_metadata, EncodeError, ExrFile, ImageReadError, ImageWriteError, OutputFormat,
+    WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
 };
 pub use limits::{format_bytes, Limits, BYTES_PER_TEXEL};
 pub use mesh::{load_mesh, load_mesh_from, Mesh, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
+pub use scene_hash::scene_hash;
 
 use diagnostic::Diagnostics;
 use read::Format;

@@ -121,3 +121,59 @@ fn an_existing_image_is_replaced_whole() {
         );
     }
 }
+
+#[test]
+fn exr_keeps_windows_sums_and_metadata() {
+    let directory = tempfile::tempdir().unwrap();
+    let path = directory.path().join("part.exr");
+    let mut part = Film {
+        origin: (5, 7),
+        full_size: (20, 10),
+        ..film()
+    };
+    part.sums = Some(glint_render::SampleSums {
+        radiance: part.pixels.iter().map(|&c| c * 3.0).collect(),
+        counts: vec![3, 0, 3, 2, 3, 3],
+    });
+    let metadata = vec![
+        ("glint.seed".to_string(), "7".to_string()),
+        ("glint.sample_range".to_string(), "4..7".to_string()),
+    ];
+    glint_io::write_image_with_metadata(&path, &part, &Default::default(), &metadata).unwrap();
+    let read = glint_io::read_exr(&path).unwrap();
+    assert_eq!((read.film.origin, read.film.full_size), ((5, 7), (20, 10)));
+    assert_eq!((read.film.width, read.film.height), (3, 2));
+    let bits = |film: &Film| -> Vec<u32> {
+        film.pixels
+            .iter()
+            .flat_map(|c| c.to_array())
+            .map(f32::to_bits)
+            .collect()
+    };
+    assert_eq!(bits(&read.film), bits(&part));
+    let (a, b) = (read.film.sums.unwrap(), part.sums.clone().unwrap());
+    assert_eq!(a.counts, b.counts);
+    assert_eq!(a.radiance[5], b.radiance[5]);
+    for entry in &metadata {
+        assert!(
+            read.metadata.contains(entry),
+            "{entry:?} in {:?}",
+            read.metadata
+        );
+    }
+    // A tile that does not fit its image is refused.
+    let outside = Film {
+        origin: (19, 0),
+        ..part.clone()
+    };
+    assert!(glint_io::write_image_with_metadata(
+        &path,
+        &Film {
+            sums: None,
+            ..outside
+        },
+        &Default::default(),
+        &[]
+    )
+    .is_err());
+}

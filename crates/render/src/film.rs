@@ -18,6 +18,23 @@ pub struct Film {
     pub full_size: (u32, u32),
     /// First-hit feature layers, when `RenderSettings::features` asked for them.
     pub features: Option<Features>,
+    /// Each pixel's unnormalised sum and sample count, when `RenderSettings::sample_range` was
+    /// given: what a farm adds up across sample ranges (see [`SampleSums`]).
+    pub sums: Option<SampleSums>,
+}
+
+/// The partial result of a sample range, laid out as `Film::pixels`: `radiance[i]` is the sum
+/// of pixel `i`'s finite samples, added in sample order starting from zero, and `counts[i]`
+/// how many there were (non-finite samples are dropped, so counts can differ per pixel). The
+/// pixel itself is `radiance[i] / counts[i]` (black where the count is 0).
+///
+/// Adding the sums of several ranges gives the same samples' sum, but not always the same
+/// `f32` as the whole render's single running sum: floating-point addition is not associative.
+/// Add them in a fixed order (by range start) for a deterministic result.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SampleSums {
+    pub radiance: Vec<Color>,
+    pub counts: Vec<u32>,
 }
 
 /// First-hit feature layers, each averaged over the pixel's samples and laid out as
@@ -45,6 +62,7 @@ impl Film {
             origin: (0, 0),
             full_size: (width, height),
             features: None,
+            sums: None,
         }
     }
 

@@ -95,7 +95,7 @@ pub use scene::{Background, BvhStats, GeometryDesc, Instance, Scene, SceneOption
 pub use texture::{ColorSource, CubeMap, Image, TextureId};
 
 // Rendering it.
-pub use film::{Features, Film};
+pub use film::{Features, Film, SampleSums};
 pub use pipeline::{
     measure_traversal, render, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings,
     RenderStats, TraversalStats, TILE_SIZE,

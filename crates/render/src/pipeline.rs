@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
-use crate::film::{Features, Film};
+use crate::film::{Features, Film, SampleSums};
 use crate::integrator::course::grid_size;
 use crate::integrator::course::CourseIntegrator;
 use crate::integrator::debug::{DebugIntegrator, DebugView};
@@ -265,6 +265,8 @@ pub struct Progress<'a> {
     /// (row-major): what a preview shows.
     pub tile: PixelBounds,
     pub pixels: &'a [Color],
+    /// Rays traced for the tile just finished (camera, secondary and shadow rays).
+    pub rays: u64,
 }
 
 impl Progress<'_> {
@@ -361,6 +363,9 @@ fn render_on_current_pool(
 #[derive(Clone, Copy, Debug, Default)]
 struct PixelValue {
     beauty: Color,
+    /// The unnormalised sum of the finite samples and their count.
+    sum: Color,
+    count: u32,
     albedo: Color,
     normal: Vec3,
     depth: f32,
@@ -430,12 +435,17 @@ fn render_with<I: Integrator>(
                 &mut counters.rays,
                 &mut sink,
             );
+            // Unnormalised, for farm parts that are added up later (`Film::sums`).
+            value.sum = sum;
+            value.count = valid;
             if valid > 0 {
                 value.beauty = sum / valid as f32;
                 // Finite samples can still overflow their sum (two of 3e38): then none of
                 // them is usable, and all are counted as dropped.
                 if !value.beauty.is_finite() {
                     value.beauty = Color::ZERO;
+                    value.sum = Color::ZERO;
+                    value.count = 0;
                     dropped += valid;
                 }
             }
@@ -464,6 +474,11 @@ fn render_with<I: Integrator>(
         normal: values.iter().map(|v| v.normal).collect(),
         depth: values.iter().map(|v| v.depth).collect(),
     });
+    // Kept only for a sample range, the one case where a farm adds pixels up.
+    let sums = settings.sample_range.is_some().then(|| SampleSums {
+        radiance: values.iter().map(|v| v.sum).collect(),
+        counts: values.iter().map(|v| v.count).collect(),
+    });
     let film = Film {
         width: bounds.width(),
         height: bounds.height(),
@@ -471,6 +486,7 @@ fn render_with<I: Integrator>(
         origin: (bounds.x0, bounds.y0),
         full_size: (width, height),
         features,
+        sums,
     };
     Ok((film, stats))
 }
@@ -525,6 +541,7 @@ fn render_tiles<P: Copy + Default + Send>(
                 tiles_total: tile_count,
                 tile: area,
                 pixels: &pixels,
+                rays: counters.rays,
             };
             if !progress(&report) {
                 cancelled.store(true, Ordering::Relaxed);

@@ -308,6 +308,7 @@ pub fn encode(
         origin: (0, 0),
         full_size: (width, height),
         features,
+        sums: None,
     };
     let options = WriteOptions {
         png: PngEncoding::default_for(integrator),

@@ -125,7 +125,15 @@ fn a_sample_range_of_every_sample_is_the_whole_render() {
             ..whole.clone()
         };
         let (same, _) = render(&scene, &ranged, &|_| true).unwrap();
-        assert_eq!(full, same, "{integrator:?}");
+        assert_eq!(full.pixels, same.pixels, "{integrator:?}");
+        assert_eq!(full.features, same.features, "{integrator:?}");
+        // Only a sample range keeps the sums; each pixel is its sum over its count.
+        assert!(full.sums.is_none());
+        let sums = same.sums.as_ref().expect("a sample range keeps its sums");
+        for ((pixel, sum), count) in same.pixels.iter().zip(&sums.radiance).zip(&sums.counts) {
+            assert_eq!(*count, 9, "{integrator:?}");
+            assert_eq!(*pixel, *sum / *count as f32, "{integrator:?}");
+        }
         // A partial range is a different, valid estimate; an empty one is refused.
         let part = RenderSettings {
             sample_range: Some(3..7),
