@@ -209,21 +209,9 @@ fn _restore(
     }
 }
 
-/// `file:line:col: message`, then the offending line and a caret: what the CLI prints after
-/// `error: ` or `warning: ` (its `located`, crates/cli/src/run.rs).
+/// What the CLI prints after `error: ` or `warning: ` (glint-io's `Diagnostic::located`).
 fn located(diagnostic: &Diagnostic) -> String {
-    let mut text = format!(
-        "{}:{}:{}: {}",
-        diagnostic.path.display(),
-        diagnostic.line,
-        diagnostic.column,
-        diagnostic.message
-    );
-    if let Some(excerpt) = diagnostic.source_excerpt() {
-        text.push('\n');
-        text.push_str(&excerpt);
-    }
-    text
+    diagnostic.located()
 }
 
 /// A `SceneError` or `SceneWarning` instance carrying the diagnostic's parts as attributes.

@@ -103,22 +103,11 @@ impl From<UsageError> for Failure {
     }
 }
 
-/// `file:line:col: message`, then the offending line and a caret under the column: a
-/// diagnostic without its severity label, which the caller puts in front (`error: `,
+/// `file:line:col: message` with the offending line and a caret (glint-io's
+/// `Diagnostic::located`); the caller puts the severity label in front (`error: `,
 /// `warning: `) the same way as for every other message of the CLI.
 pub fn located(diagnostic: &Diagnostic) -> String {
-    let mut text = format!(
-        "{}:{}:{}: {}",
-        diagnostic.path.display(),
-        diagnostic.line,
-        diagnostic.column,
-        diagnostic.message
-    );
-    if let Some(excerpt) = diagnostic.source_excerpt() {
-        text.push('\n');
-        text.push_str(&excerpt);
-    }
-    text
+    diagnostic.located()
 }
 
 /// Where a run is, so that Ctrl-C does the right thing at each point.

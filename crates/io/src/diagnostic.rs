@@ -80,6 +80,24 @@ impl fmt::Display for Diagnostic {
 }
 
 impl Diagnostic {
+    /// `file:line:col: message`, then the offending line and a caret under the column: the
+    /// diagnostic without its severity label, which every front end (the CLI, Python, the
+    /// browser) puts in front as `error: ` or `warning: `, so all of them print the same text.
+    pub fn located(&self) -> String {
+        let mut text = format!(
+            "{}:{}:{}: {}",
+            self.path.display(),
+            self.line,
+            self.column,
+            self.message
+        );
+        if let Some(excerpt) = self.source_excerpt() {
+            text.push('\n');
+            text.push_str(&excerpt);
+        }
+        text
+    }
+
     /// The text of the offending line (without its line break), when known. `Display` shows
     /// an excerpt around the column when the line is very long.
     pub fn source_line(&self) -> Option<&str> {

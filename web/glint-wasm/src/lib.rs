@@ -80,21 +80,10 @@ impl Message {
     }
 }
 
-/// `file:line:col: message`, then the offending line and a caret: the CLI's `run::located`,
+/// What the CLI prints after `error: ` or `warning: ` (glint-io's `Diagnostic::located`),
 /// which the end-to-end test holds the page to.
 fn located(diagnostic: &Diagnostic) -> String {
-    let mut text = format!(
-        "{}:{}:{}: {}",
-        diagnostic.path.display(),
-        diagnostic.line,
-        diagnostic.column,
-        diagnostic.message
-    );
-    if let Some(excerpt) = diagnostic.source_excerpt() {
-        text.push('\n');
-        text.push_str(&excerpt);
-    }
-    text
+    diagnostic.located()
 }
 
 /// A scene loaded (or not) from its text and files.
