@@ -304,8 +304,8 @@ def write_image(path: PathLike, image: np.ndarray | Mapping[str, np.ndarray]) ->
     course's conversion: clamp, floor(c * 255), no gamma) or ``.exr`` (linear float32).
 
     ``image`` is an ``(H, W, 3)`` array, or :func:`render`'s dict with ``features=True``,
-    whose feature layers go into the EXR as the CLI writes them (``albedo.R`` ...,
-    ``normal.R`` ..., ``depth.Y``). The file is written whole or not at all.
+    whose feature layers go into the EXR as the CLI writes them (``Denoising Albedo.R`` ...,
+    ``Denoising Normal.X`` ..., ``Depth.Z``). The file is written whole or not at all.
 
     >>> import tempfile, pathlib
     >>> folder = pathlib.Path(tempfile.mkdtemp())

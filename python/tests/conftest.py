@@ -12,6 +12,15 @@ import pytest
 REPO = Path(__file__).resolve().parents[2]
 THREE_SPHERES = REPO / "scenes" / "three_spheres.xml"
 
+# The EXR channels the CLI writes (Blender's multilayer pass names; README: feature layers),
+# by the layer `glint.render(..., features=True)` returns them under.
+EXR_CHANNELS = {
+    "beauty": ["R", "G", "B"],
+    "albedo": ["Denoising Albedo.R", "Denoising Albedo.G", "Denoising Albedo.B"],
+    "normal": ["Denoising Normal.X", "Denoising Normal.Y", "Denoising Normal.Z"],
+}
+EXR_DEPTH = "Depth.Z"
+
 
 def _missing(what: str) -> None:
     """Under CI a missing tool is a failure, elsewhere a skip that says so."""

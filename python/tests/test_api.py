@@ -8,7 +8,7 @@ import warnings
 
 import numpy as np
 import pytest
-from conftest import THREE_SPHERES, read_exr
+from conftest import EXR_CHANNELS, EXR_DEPTH, THREE_SPHERES, read_exr
 
 import glint
 
@@ -221,13 +221,12 @@ def test_write_image_writes_what_render_returned(tmp_path, spheres):
     glint.write_image(tmp_path / "beauty.exr", layers["beauty"])
     everything = read_exr(tmp_path / "all.exr")
     assert sorted(everything) == sorted(
-        ["R", "G", "B", "albedo.R", "albedo.G", "albedo.B"]
-        + ["normal.R", "normal.G", "normal.B", "depth.Y"]
+        [name for names in EXR_CHANNELS.values() for name in names] + [EXR_DEPTH]
     )
-    for layer, prefix in (("beauty", ""), ("albedo", "albedo."), ("normal", "normal.")):
-        stacked = np.stack([everything[prefix + c] for c in "RGB"], axis=2)
+    for layer, names in EXR_CHANNELS.items():
+        stacked = np.stack([everything[name] for name in names], axis=2)
         assert np.array_equal(bits(stacked), bits(layers[layer]))
-    assert np.array_equal(bits(everything["depth.Y"]), bits(layers["depth"]))
+    assert np.array_equal(bits(everything[EXR_DEPTH]), bits(layers["depth"]))
     assert sorted(read_exr(tmp_path / "beauty.exr")) == ["B", "G", "R"]
 
     # PNG: the course's conversion, floor(clamp(c) * 255), no gamma.

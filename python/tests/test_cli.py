@@ -7,7 +7,7 @@ import subprocess
 
 import numpy as np
 import pytest
-from conftest import THREE_SPHERES, read_exr
+from conftest import EXR_CHANNELS, EXR_DEPTH, THREE_SPHERES, read_exr
 
 import glint
 
@@ -54,10 +54,10 @@ def test_render_returns_the_cli_exr_pixels(cli, tmp_path, integrator, spp, seed,
         features=True,  # the CLI computes the feature layers for an EXR
         **extra,
     )
-    for layer, prefix in (("beauty", ""), ("albedo", "albedo."), ("normal", "normal.")):
-        from_cli = np.stack([written[prefix + channel] for channel in "RGB"], axis=2)
+    for layer, names in EXR_CHANNELS.items():
+        from_cli = np.stack([written[name] for name in names], axis=2)
         assert np.array_equal(bits(layers[layer]), bits(from_cli)), layer
-    assert np.array_equal(bits(layers["depth"]), bits(written["depth.Y"]))
+    assert np.array_equal(bits(layers["depth"]), bits(written[EXR_DEPTH]))
     # And the beauty alone is the same without the feature layers.
     beauty = glint.render(
         scene,
