@@ -232,7 +232,10 @@ pub fn run(
     limits.max_texture_bytes = limits
         .max_texture_bytes
         .min(job.max_memory.saturating_sub(film_bytes));
-    let loaded = glint_io::load_scene_limited(&job.scene, &limits).map_err(Failure::Scene)?;
+    // In the pool, so that `-n` also bounds the threads that read meshes.
+    let loaded = pool
+        .install(|| glint_io::load_scene_limited(&job.scene, &limits))
+        .map_err(Failure::Scene)?;
     if job.strict && !loaded.warnings.is_empty() {
         for warning in &loaded.warnings {
             let _ = writeln!(err, "error: {}", located(warning));

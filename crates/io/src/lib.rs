@@ -52,6 +52,7 @@ mod json;
 mod limits;
 mod mesh;
 mod obj;
+mod obj_fast;
 mod ply;
 mod rays;
 mod read;

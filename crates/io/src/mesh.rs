@@ -86,7 +86,7 @@ pub fn load_mesh_from(path: &Path, assets: &dyn Assets) -> Result<Mesh, MeshErro
             triangles,
         })
     } else {
-        crate::obj::read_obj(&mut bytes.as_slice()).map_err(format_error)
+        crate::obj::read_obj(&bytes).map_err(format_error)
     }
 }
 

@@ -1,6 +1,7 @@
-//! OBJ meshes with tobj. The course meshes hold only `v` and `f` records (FORMAT.md 4.6); normals
-//! and texture coordinates are not used, and materials (`mtllib`, `usemtl`) are ignored because
-//! the course gives one shader per mesh.
+//! OBJ meshes. The course meshes hold only `v` and `f` records (FORMAT.md 4.6): those are read
+//! in parallel by `obj_fast`, which gives tobj's triangles bit for bit or leaves the file to
+//! tobj; normals and texture coordinates are not used, and materials (`mtllib`, `usemtl`) are
+//! ignored because the course gives one shader per mesh.
 
 use std::io::BufRead;
 use std::path::Path;
@@ -37,7 +38,7 @@ pub(crate) fn load_triangles(
             limits.max_triangles
         )));
     }
-    let mesh = read_obj(&mut bytes.as_slice()).map_err(AssetError::Failed)?;
+    let mesh = read_obj(&bytes).map_err(AssetError::Failed)?;
     Ok((0..mesh.triangles.len())
         .map(|index| mesh.triangle(index))
         .collect())
@@ -46,6 +47,10 @@ pub(crate) fn load_triangles(
 /// How many triangles the `f` records of an OBJ file make when fan-triangulated, counted
 /// before parsing so that a face of millions of corners is refused before it is expanded.
 pub(crate) fn count_triangles(bytes: &[u8]) -> u64 {
+    crate::obj_fast::sum_over_lines(bytes, count_triangles_of_lines)
+}
+
+fn count_triangles_of_lines(bytes: &[u8]) -> u64 {
     bytes
         .split(|&byte| byte == b'\n')
         .filter_map(|line| {
@@ -65,7 +70,15 @@ pub(crate) fn count_triangles(bytes: &[u8]) -> u64 {
 /// The one OBJ reader: scene meshes (`load_triangles`) and stand-alone meshes
 /// (`crate::load_mesh`) both read through it. A face that names a vertex that does not exist
 /// or is not finite is an error.
-pub(crate) fn read_obj(reader: &mut impl BufRead) -> Result<Mesh, String> {
+pub(crate) fn read_obj(bytes: &[u8]) -> Result<Mesh, String> {
+    match crate::obj_fast::read(bytes) {
+        Some(mesh) => Ok(mesh),
+        None => read_with_tobj(&mut &bytes[..]),
+    }
+}
+
+/// `read_obj` by tobj, for every file: what `obj_fast` declines, and its tests' reference.
+pub(crate) fn read_with_tobj(reader: &mut impl BufRead) -> Result<Mesh, String> {
     // `..Default::default()` is needless today, but tobj's optional features (merging,
     // reordering) add fields, and feature unification could turn them on.
     #[allow(clippy::needless_update)]

@@ -1,0 +1,379 @@
+//! The common case of an OBJ file read in parallel: `v` and `f` records only (FORMAT.md 4.6;
+//! every course mesh, most of `../shared/models`), cut into chunks at line ends and parsed one
+//! chunk per task, then stitched by prefix sums of the chunks' vertex counts.
+//!
+//! It gives exactly the triangles tobj gives (`obj::read_obj`'s other path), or declines
+//! (`None`) and leaves the file to tobj: it accepts only what it can read the way tobj does,
+//! with the same tokenising (`str::split_whitespace`), the same number parsing (`f32` and
+//! `isize` `FromStr`), the same fan triangulation `(v0, vk, vk+1)` and the same relative
+//! indices. Anything else declines: a byte that is not ASCII, `vt`, `vn` and `l` records, a
+//! face corner with a `/`, a face of fewer than three corners, a `v` with a fourth value, a
+//! malformed number, an index 0 or one naming a vertex not yet defined at its line (tobj
+//! accepts forward references within an object; this reader does not try), an `usemtl`
+//! without a name, a face on a non-finite vertex. Errors are therefore always tobj's.
+//! `tests::agrees_with_tobj` holds it to that on every OBJ file of the course corpus and
+//! the shared models and on the malformed cases of `obj.rs`.
+
+use glint_render::Vec3;
+
+use crate::mesh::Mesh;
+
+/// Chunks are at least this long: below it, the work of a task is less than its cost.
+const CHUNK_BYTES: usize = 1 << 18;
+
+/// What one chunk of lines holds.
+#[derive(Default)]
+struct Chunk {
+    vertices: Vec<Vec3>,
+    /// Per face: its corners' range in `corners` and how many of this chunk's vertices were
+    /// defined before its line.
+    faces: Vec<Face>,
+    /// Corner indices as written: `x >= 1` is vertex `x - 1` of the file, `x < 0` counts back
+    /// from the vertices defined before the face's line.
+    corners: Vec<isize>,
+}
+
+struct Face {
+    first: u32,
+    count: u32,
+    defined: u32,
+}
+
+/// The mesh of an OBJ file's bytes, or `None` when tobj should read it (module docs).
+pub(crate) fn read(bytes: &[u8]) -> Option<Mesh> {
+    if !bytes.is_ascii() || bytes.len() >= u32::MAX as usize {
+        return None;
+    }
+    let text = std::str::from_utf8(bytes).ok()?;
+    let chunks = map(&split_at_lines(text), |piece| parse_chunk(piece))
+        .into_iter()
+        .collect::<Option<Vec<Chunk>>>()?;
+    // The file's vertex index of each chunk's first vertex.
+    let mut bases = Vec::with_capacity(chunks.len());
+    let mut total = 0usize;
+    for chunk in &chunks {
+        bases.push(total);
+        total += chunk.vertices.len();
+    }
+    if total > u32::MAX as usize {
+        return None;
+    }
+    let mut positions = Vec::with_capacity(total);
+    for chunk in &chunks {
+        positions.extend_from_slice(&chunk.vertices);
+    }
+    let jobs: Vec<(&Chunk, usize)> = chunks.iter().zip(bases).collect();
+    let triangles = map(&jobs, |&(chunk, base)| triangulate(chunk, base, &positions))
+        .into_iter()
+        .collect::<Option<Vec<Vec<[u32; 3]>>>>()?
+        .concat();
+    Some(Mesh {
+        positions,
+        triangles,
+    })
+}
+
+/// `text` cut after a `\n` about every `CHUNK_BYTES`, into as many pieces as there are
+/// threads to take them (at least one piece).
+fn split_at_lines(text: &str) -> Vec<&str> {
+    // ASCII (checked by the caller): every byte offset is a char boundary.
+    line_pieces(text.as_bytes())
+        .into_iter()
+        .map(|range| &text[range])
+        .collect()
+}
+
+/// Byte ranges covering `bytes`, each ending after a `\n` but the last, about `CHUNK_BYTES`
+/// or more long, at most four per thread.
+fn line_pieces(bytes: &[u8]) -> Vec<std::ops::Range<usize>> {
+    let pieces = (bytes.len() / CHUNK_BYTES).clamp(1, 4 * threads());
+    let target = bytes.len().div_ceil(pieces).max(1);
+    let mut out = Vec::with_capacity(pieces);
+    let mut start = 0;
+    while bytes.len() - start > target {
+        match bytes[start + target..]
+            .iter()
+            .position(|&byte| byte == b'\n')
+        {
+            Some(offset) => {
+                let end = start + target + offset + 1;
+                out.push(start..end);
+                start = end;
+            }
+            None => break,
+        }
+    }
+    out.push(start..bytes.len());
+    out
+}
+
+/// `f(piece)` summed over pieces of `bytes` cut at line ends, in parallel.
+pub(crate) fn sum_over_lines(bytes: &[u8], f: impl Fn(&[u8]) -> u64 + Sync + Send) -> u64 {
+    map(&line_pieces(bytes), |range| f(&bytes[range.clone()]))
+        .into_iter()
+        .sum()
+}
+
+fn parse_chunk(text: &str) -> Option<Chunk> {
+    let mut chunk = Chunk::default();
+    for line in text.split('\n') {
+        // tobj reads lines with `BufRead::lines`, which drops a `\r` before the `\n`.
+        let line = line.strip_suffix('\r').unwrap_or(line);
+        let mut words = line.split_whitespace();
+        match words.next() {
+            None | Some("#") => {}
+            Some("v") => {
+                let mut xyz = [0.0f32; 3];
+                for value in &mut xyz {
+                    *value = words.next()?.parse().ok()?;
+                }
+                if words.next().is_some() {
+                    return None;
+                }
+                chunk.vertices.push(Vec3::from_array(xyz));
+            }
+            Some("f") => {
+                let first = chunk.corners.len();
+                for word in words {
+                    if word.contains('/') {
+                        return None;
+                    }
+                    let index: isize = word.parse().ok()?;
+                    if index == 0 {
+                        return None;
+                    }
+                    chunk.corners.push(index);
+                }
+                let count = chunk.corners.len() - first;
+                if count < 3 {
+                    return None;
+                }
+                chunk.faces.push(Face {
+                    first: first as u32,
+                    count: count as u32,
+                    defined: chunk.vertices.len() as u32,
+                });
+            }
+            Some("vt" | "vn" | "l") => return None,
+            Some("usemtl") => {
+                // tobj refuses a nameless `usemtl`, read this way.
+                if line.split_once(' ').unwrap_or_default().1.trim().is_empty() {
+                    return None;
+                }
+            }
+            // `o`, `g`, `s`, `mtllib` and unknown records change no triangle.
+            Some(_) => {}
+        }
+    }
+    Some(chunk)
+}
+
+/// The chunk's faces as fans of vertex indices of the file; `None` on an index tobj would
+/// refuse or a vertex that is not finite.
+fn triangulate(chunk: &Chunk, base: usize, positions: &[Vec3]) -> Option<Vec<[u32; 3]>> {
+    let mut triangles = Vec::with_capacity(chunk.faces.len());
+    for face in &chunk.faces {
+        let defined = base + face.defined as usize;
+        let resolve = |index: isize| -> Option<u32> {
+            let vertex = if index < 0 {
+                defined.checked_sub(index.unsigned_abs())?
+            } else {
+                index as usize - 1
+            };
+            (vertex < defined && positions[vertex].is_finite()).then_some(vertex as u32)
+        };
+        let corners = &chunk.corners[face.first as usize..(face.first + face.count) as usize];
+        let apex = resolve(corners[0])?;
+        let mut previous = resolve(corners[1])?;
+        for &corner in &corners[2..] {
+            let next = resolve(corner)?;
+            triangles.push([apex, previous, next]);
+            previous = next;
+        }
+    }
+    Some(triangles)
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+fn threads() -> usize {
+    rayon::current_num_threads()
+}
+
+#[cfg(not(target_arch = "wasm32"))]
+fn map<T: Sync, U: Send>(items: &[T], f: impl Fn(&T) -> U + Sync + Send) -> Vec<U> {
+    use rayon::prelude::*;
+    items.par_iter().map(f).collect()
+}
+
+// The browser's module has no threads: the same pieces, one after the other.
+#[cfg(target_arch = "wasm32")]
+fn threads() -> usize {
+    1
+}
+
+#[cfg(target_arch = "wasm32")]
+fn map<T, U>(items: &[T], f: impl Fn(&T) -> U) -> Vec<U> {
+    items.iter().map(f).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// tobj's triangles of `bytes` (the other path of `read_obj`), as coordinates.
+    fn tobj_triangles(bytes: &[u8]) -> Result<Vec<[Vec3; 3]>, String> {
+        let mesh = crate::obj::read_with_tobj(&mut &bytes[..])?;
+        Ok((0..mesh.triangles.len())
+            .map(|i| mesh.triangle(i))
+            .collect())
+    }
+
+    fn bits(triangles: &[[Vec3; 3]]) -> Vec<[u32; 9]> {
+        triangles
+            .iter()
+            .map(|t| {
+                let f = t.map(|v| v.to_array()).concat();
+                std::array::from_fn(|i| f[i].to_bits())
+            })
+            .collect()
+    }
+
+    /// Where the fast path reads a file, its triangles are tobj's bit for bit; where it
+    /// declines, tobj's answer stands. Returns whether it read the file.
+    fn check(name: &str, bytes: &[u8]) -> bool {
+        let expected = tobj_triangles(bytes);
+        match read(bytes) {
+            Some(mesh) => {
+                let ours: Vec<[Vec3; 3]> = (0..mesh.triangles.len())
+                    .map(|i| mesh.triangle(i))
+                    .collect();
+                let expected = expected.unwrap_or_else(|error| {
+                    panic!("{name}: read fast, but tobj refuses it: {error}")
+                });
+                assert_eq!(
+                    bits(&ours),
+                    bits(&expected),
+                    "{name}: triangles differ from tobj's"
+                );
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn obj_files(directory: &std::path::Path, out: &mut Vec<std::path::PathBuf>) {
+        let Ok(entries) = std::fs::read_dir(directory) else {
+            return;
+        };
+        for entry in entries.flatten() {
+            let path = entry.path();
+            if path.is_dir() {
+                obj_files(&path, out);
+            } else if path
+                .extension()
+                .is_some_and(|extension| extension.eq_ignore_ascii_case("obj"))
+            {
+                out.push(path);
+            }
+        }
+    }
+
+    #[test]
+    fn agrees_with_tobj_on_the_shared_meshes() {
+        let shared = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared");
+        let mut files = Vec::new();
+        obj_files(&shared.join("scenes/course"), &mut files);
+        obj_files(&shared.join("models"), &mut files);
+        if files.is_empty() {
+            assert!(
+                std::env::var_os("CI").is_none(),
+                "no OBJ file under {} (CI needs ../shared)",
+                shared.display()
+            );
+            eprintln!("SKIPPED: no ../shared OBJ files");
+            return;
+        }
+        let mut fast = 0;
+        for path in &files {
+            let bytes = std::fs::read(path).unwrap();
+            fast += usize::from(check(&path.display().to_string(), &bytes));
+        }
+        // The course's meshes (the dragon, the bunny, `al.obj`) are plain `v`/`f` files: the
+        // fast path must read them, not decline.
+        let course_fast = files
+            .iter()
+            .filter(|path| path.to_string_lossy().contains("scenes/course"))
+            .all(|path| read(&std::fs::read(path).unwrap()).is_some());
+        assert!(course_fast, "a course mesh fell back to tobj");
+        eprintln!("{fast} of {} OBJ files read by the fast path", files.len());
+    }
+
+    #[test]
+    fn agrees_with_tobj_on_small_and_odd_files() {
+        let cases: &[(&str, bool)] = &[
+            (
+                "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 2 0\nf 1 2 3 4 5\n",
+                true,
+            ),
+            ("v 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf -3 -2 -1\r\n", true),
+            (
+                "# c\n\nv 0 0 0\no a\nv 1 0 0\ng b\ns 1\nv 0 1 0\nusemtl m\nf 1 +2 3\n",
+                true,
+            ),
+            ("v 0 0 0\x0bv 1 0 0\n", false),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n", false),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", false),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -5 1 2\n", false),
+            ("v a b c\nf 1 2 3\n", false),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1/2/3 2/9/9 3//7\n", false),
+            ("f\nv\nvt 1\nvn\n", false),
+            ("v 1e40 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", false),
+            ("v 0 0 0 2\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", false),
+            ("f 1 2 3\nv 0 0 0\nv 1 0 0\nv 0 1 0\n", false),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl\nf 1 2 3\n", false),
+            ("v 0 0 0\nv 1 0 0\nf 1 2\n", false),
+            ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n# caf\u{e9}\n", false),
+        ];
+        for (index, (text, fast)) in cases.iter().enumerate() {
+            let read_fast = check(&format!("case {index}"), text.as_bytes());
+            assert_eq!(read_fast, *fast, "case {index}: {text:?}");
+        }
+    }
+
+    /// Many chunks: faces that name vertices of earlier chunks, relative and absolute.
+    #[test]
+    fn chunks_stitch_across_their_boundaries() {
+        let mut text = String::new();
+        let mut vertices = 0usize;
+        for row in 0..40_000 {
+            text.push_str(&format!("v {row} {}.25 -{}e-3\n", row % 7, row % 13));
+            vertices += 1;
+            if vertices >= 3 && row % 3 == 0 {
+                text.push_str("f -1 -2 -3\n");
+                text.push_str(&format!(
+                    "f {} 1 {} {}\n",
+                    vertices,
+                    vertices / 2 + 1,
+                    vertices - 1
+                ));
+            }
+        }
+        assert!(
+            text.len() > 4 * CHUNK_BYTES,
+            "the test needs several chunks"
+        );
+        assert!(split_at_lines(&text).len() > 1);
+        assert!(check("generated", text.as_bytes()));
+        // The limit's count, summed over pieces, is the triangles made.
+        let made = read(text.as_bytes()).unwrap().triangles.len() as u64;
+        assert_eq!(crate::obj::count_triangles(text.as_bytes()), made);
+    }
+
+    #[test]
+    fn pieces_cover_the_text_and_end_at_line_ends() {
+        let text = "v 1 2 3\n".repeat(200_000);
+        let pieces = split_at_lines(&text);
+        assert_eq!(pieces.concat(), text);
+        assert!(pieces.iter().all(|piece| piece.ends_with('\n')));
+    }
+}
