@@ -249,53 +249,84 @@ mod x86 {
         }
     }
 
-    #[target_feature(enable = "avx2,fma")]
-    #[inline]
-    fn box_ray(p: &BoxPlanes) -> BoxRay {
-        BoxRay {
-            origin: p.origin.map(|c| _mm256_set1_ps(c)),
-            inv_dir: p.inv_dir.map(|c| _mm256_set1_ps(c)),
-            near: p.near,
-            far: p.far,
-            t_min: _mm256_set1_ps(p.t_min),
+    // The single-ray kernels below are `#[inline(always)]` functions without `target_feature`
+    // (rustc forbids the two together): a `target_feature` kernel called from the featureless
+    // `Kernel` methods stayed an out-of-line call in the traversal loop (the profile showed
+    // `node_test` and `block_test` as functions of their own, with the per-ray constants
+    // reloaded from memory at every call). Forced inline into `closest`/`any`, which carry
+    // the features, their intrinsics are compiled for AVX2 there, with the ray's constants
+    // in registers for the whole walk. Hence `unsafe`: they must only be reached from there.
+
+    /// # Safety
+    /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
+    #[inline(always)]
+    unsafe fn box_ray(p: &BoxPlanes) -> BoxRay {
+        // SAFETY: the caller runs with AVX2.
+        unsafe {
+            BoxRay {
+                origin: [
+                    _mm256_set1_ps(p.origin[0]),
+                    _mm256_set1_ps(p.origin[1]),
+                    _mm256_set1_ps(p.origin[2]),
+                ],
+                inv_dir: [
+                    _mm256_set1_ps(p.inv_dir[0]),
+                    _mm256_set1_ps(p.inv_dir[1]),
+                    _mm256_set1_ps(p.inv_dir[2]),
+                ],
+                near: p.near,
+                far: p.far,
+                t_min: _mm256_set1_ps(p.t_min),
+            }
         }
     }
 
     /// The scalar kernel's slab test, eight children at once, same operations in the same
     /// order.
-    #[target_feature(enable = "avx2,fma")]
-    #[inline]
-    fn node_test(node: &WideNode, r: &BoxRay, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
-        let plane = |row: usize| {
-            // SAFETY: each row is 8 f32 inside the 64-byte aligned node, so 32-byte aligned.
-            unsafe { _mm256_load_ps(node.bounds[row].as_ptr()) }
-        };
-        let slab = |row: usize, axis: usize| {
-            _mm256_mul_ps(_mm256_sub_ps(plane(row), r.origin[axis]), r.inv_dir[axis])
-        };
-        let near_x = slab(r.near[0], 0);
-        let near_y = slab(r.near[1], 1);
-        let near_z = slab(r.near[2], 2);
-        let far_x = slab(r.far[0], 0);
-        let far_y = slab(r.far[1], 1);
-        let far_z = slab(r.far[2], 2);
-        // `max_ps(a, b)`/`min_ps(a, b)` return b when either is NaN: with the running value
-        // second, a NaN slab (a ray in a slab plane) leaves it alone, as in the scalar kernel.
-        let t0 = _mm256_max_ps(
-            near_z,
-            _mm256_max_ps(near_y, _mm256_max_ps(near_x, r.t_min)),
-        );
-        let t1 = _mm256_min_ps(
-            far_z,
-            _mm256_min_ps(far_y, _mm256_min_ps(far_x, _mm256_set1_ps(f32::INFINITY))),
-        );
-        let t1 = _mm256_min_ps(
-            _mm256_mul_ps(t1, _mm256_set1_ps(FAR_SCALE)),
-            _mm256_set1_ps(t_max),
-        );
-        // SAFETY: `entry` is 8 f32 (unaligned store).
-        unsafe { _mm256_storeu_ps(entry.as_mut_ptr(), t0) };
-        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+    ///
+    /// # Safety
+    /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
+    #[inline(always)]
+    unsafe fn node_test(node: &WideNode, r: &BoxRay, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
+        // SAFETY: the caller runs with AVX2 and FMA. Each row is 8 f32 inside the 64-byte
+        // aligned node, so 32-byte aligned; `near`/`far` are rows 0 to 5 (`BoxPlanes::new`
+        // makes them `a` or `a + 3` for an axis `a` < 3), so the unchecked row reads are in
+        // bounds; `entry` is 8 f32 (unaligned store).
+        unsafe {
+            macro_rules! slab {
+                ($row:expr, $axis:expr) => {
+                    _mm256_mul_ps(
+                        _mm256_sub_ps(
+                            _mm256_load_ps(node.bounds.get_unchecked($row).as_ptr()),
+                            r.origin[$axis],
+                        ),
+                        r.inv_dir[$axis],
+                    )
+                };
+            }
+            let near_x = slab!(r.near[0], 0);
+            let near_y = slab!(r.near[1], 1);
+            let near_z = slab!(r.near[2], 2);
+            let far_x = slab!(r.far[0], 0);
+            let far_y = slab!(r.far[1], 1);
+            let far_z = slab!(r.far[2], 2);
+            // `max_ps(a, b)`/`min_ps(a, b)` return b when either is NaN: with the running value
+            // second, a NaN slab (a ray in a slab plane) leaves it alone, as in the scalar kernel.
+            let t0 = _mm256_max_ps(
+                near_z,
+                _mm256_max_ps(near_y, _mm256_max_ps(near_x, r.t_min)),
+            );
+            let t1 = _mm256_min_ps(
+                far_z,
+                _mm256_min_ps(far_y, _mm256_min_ps(far_x, _mm256_set1_ps(f32::INFINITY))),
+            );
+            let t1 = _mm256_min_ps(
+                _mm256_mul_ps(t1, _mm256_set1_ps(FAR_SCALE)),
+                _mm256_set1_ps(t_max),
+            );
+            _mm256_storeu_ps(entry.as_mut_ptr(), t0);
+            _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
+        }
     }
 
     /// Returned by `block_test` when some lane has an edge function of exactly zero: those need
@@ -304,85 +335,93 @@ mod x86 {
 
     /// The watertight test of `triangle::intersect` on four lanes: the mask of lanes hit within
     /// [t_min, t_max] and their t (or `ZERO_EDGE`).
-    #[target_feature(enable = "avx2,fma")]
-    #[inline]
-    fn block_test(
+    ///
+    /// # Safety
+    /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
+    #[inline(always)]
+    unsafe fn block_test(
         block: &TriangleBlock,
         ray: &WoopRay,
         t_min: f32,
         t_max: f32,
     ) -> (u32, [f32; BLOCK]) {
-        let load = |corner: usize, axis: usize| {
-            // SAFETY: a row is 4 f32, 16-byte aligned in the 16-byte aligned block.
-            unsafe { _mm_load_ps(block.v[corner][axis].as_ptr()) }
-        };
-        let (kx, ky, kz) = (ray.kx, ray.ky, ray.kz);
-        let ox = _mm_set1_ps(ray.origin[kx]);
-        let oy = _mm_set1_ps(ray.origin[ky]);
-        let oz = _mm_set1_ps(ray.origin[kz]);
-        let sx = _mm_set1_ps(ray.sx);
-        let sy = _mm_set1_ps(ray.sy);
-        let sz = _mm_set1_ps(ray.sz);
-        // `WoopRay::shear`: a = v − o, then x = a[kx] − sx·a[kz], y = a[ky] − sy·a[kz].
-        let shear = |corner: usize| {
-            let ax = _mm_sub_ps(load(corner, kx), ox);
-            let ay = _mm_sub_ps(load(corner, ky), oy);
-            let az = _mm_sub_ps(load(corner, kz), oz);
-            (
-                _mm_sub_ps(ax, _mm_mul_ps(sx, az)),
-                _mm_sub_ps(ay, _mm_mul_ps(sy, az)),
-                az,
-            )
-        };
-        let (ax, ay, az) = shear(0);
-        let (bx, by, bz) = shear(1);
-        let (cx, cy, cz) = shear(2);
-        // `triangle::edge(p, q) = q.x·p.y − q.y·p.x`: U = edge(b, c), V = edge(c, a), W = edge(a, b).
-        let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
-        let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
-        let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
-        let zero = _mm_setzero_ps();
-        let any_zero = _mm_or_ps(
-            _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
-            _mm_cmpeq_ps(w, zero),
-        );
-        if _mm_movemask_ps(any_zero) != 0 {
-            return (ZERO_EDGE, [0.0; BLOCK]);
+        // SAFETY (the whole body): the caller runs with AVX2; a row is 4 f32, 16-byte aligned
+        // in the 16-byte aligned block; `out` is 4 f32 (unaligned store).
+        unsafe {
+            macro_rules! load {
+                ($corner:expr, $axis:expr) => {
+                    _mm_load_ps(block.v[$corner][$axis].as_ptr())
+                };
+            }
+            let (kx, ky, kz) = (ray.kx, ray.ky, ray.kz);
+            let ox = _mm_set1_ps(ray.origin[kx]);
+            let oy = _mm_set1_ps(ray.origin[ky]);
+            let oz = _mm_set1_ps(ray.origin[kz]);
+            let sx = _mm_set1_ps(ray.sx);
+            let sy = _mm_set1_ps(ray.sy);
+            let sz = _mm_set1_ps(ray.sz);
+            // `WoopRay::shear`: a = v − o, then x = a[kx] − sx·a[kz], y = a[ky] − sy·a[kz].
+            macro_rules! shear {
+                ($corner:expr) => {{
+                    let ax = _mm_sub_ps(load!($corner, kx), ox);
+                    let ay = _mm_sub_ps(load!($corner, ky), oy);
+                    let az = _mm_sub_ps(load!($corner, kz), oz);
+                    (
+                        _mm_sub_ps(ax, _mm_mul_ps(sx, az)),
+                        _mm_sub_ps(ay, _mm_mul_ps(sy, az)),
+                        az,
+                    )
+                }};
+            }
+            let (ax, ay, az) = shear!(0);
+            let (bx, by, bz) = shear!(1);
+            let (cx, cy, cz) = shear!(2);
+            // `triangle::edge(p, q) = q.x·p.y − q.y·p.x`: U = edge(b, c), V = edge(c, a), W = edge(a, b).
+            let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
+            let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
+            let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
+            let zero = _mm_setzero_ps();
+            let any_zero = _mm_or_ps(
+                _mm_or_ps(_mm_cmpeq_ps(u, zero), _mm_cmpeq_ps(v, zero)),
+                _mm_cmpeq_ps(w, zero),
+            );
+            if _mm_movemask_ps(any_zero) != 0 {
+                return (ZERO_EDGE, [0.0; BLOCK]);
+            }
+            let negative = _mm_or_ps(
+                _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
+                _mm_cmplt_ps(w, zero),
+            );
+            let positive = _mm_or_ps(
+                _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
+                _mm_cmpgt_ps(w, zero),
+            );
+            let det = _mm_add_ps(_mm_add_ps(u, v), w);
+            // Not on both sides of an edge, and a non-zero (ordered: not NaN) determinant.
+            let valid = _mm_andnot_ps(
+                _mm_and_ps(negative, positive),
+                _mm_cmp_ps::<_CMP_NEQ_OQ>(det, zero),
+            );
+            if _mm_movemask_ps(valid) == 0 {
+                return (0, [0.0; BLOCK]);
+            }
+            let t_scaled = _mm_add_ps(
+                _mm_add_ps(
+                    _mm_mul_ps(u, _mm_mul_ps(sz, az)),
+                    _mm_mul_ps(v, _mm_mul_ps(sz, bz)),
+                ),
+                _mm_mul_ps(w, _mm_mul_ps(sz, cz)),
+            );
+            let t = _mm_div_ps(t_scaled, det);
+            let in_window = _mm_and_ps(
+                _mm_cmp_ps::<_CMP_GE_OQ>(t, _mm_set1_ps(t_min)),
+                _mm_cmp_ps::<_CMP_LE_OQ>(t, _mm_set1_ps(t_max)),
+            );
+            let mask = _mm_movemask_ps(_mm_and_ps(valid, in_window)) as u32;
+            let mut out = [0.0f32; BLOCK];
+            _mm_storeu_ps(out.as_mut_ptr(), t);
+            (mask, out)
         }
-        let negative = _mm_or_ps(
-            _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
-            _mm_cmplt_ps(w, zero),
-        );
-        let positive = _mm_or_ps(
-            _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
-            _mm_cmpgt_ps(w, zero),
-        );
-        let det = _mm_add_ps(_mm_add_ps(u, v), w);
-        // Not on both sides of an edge, and a non-zero (ordered: not NaN) determinant.
-        let valid = _mm_andnot_ps(
-            _mm_and_ps(negative, positive),
-            _mm_cmp_ps::<_CMP_NEQ_OQ>(det, zero),
-        );
-        if _mm_movemask_ps(valid) == 0 {
-            return (0, [0.0; BLOCK]);
-        }
-        let t_scaled = _mm_add_ps(
-            _mm_add_ps(
-                _mm_mul_ps(u, _mm_mul_ps(sz, az)),
-                _mm_mul_ps(v, _mm_mul_ps(sz, bz)),
-            ),
-            _mm_mul_ps(w, _mm_mul_ps(sz, cz)),
-        );
-        let t = _mm_div_ps(t_scaled, det);
-        let in_window = _mm_and_ps(
-            _mm_cmp_ps::<_CMP_GE_OQ>(t, _mm_set1_ps(t_min)),
-            _mm_cmp_ps::<_CMP_LE_OQ>(t, _mm_set1_ps(t_max)),
-        );
-        let mask = _mm_movemask_ps(_mm_and_ps(valid, in_window)) as u32;
-        let mut out = [0.0f32; BLOCK];
-        // SAFETY: `out` is 4 f32 (unaligned store).
-        unsafe { _mm_storeu_ps(out.as_mut_ptr(), t) };
-        (mask, out)
     }
 
     /// # Safety
