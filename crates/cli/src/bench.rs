@@ -40,7 +40,7 @@ pub enum BenchCommand {
     Table(TableArgs),
     /// Trace one ray file on one mesh and print one JSON line (the fields of embree_rays.py).
     Rays(RaysArgs),
-    /// Write the primary, bounce and shadow ray sets of a mesh or scene to .rays files.
+    /// Write the primary, bounce, shadow and random ray sets of a mesh or scene to .rays files.
     MakeRays(MakeRaysArgs),
     /// Packet against single-ray traversal on the same rays, alternating; medians and ratios.
     Packets(PacketsArgs),
@@ -117,6 +117,10 @@ pub struct RaysArgs {
     /// the ray count when it is a square, as for `make-rays` primary rays].
     #[arg(long, value_name = "PIXELS", requires = "packets")]
     pub image_width: Option<u32>,
+    /// Packets of eight consecutive rays whatever the width (8x1 pixel rows of primary rays,
+    /// the packets of `embree_native`'s `rtcIntersect8`).
+    #[arg(long, requires = "packets", conflicts_with = "image_width")]
+    pub consecutive: bool,
 }
 
 #[derive(Args, Debug)]
@@ -150,7 +154,8 @@ pub struct MakeRaysArgs {
     /// Course scene file: its camera and first point light.
     #[arg(long, value_name = "SCENE")]
     pub scene: Option<PathBuf>,
-    /// Output folder; files are NAME.primary.rays, NAME.bounce.rays, NAME.shadow.rays.
+    /// Output folder; files are NAME.primary.rays, NAME.bounce.rays, NAME.shadow.rays and
+    /// NAME.random.rays.
     #[arg(long, value_name = "DIR")]
     pub out_dir: PathBuf,
     #[arg(long, value_name = "PIXELS", default_value_t = 1024)]
@@ -401,11 +406,13 @@ fn rays(args: &RaysArgs) -> Result<(), String> {
     let threads = args.threads.max(1);
     let (scene, build_s) = build(&parts, args.accel.into(), threads)?;
     let packets = args.packets.then(|| {
-        Packets::new(
-            &rays,
+        let width = if args.consecutive {
+            None
+        } else {
             args.image_width
-                .or_else(|| Packets::square_width(rays.len())),
-        )
+                .or_else(|| Packets::square_width(rays.len()))
+        };
+        Packets::new(&rays, width)
     });
     let mode = packets.as_ref().map_or(Mode::Single, Mode::Packets);
     let traced = trace_mode(&scene, &rays, mode, args.occlusion, threads, args.repeat)?;
@@ -430,7 +437,11 @@ fn rays(args: &RaysArgs) -> Result<(), String> {
             AccelArg::Wide => "wide",
             AccelArg::Binary => "binary",
         },
-        if args.packets { "packets" } else { "single" },
+        match (args.packets, args.consecutive) {
+            (false, _) => "single",
+            (true, false) => "packets",
+            (true, true) => "packets8x1",
+        },
         name.replace('"', "'"),
         triangles,
         rays.len(),
@@ -505,6 +516,7 @@ fn write_workload(dir: &Path, name: &str, w: &Workload) -> Result<(), String> {
         ("primary", &w.primary),
         ("bounce", &w.bounce),
         ("shadow", &w.shadow),
+        ("random", &w.random),
     ] {
         let path = dir.join(format!("{name}.{set}.rays"));
         glint_io::write_rays(&path, rays).map_err(|e| e.to_string())?;
@@ -680,8 +692,8 @@ fn packets_compare(args: &PacketsArgs) -> Result<(), String> {
     let threads = args.threads.max(1);
     let rounds = args.rounds.max(1);
     println!(
-        "glint bench packets: {}x{} primary rays in packets of 4x2 pixel blocks, bounce and \
-         shadow rays in packets of 8 consecutive rays; {} thread(s); medians of {} alternating \
+        "glint bench packets: {}x{} primary rays in packets of 4x2 pixel blocks, bounce, \
+         shadow and random rays in packets of 8 consecutive rays; {} thread(s); medians of {} alternating \
          rounds; Mrays/s",
         args.size, args.size, threads, rounds
     );
@@ -705,6 +717,7 @@ fn packets_compare(args: &PacketsArgs) -> Result<(), String> {
             ("primary", &w.primary, false, Some(args.size)),
             ("bounce", &w.bounce, false, None),
             ("shadow", &w.shadow, true, None),
+            ("random", &w.random, false, None),
         ];
         let packets: Vec<Packets> = sets
             .iter()

@@ -6,6 +6,10 @@
 //!   primary hit (what a diffuse path tracer sends next);
 //! - **shadow**: from the same points to a point light (direction = light − origin, so the light
 //!   sits at t = 1; the light is outside the scene's bounds, so nothing lies beyond it).
+//! - **random**: incoherent rays with nothing in common, as many as primary rays: origins
+//!   uniform in the scene's bounding box, directions uniform on the unit sphere (unit length),
+//!   both from `Rng::for_sample(RANDOM_SEED, index, 0)` (ray `index` draws its origin's x, y, z
+//!   then the direction's two numbers), so the set is the same on every machine and run.
 //!
 //! Every ray spans t in [0, ∞), the convention of `../shared/bench/embree_rays.py`'s ray files,
 //! so other engines trace exactly the same queries. Secondary rays start a small distance off
@@ -18,11 +22,14 @@ use crate::camera::{Camera, Projection};
 use crate::geometry::Aabb;
 use crate::math::{Frame, Vec3};
 use crate::ray::Ray;
-use crate::sampling::{sample_cosine_hemisphere, Rng};
+use crate::sampling::{sample_cosine_hemisphere, sample_uniform_sphere, Rng};
 use crate::scene::{Scene, SurfaceNeeds};
 
 /// How far secondary rays start off the surface, relative to the scene's bounding-box diagonal.
 pub const SURFACE_OFFSET: f32 = 1e-4;
+
+/// The seed of the random ray set.
+pub const RANDOM_SEED: u64 = 0x7a2d_0f5e;
 
 /// The three ray sets of one scene.
 #[derive(Clone, Debug, Default)]
@@ -30,6 +37,7 @@ pub struct Workload {
     pub primary: Vec<Ray>,
     pub bounce: Vec<Ray>,
     pub shadow: Vec<Ray>,
+    pub random: Vec<Ray>,
 }
 
 /// A perspective camera looking at the centre of `bounds` from the front-right and a little
@@ -107,14 +115,31 @@ pub fn secondary_rays(
     pairs.into_iter().flatten().unzip()
 }
 
-/// All three sets for `scene` seen through `camera` at `size` x `size` pixels.
+/// `count` rays with origins uniform in `bounds` and directions uniform on the unit sphere,
+/// ray `index` drawn from `Rng::for_sample(seed, index, 0)`: origin x, y, z, then direction.
+pub fn random_rays(bounds: Aabb, count: usize, seed: u64) -> Vec<Ray> {
+    let extent = bounds.max - bounds.min;
+    (0..count)
+        .map(|index| {
+            let mut rng = Rng::for_sample(seed, index as u64, 0);
+            let (x, y, z) = (rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let origin = bounds.min + Vec3::new(x * extent.x, y * extent.y, z * extent.z);
+            let direction = sample_uniform_sphere(rng.next_f32(), rng.next_f32());
+            Ray::new(origin, direction)
+        })
+        .collect()
+}
+
+/// All four sets for `scene` seen through `camera` at `size` x `size` pixels.
 pub fn workload(scene: &Scene, camera: &Camera, size: u32, light: Vec3) -> Workload {
     let primary = primary_rays(camera, size, size);
     let (bounce, shadow) = secondary_rays(scene, &primary, light, 0x5eed);
+    let random = random_rays(scene.bounds(), primary.len(), RANDOM_SEED);
     Workload {
         primary,
         bounce,
         shadow,
+        random,
     }
 }
 
