@@ -7,7 +7,6 @@ pub mod warp;
 
 pub use warp::*;
 
-
 /// PCG32 (O'Neill, XSH-RR variant): small state, good statistics, portable.
 #[derive(Clone, Debug)]
 pub struct Rng {
@@ -32,8 +31,19 @@ impl Rng {
     /// The stream of one pixel sample: keyed by a hash of all three so neighbouring pixels
     /// and samples are decorrelated.
     pub fn for_sample(seed: u64, pixel: u64, sample: u64) -> Rng {
-        let key =
-            mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel.wrapping_mul(0xff51_afd7_ed55_8ccd));
+        Rng::for_pixel_sample(Rng::pixel_key(seed, pixel), sample)
+    }
+
+    /// What `for_sample` derives from the seed and the pixel alone: computed once per pixel
+    /// by samplers that draw many samples of it.
+    #[inline]
+    pub fn pixel_key(seed: u64, pixel: u64) -> u64 {
+        mix64(mix64(seed ^ 0x9e37_79b9_7f4a_7c15) ^ pixel.wrapping_mul(0xff51_afd7_ed55_8ccd))
+    }
+
+    /// `for_sample(seed, pixel, sample)` given `pixel_key(seed, pixel)`.
+    #[inline]
+    pub fn for_pixel_sample(key: u64, sample: u64) -> Rng {
         Rng::new(mix64(key ^ sample.wrapping_mul(0xc4ce_b9fe_1a85_ec53)), key)
     }
 
@@ -70,4 +80,3 @@ pub fn mix64(mut z: u64) -> u64 {
     z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
     z ^ (z >> 31)
 }
-

@@ -40,18 +40,38 @@ impl PathSampler for Rng {
 pub const QMC_DIMENSIONS: u32 = 32;
 
 /// What all the samples of one pixel share: each dimension's hash, which seeds the shuffle of
-/// the sample index and the scrambling. Computed once per pixel (`SobolPixel::new`), then
+/// the sample index and the scrambling, with everything the shuffle derives from it alone, and
+/// the key of the samples' PCG streams. Computed once per pixel (`SobolPixel::new`), then
 /// `sampler` hands out each sample's `SobolSampler`.
 #[derive(Clone, Debug)]
 pub struct SobolPixel {
-    seed: u64,
-    pixel: u64,
+    /// `Rng::pixel_key(seed, pixel)`.
+    rng_key: u64,
     sample_count: u32,
     /// The smallest all-ones mask covering `sample_count - 1` (`permute`'s `w`).
     mask: u32,
-    hashes: [u64; QMC_DIMENSIONS as usize],
-    /// Per dimension, the permutation seed (`hash as u32`) modulo the sample count.
-    seeds_mod_count: [u32; QMC_DIMENSIONS as usize],
+    /// Whether `sample_count` is a power of two: then `mask` is `sample_count - 1`, the
+    /// shuffle never walks a cycle again and its final modulo is a mask.
+    power_of_two: bool,
+    dimensions: [DimensionSeeds; QMC_DIMENSIONS as usize],
+}
+
+/// One dimension's hash as the shuffle (`permute_with`) and the scrambler use it: the
+/// permutation seed's shifts and its seed-dependent multiplier folded into the constant that
+/// follows it (`(i · a) · b = i · (a · b)` modulo 2³²).
+#[derive(Clone, Copy, Debug, Default)]
+struct DimensionSeeds {
+    /// `hash as u32`: the permutation seed, and the second dimension's scrambling seed.
+    seed: u32,
+    /// `(hash >> 32) as u32`: the first dimension's scrambling seed.
+    scramble_first: u32,
+    seed_16: u32,
+    seed_8: u32,
+    seed_23: u32,
+    /// `(1 | seed >> 27) · 0x6935_fa69`.
+    multiplier: u32,
+    /// `seed % sample_count`.
+    seed_mod_count: u32,
 }
 
 impl SobolPixel {
@@ -60,16 +80,31 @@ impl SobolPixel {
         let pixel_key =
             mix64(mix64(seed ^ 0x5851_f42d_4c95_7f2d) ^ pixel.wrapping_mul(0x2545_f491_4f6c_dd1d));
         let sample_count = sample_count.max(1);
-        let hashes: [u64; QMC_DIMENSIONS as usize] = std::array::from_fn(|dimension| {
-            mix64(pixel_key ^ (dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15))
+        let power_of_two = sample_count.is_power_of_two();
+        let dimensions = std::array::from_fn(|dimension| {
+            let hash =
+                mix64(pixel_key ^ (dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+            let seed = hash as u32;
+            DimensionSeeds {
+                seed,
+                scramble_first: (hash >> 32) as u32,
+                seed_16: seed >> 16,
+                seed_8: seed >> 8,
+                seed_23: seed >> 23,
+                multiplier: (1 | seed >> 27).wrapping_mul(0x6935_fa69),
+                seed_mod_count: if power_of_two {
+                    seed & (sample_count - 1)
+                } else {
+                    seed % sample_count
+                },
+            }
         });
         SobolPixel {
-            seed,
-            pixel,
+            rng_key: Rng::pixel_key(seed, pixel),
             sample_count,
             mask: permute_mask(sample_count),
-            hashes,
-            seeds_mod_count: hashes.map(|hash| hash as u32 % sample_count),
+            power_of_two,
+            dimensions,
         }
     }
 
@@ -77,9 +112,49 @@ impl SobolPixel {
     #[inline]
     pub fn sampler(&self, sample_index: u32) -> SobolSampler<'_> {
         SobolSampler {
-            rng: Rng::for_sample(self.seed, self.pixel, sample_index as u64),
+            rng: None,
             pixel: self,
             sample_index,
+        }
+    }
+
+    /// `permute_with(i, n, w, seed, seed % n)` for this pixel's n and a dimension's seeds.
+    #[inline(always)]
+    fn shuffle(&self, mut i: u32, seeds: &DimensionSeeds) -> u32 {
+        let (n, w) = (self.sample_count, self.mask);
+        loop {
+            i ^= seeds.seed;
+            i = i.wrapping_mul(0xe170_893d);
+            i ^= seeds.seed_16;
+            i ^= (i & w) >> 4;
+            i ^= seeds.seed_8;
+            i = i.wrapping_mul(0x0929_eb3f);
+            i ^= seeds.seed_23;
+            i ^= (i & w) >> 1;
+            i = i.wrapping_mul(seeds.multiplier);
+            i ^= (i & w) >> 11;
+            i = i.wrapping_mul(0x74dc_b303);
+            i ^= (i & w) >> 2;
+            i = i.wrapping_mul(0x9e50_1cc3);
+            i ^= (i & w) >> 2;
+            i = i.wrapping_mul(0xc860_a3df);
+            i &= w;
+            i ^= i >> 5;
+            // With n a power of two, i ≤ w = n − 1 here; and since n divides 2³², the final
+            // (i + seed) mod 2³² mod n is a mask (n = 1 included: w = 0).
+            if self.power_of_two {
+                return i.wrapping_add(seeds.seed) & w;
+            }
+            if i < n {
+                break;
+            }
+        }
+        match i.overflowing_add(seeds.seed) {
+            (wrapped, true) => wrapped,
+            (_, false) => {
+                let sum = i as u64 + seeds.seed_mod_count as u64;
+                (if sum >= n as u64 { sum - n as u64 } else { sum }) as u32
+            }
         }
     }
 }
@@ -87,26 +162,28 @@ impl SobolPixel {
 /// Owen-scrambled, index-padded Sobol' samples for one pixel sample (module docs).
 #[derive(Clone, Debug)]
 pub struct SobolSampler<'a> {
-    rng: Rng,
+    /// The sample's PCG stream, made on the first draw beyond `QMC_DIMENSIONS` (most paths
+    /// never get there).
+    rng: Option<Rng>,
     pixel: &'a SobolPixel,
     sample_index: u32,
 }
 
 impl SobolSampler<'_> {
-    /// The shuffled index into the Sobol' sequence and the scrambling seed of a dimension
-    /// (below `QMC_DIMENSIONS`).
+    /// The shuffled index into the Sobol' sequence and the seeds of a dimension (below
+    /// `QMC_DIMENSIONS`).
+    #[inline(always)]
+    fn index_and_seeds(&self, dimension: u32) -> (u32, &DimensionSeeds) {
+        let seeds = &self.pixel.dimensions[dimension as usize];
+        (self.pixel.shuffle(self.sample_index, seeds), seeds)
+    }
+
+    /// The sample's PCG stream (`Rng::for_sample(seed, pixel, sample_index)`).
     #[inline]
-    fn index_and_hash(&self, dimension: u32) -> (u32, u64) {
-        let pixel = self.pixel;
-        let hash = pixel.hashes[dimension as usize];
-        let index = permute_with(
-            self.sample_index,
-            pixel.sample_count,
-            pixel.mask,
-            hash as u32,
-            pixel.seeds_mod_count[dimension as usize],
-        );
-        (index, hash)
+    fn rng(&mut self) -> &mut Rng {
+        let (key, sample) = (self.pixel.rng_key, self.sample_index as u64);
+        self.rng
+            .get_or_insert_with(|| Rng::for_pixel_sample(key, sample))
     }
 }
 
@@ -162,20 +239,21 @@ impl PathSampler for SobolSampler<'_> {
     #[inline(always)]
     fn sample_1d(&mut self, dimension: u32) -> f32 {
         if dimension >= QMC_DIMENSIONS {
-            return self.rng.next_f32();
+            return self.rng().next_f32();
         }
-        let (index, hash) = self.index_and_hash(dimension);
-        unit_float(owen_hash(index, (hash >> 32) as u32).reverse_bits())
+        let (index, seeds) = self.index_and_seeds(dimension);
+        unit_float(owen_hash(index, seeds.scramble_first).reverse_bits())
     }
 
     #[inline(always)]
     fn sample_2d(&mut self, dimension: u32) -> (f32, f32) {
         if dimension >= QMC_DIMENSIONS {
-            return (self.rng.next_f32(), self.rng.next_f32());
+            let rng = self.rng();
+            return (rng.next_f32(), rng.next_f32());
         }
-        let (index, hash) = self.index_and_hash(dimension);
-        let first = owen_hash(index, (hash >> 32) as u32);
-        let second = owen_hash(sobol_second_dimension_reversed(index), hash as u32);
+        let (index, seeds) = self.index_and_seeds(dimension);
+        let first = owen_hash(index, seeds.scramble_first);
+        let second = owen_hash(sobol_second_dimension_reversed(index), seeds.seed);
         // Both reversed at once: reversing the 64 bits (first, second) gives (second', first').
         let reversed = ((first as u64) << 32 | second as u64).reverse_bits();
         (
@@ -198,6 +276,10 @@ pub fn sobol_second_dimension(index: u32) -> u32 {
 /// of v_k over the set bits k of the index, so it is looked up a byte of the index at a time.
 #[inline]
 fn sobol_second_dimension_reversed(index: u32) -> u32 {
+    if index < 256 {
+        // Up to 256 samples per pixel, one byte: the other three tables give 0.
+        return SOBOL_SECOND_DIMENSION[0][index as usize];
+    }
     let [b0, b1, b2, b3] = index.to_le_bytes();
     SOBOL_SECOND_DIMENSION[0][b0 as usize]
         ^ SOBOL_SECOND_DIMENSION[1][b1 as usize]
@@ -350,6 +432,37 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn pixel_shuffle_matches_permute_with() {
+        let mut rng = Rng::new(13, 1);
+        for n in (1..=70).chain([127, 128, 129, 256, 1000, 1024, 4096, 65_537]) {
+            for pixel in 0..8 {
+                let sobol = SobolPixel::new(rng.next_u32() as u64, pixel, n);
+                for seeds in &sobol.dimensions {
+                    let w = permute_mask(n);
+                    for i in (0..n.min(64)).chain((0..16).map(|_| rng.below(n))) {
+                        let expected = permute_with(i, n, w, seeds.seed, seeds.seed % n);
+                        assert_eq!(sobol.shuffle(i, seeds), expected, "i {i} n {n}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn pixel_rng_is_the_sample_stream() {
+        // Beyond the Sobol' dimensions, the sample's own PCG stream, in call order.
+        let sobol = SobolPixel::new(3, 41, 16);
+        let mut sampler = sobol.sampler(5);
+        let mut rng = Rng::for_sample(3, 41, 5);
+        assert_eq!(sampler.sample_1d(QMC_DIMENSIONS), rng.next_f32());
+        assert_eq!(
+            sampler.sample_2d(QMC_DIMENSIONS + 4),
+            (rng.next_f32(), rng.next_f32())
+        );
+        assert_eq!(sampler.sample_1d(QMC_DIMENSIONS + 1), rng.next_f32());
     }
 
     #[test]
