@@ -42,7 +42,7 @@ not_run_reason() {
   case "$1" in
     "cargo test --workspace"* | scripts/test-all.sh*) echo "the test suite itself (CI runs it)" ;;
     *"-- bench table"*) echo "a benchmark of several minutes" ;;
-    bench/embree_compare.sh*) echo "needs Embree 4 (see bench/README.md)" ;;
+    bench/embree_compare.sh*) echo "needs native Embree 3, libembree-dev (see bench/README.md)" ;;
     farm/slurm/submit.sh*) echo "needs a Slurm cluster (farm/ci.sh test starts one and runs it)" ;;
     *"npm run serve"*) echo "serves the page until stopped (web/ci.sh test serves and tests it)" ;;
     bench/cornell_vs_mitsuba.py*) echo "needs Mitsuba 3 (see bench/README.md)" ;;
