@@ -84,8 +84,12 @@ def test_the_gil_is_released_while_rendering():
     assert count > 100_000 * elapsed
 
 
+# The child restores Python's own SIGINT handler: a process started in the background by a
+# non-interactive shell (as a CI job may be) inherits SIGINT ignored, and Python then installs no
+# KeyboardInterrupt at all; an interactive session always has it.
 CHILD = r"""
-import sys, time, glint
+import signal, sys, time, glint
+signal.signal(signal.SIGINT, signal.default_int_handler)
 scene = glint.load_scene(sys.argv[1])
 def progress(fraction):
     print(f"progress {fraction} {time.perf_counter()}", flush=True)
