@@ -63,7 +63,7 @@ pub fn permute(i: u32, n: u32, seed: u32) -> u32 {
     if n <= 1 {
         return 0;
     }
-    crate::sampling::sobol::permute_with(i, n, crate::sampling::sobol::permute_mask(n), seed, seed % n)
+    crate::sampling::sobol::Permutation::new(n, seed).apply(i)
 }
 
 /// Mirror reflection of direction `d` about unit normal `n`: r = d − 2(d·n)n (slide001 p.105).

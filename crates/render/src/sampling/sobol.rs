@@ -47,91 +47,78 @@ pub const QMC_DIMENSIONS: u32 = 32;
 pub struct SobolPixel {
     /// `Rng::pixel_key(seed, pixel)`.
     rng_key: u64,
-    sample_count: u32,
-    /// The smallest all-ones mask covering `sample_count - 1` (`permute`'s `w`).
-    mask: u32,
-    /// Whether `sample_count` is a power of two: then `mask` is `sample_count - 1`, the
-    /// shuffle never walks a cycle again and its final modulo is a mask.
-    power_of_two: bool,
     dimensions: [DimensionSeeds; QMC_DIMENSIONS as usize],
 }
 
-/// One dimension's hash as the shuffle (`permute_with`) and the scrambler use it: the
-/// permutation seed's shifts and its seed-dependent multiplier folded into the constant that
-/// follows it (`(i · a) · b = i · (a · b)` modulo 2³²).
+/// One dimension's hash as the shuffle and the scrambler use it.
 #[derive(Clone, Copy, Debug, Default)]
 struct DimensionSeeds {
-    /// `hash as u32`: the permutation seed, and the second dimension's scrambling seed.
-    seed: u32,
+    /// The shuffle of the sample index, seeded by `hash as u32` (also the second dimension's
+    /// scrambling seed: `permutation.seed`).
+    permutation: Permutation,
     /// `(hash >> 32) as u32`: the first dimension's scrambling seed.
     scramble_first: u32,
+}
+
+/// Kensler's hash-based permutation of 0..n (Correlated Multi-Jittered Sampling, 2013) for one
+/// (n, seed), with everything that depends on them alone computed once: the mask `w`, the
+/// seed's shifts, its multiplier folded into the constant that follows it (`(i · a) · b =
+/// i · (a · b)` modulo 2³²) and `seed mod n`, so that applying it costs no division. The
+/// course integrator's `permute` and the Sobol' sampler's index shuffle are this one function.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct Permutation {
+    n: u32,
+    /// The smallest all-ones mask covering n − 1.
+    w: u32,
+    /// Whether n is a power of two: then w = n − 1, no cycle is walked again and the final
+    /// modulo is a mask.
+    power_of_two: bool,
+    seed: u32,
     seed_16: u32,
     seed_8: u32,
     seed_23: u32,
     /// `(1 | seed >> 27) · 0x6935_fa69`.
     multiplier: u32,
-    /// `seed % sample_count`.
-    seed_mod_count: u32,
+    seed_mod_n: u32,
 }
 
-impl SobolPixel {
-    /// Pixel `pixel` (row-major index) rendered with `sample_count` samples.
-    pub fn new(seed: u64, pixel: u64, sample_count: u32) -> SobolPixel {
-        let pixel_key =
-            mix64(mix64(seed ^ 0x5851_f42d_4c95_7f2d) ^ pixel.wrapping_mul(0x2545_f491_4f6c_dd1d));
-        let sample_count = sample_count.max(1);
-        let power_of_two = sample_count.is_power_of_two();
-        let dimensions = std::array::from_fn(|dimension| {
-            let hash =
-                mix64(pixel_key ^ (dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
-            let seed = hash as u32;
-            DimensionSeeds {
-                seed,
-                scramble_first: (hash >> 32) as u32,
-                seed_16: seed >> 16,
-                seed_8: seed >> 8,
-                seed_23: seed >> 23,
-                multiplier: (1 | seed >> 27).wrapping_mul(0x6935_fa69),
-                seed_mod_count: if power_of_two {
-                    seed & (sample_count - 1)
-                } else {
-                    seed % sample_count
-                },
-            }
-        });
-        SobolPixel {
-            rng_key: Rng::pixel_key(seed, pixel),
-            sample_count,
-            mask: permute_mask(sample_count),
+impl Permutation {
+    /// The permutation of 0..n chosen by `seed`; n ≥ 1.
+    pub(crate) fn new(n: u32, seed: u32) -> Permutation {
+        debug_assert!(n >= 1);
+        let power_of_two = n.is_power_of_two();
+        Permutation {
+            n,
+            w: permute_mask(n),
             power_of_two,
-            dimensions,
+            seed,
+            seed_16: seed >> 16,
+            seed_8: seed >> 8,
+            seed_23: seed >> 23,
+            multiplier: (1 | seed >> 27).wrapping_mul(0x6935_fa69),
+            seed_mod_n: if power_of_two {
+                seed & (n - 1)
+            } else {
+                seed % n
+            },
         }
     }
 
-    /// The sampler of sample `sample_index` (below the pixel's sample count).
-    #[inline]
-    pub fn sampler(&self, sample_index: u32) -> SobolSampler<'_> {
-        SobolSampler {
-            rng: None,
-            pixel: self,
-            sample_index,
-        }
-    }
-
-    /// `permute_with(i, n, w, seed, seed % n)` for this pixel's n and a dimension's seeds.
+    /// The image of i < n: Kensler's rounds, cycle-walking until below n, then
+    /// `(i + seed) mod 2³² mod n` without a division.
     #[inline(always)]
-    fn shuffle(&self, mut i: u32, seeds: &DimensionSeeds) -> u32 {
-        let (n, w) = (self.sample_count, self.mask);
+    pub(crate) fn apply(&self, mut i: u32) -> u32 {
+        let (n, w) = (self.n, self.w);
         loop {
-            i ^= seeds.seed;
+            i ^= self.seed;
             i = i.wrapping_mul(0xe170_893d);
-            i ^= seeds.seed_16;
+            i ^= self.seed_16;
             i ^= (i & w) >> 4;
-            i ^= seeds.seed_8;
+            i ^= self.seed_8;
             i = i.wrapping_mul(0x0929_eb3f);
-            i ^= seeds.seed_23;
+            i ^= self.seed_23;
             i ^= (i & w) >> 1;
-            i = i.wrapping_mul(seeds.multiplier);
+            i = i.wrapping_mul(self.multiplier);
             i ^= (i & w) >> 11;
             i = i.wrapping_mul(0x74dc_b303);
             i ^= (i & w) >> 2;
@@ -143,18 +130,50 @@ impl SobolPixel {
             // With n a power of two, i ≤ w = n − 1 here; and since n divides 2³², the final
             // (i + seed) mod 2³² mod n is a mask (n = 1 included: w = 0).
             if self.power_of_two {
-                return i.wrapping_add(seeds.seed) & w;
+                return i.wrapping_add(self.seed) & w;
             }
             if i < n {
                 break;
             }
         }
-        match i.overflowing_add(seeds.seed) {
+        match i.overflowing_add(self.seed) {
+            // Past 2³², the wrapped sum is below i, so below n already.
             (wrapped, true) => wrapped,
             (_, false) => {
-                let sum = i as u64 + seeds.seed_mod_count as u64;
+                let sum = i as u64 + self.seed_mod_n as u64;
                 (if sum >= n as u64 { sum - n as u64 } else { sum }) as u32
             }
+        }
+    }
+}
+
+impl SobolPixel {
+    /// Pixel `pixel` (row-major index) rendered with `sample_count` samples.
+    pub fn new(seed: u64, pixel: u64, sample_count: u32) -> SobolPixel {
+        let pixel_key =
+            mix64(mix64(seed ^ 0x5851_f42d_4c95_7f2d) ^ pixel.wrapping_mul(0x2545_f491_4f6c_dd1d));
+        let sample_count = sample_count.max(1);
+        let dimensions = std::array::from_fn(|dimension| {
+            let hash =
+                mix64(pixel_key ^ (dimension as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
+            DimensionSeeds {
+                permutation: Permutation::new(sample_count, hash as u32),
+                scramble_first: (hash >> 32) as u32,
+            }
+        });
+        SobolPixel {
+            rng_key: Rng::pixel_key(seed, pixel),
+            dimensions,
+        }
+    }
+
+    /// The sampler of sample `sample_index` (below the pixel's sample count).
+    #[inline]
+    pub fn sampler(&self, sample_index: u32) -> SobolSampler<'_> {
+        SobolSampler {
+            rng: None,
+            pixel: self,
+            sample_index,
         }
     }
 }
@@ -175,7 +194,7 @@ impl SobolSampler<'_> {
     #[inline(always)]
     fn index_and_seeds(&self, dimension: u32) -> (u32, &DimensionSeeds) {
         let seeds = &self.pixel.dimensions[dimension as usize];
-        (self.pixel.shuffle(self.sample_index, seeds), seeds)
+        (seeds.permutation.apply(self.sample_index), seeds)
     }
 
     /// The sample's PCG stream (`Rng::for_sample(seed, pixel, sample_index)`).
@@ -187,52 +206,11 @@ impl SobolSampler<'_> {
     }
 }
 
-/// `integrator::permute`'s `w` for n: the smallest all-ones mask covering n − 1.
-pub(crate) fn permute_mask(n: u32) -> u32 {
+/// `Permutation`'s `w` for n: the smallest all-ones mask covering n − 1.
+fn permute_mask(n: u32) -> u32 {
     u32::MAX
         .checked_shr(n.saturating_sub(1).leading_zeros())
         .unwrap_or(0)
-}
-
-/// `integrator::permute(i, n, seed)` for i < n, given the mask `w` of n and `seed % n` (what
-/// depends only on the pixel and the dimension), so that no sample pays for them: the same
-/// rounds, and the final `(i + seed) mod 2³² mod n` without a division.
-#[inline]
-pub(crate) fn permute_with(mut i: u32, n: u32, w: u32, seed: u32, seed_mod_n: u32) -> u32 {
-    if n <= 1 {
-        return 0;
-    }
-    loop {
-        i ^= seed;
-        i = i.wrapping_mul(0xe170_893d);
-        i ^= seed >> 16;
-        i ^= (i & w) >> 4;
-        i ^= seed >> 8;
-        i = i.wrapping_mul(0x0929_eb3f);
-        i ^= seed >> 23;
-        i ^= (i & w) >> 1;
-        i = i.wrapping_mul(1 | seed >> 27);
-        i = i.wrapping_mul(0x6935_fa69);
-        i ^= (i & w) >> 11;
-        i = i.wrapping_mul(0x74dc_b303);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0x9e50_1cc3);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0xc860_a3df);
-        i &= w;
-        i ^= i >> 5;
-        if i < n {
-            break;
-        }
-    }
-    match i.overflowing_add(seed) {
-        // Past 2³², the wrapped sum is below i, so below n already.
-        (wrapped, true) => wrapped,
-        (_, false) => {
-            let sum = i as u64 + seed_mod_n as u64;
-            (if sum >= n as u64 { sum - n as u64 } else { sum }) as u32
-        }
-    }
 }
 
 impl PathSampler for SobolSampler<'_> {
@@ -253,7 +231,7 @@ impl PathSampler for SobolSampler<'_> {
         }
         let (index, seeds) = self.index_and_seeds(dimension);
         let first = owen_hash(index, seeds.scramble_first);
-        let second = owen_hash(sobol_second_dimension_reversed(index), seeds.seed);
+        let second = owen_hash(sobol_second_dimension_reversed(index), seeds.permutation.seed);
         // Both reversed at once: reversing the 64 bits (first, second) gives (second', first').
         let reversed = ((first as u64) << 32 | second as u64).reverse_bits();
         (
@@ -380,7 +358,7 @@ mod tests {
     }
 
     /// Kensler's permutation as the paper writes it (with its final modulo), the reference
-    /// for the division-free `permute_with`.
+    /// for the division-free `Permutation`.
     fn kensler_permute(mut i: u32, n: u32, seed: u32) -> u32 {
         let w = permute_mask(n);
         loop {
@@ -435,16 +413,16 @@ mod tests {
     }
 
     #[test]
-    fn pixel_shuffle_matches_permute_with() {
+    fn pixel_shuffle_matches_kensler() {
         let mut rng = Rng::new(13, 1);
         for n in (1..=70).chain([127, 128, 129, 256, 1000, 1024, 4096, 65_537]) {
             for pixel in 0..8 {
                 let sobol = SobolPixel::new(rng.next_u32() as u64, pixel, n);
                 for seeds in &sobol.dimensions {
-                    let w = permute_mask(n);
+                    let p = &seeds.permutation;
                     for i in (0..n.min(64)).chain((0..16).map(|_| rng.below(n))) {
-                        let expected = permute_with(i, n, w, seeds.seed, seeds.seed % n);
-                        assert_eq!(sobol.shuffle(i, seeds), expected, "i {i} n {n}");
+                        let expected = kensler_permute(i, n, p.seed);
+                        assert_eq!(p.apply(i), expected, "i {i} n {n}");
                     }
                 }
             }
