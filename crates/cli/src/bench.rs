@@ -19,6 +19,7 @@ use std::time::Instant;
 
 use clap::{Args, Subcommand, ValueEnum};
 use glint_render::accel::instances::AccelKind;
+use glint_render::accel::wide::WalkCounts;
 use glint_render::accel::workload::{self, Workload};
 use glint_render::accel::PACKET;
 use glint_render::{Aabb, Camera, Light, Ray, Scene, SceneParts, Vec3};
@@ -109,6 +110,11 @@ pub struct RaysArgs {
     pub write_t: Option<PathBuf>,
     #[arg(long, value_enum, default_value_t = AccelArg::Wide)]
     pub accel: AccelArg,
+    /// Also count the walk (untimed, a separate counting traversal of the wide BVH): inner
+    /// nodes visited and triangle blocks tested per ray, printed as `nodes_per_ray` and
+    /// `blocks_per_ray`
+    #[arg(long)]
+    pub count: bool,
     /// Trace in packets of eight rays (`Scene::intersect_packet`): 4x2 pixel blocks of an image
     /// `--image-width` pixels wide, or eight consecutive rays where the width is unknown.
     #[arg(long)]
@@ -424,6 +430,20 @@ fn rays(args: &RaysArgs) -> Result<(), String> {
         };
         glint_io::write_hit_distances(path, &t).map_err(|e| e.to_string())?;
     }
+    let counts = if args.count {
+        let mut counts = WalkCounts::default();
+        for ray in &rays {
+            scene.instances().count_closest(ray, &mut counts);
+        }
+        let per_ray = |n: u64| n as f64 / rays.len().max(1) as f64;
+        format!(
+            ", \"nodes_per_ray\": {:.3}, \"blocks_per_ray\": {:.3}",
+            per_ray(counts.nodes),
+            per_ray(counts.blocks)
+        )
+    } else {
+        String::new()
+    };
     let name = args
         .mesh
         .file_name()
@@ -432,7 +452,7 @@ fn rays(args: &RaysArgs) -> Result<(), String> {
     println!(
         "{{\"engine\": \"glint\", \"accel\": \"{}\", \"traversal\": \"{}\", \"mesh\": \"{}\", \
          \"triangles\": {}, \"rays\": {}, \"threads\": {}, \"query\": \"{}\", \"build_s\": {:.4}, \
-         \"best_s\": {:.4}, \"median_s\": {:.4}, \"mrays_per_s\": {:.3}, \"hits\": {}}}",
+         \"best_s\": {:.4}, \"median_s\": {:.4}, \"mrays_per_s\": {:.3}, \"hits\": {}{}}}",
         match args.accel {
             AccelArg::Wide => "wide",
             AccelArg::Binary => "binary",
@@ -455,7 +475,8 @@ fn rays(args: &RaysArgs) -> Result<(), String> {
         traced.best(),
         traced.median(),
         rays.len() as f64 / traced.best() / 1e6,
-        traced.hits
+        traced.hits,
+        counts
     );
     Ok(())
 }
