@@ -14,20 +14,28 @@ impl WideBvh {
     /// first, so the answer depends neither on the traversal order nor on the structure.
     #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<LocalHit> {
-        let (t, primitive) = self.intersect_preliminary(ray)?;
-        Some(self.finish(ray, t, primitive))
+        match self.isa {
+            // Checks the ray itself (on its own copy of it, see `simd::closest`).
+            Isa::Avx2(avx2) => simd::closest(avx2, self, ray),
+            Isa::Scalar => self.closest_scalar(ray),
+        }
     }
 
-    /// `intersect` without the barycentrics: (t, primitive). `finish` adds them.
-    #[inline]
-    pub fn intersect_preliminary(&self, ray: &Ray) -> Option<(f32, u32)> {
+    /// The scalar kernel's closest hit, out of line: inlined, its zeroed 3 KB stack made
+    /// `intersect` save registers and reserve the frame on every call, also on the AVX2 path.
+    #[inline(never)]
+    fn closest_scalar(&self, ray: &Ray) -> Option<LocalHit> {
         if !ray_is_valid(ray) {
             return None;
         }
-        match self.isa {
-            Isa::Avx2(avx2) => simd::closest(avx2, self, ray),
-            Isa::Scalar => closest(&ScalarKernel, self, ray, &mut ArrayStack::new()),
-        }
+        closest(&ScalarKernel, self, ray, &mut ArrayStack::new())
+    }
+
+    /// `intersect` without the barycentrics: (t, primitive). `finish` adds them (the same
+    /// values `intersect` reports).
+    #[inline]
+    pub fn intersect_preliminary(&self, ray: &Ray) -> Option<(f32, u32)> {
+        self.intersect(ray).map(|h| (h.t, h.primitive))
     }
 
     /// True when any primitive meets the ray with t in `[ray.t_min, ray.t_max]`.

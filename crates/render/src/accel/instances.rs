@@ -146,7 +146,7 @@ impl Geometry {
     /// the binary reference).
     fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<(f32, u32)> {
         match &self.blas {
-            Blas::Wide(bvh) => bvh.count_closest(ray, counts),
+            Blas::Wide(bvh) => bvh.count_closest(ray, counts).map(|h| (h.t, h.primitive)),
             Blas::Binary { .. } => self.intersect_preliminary(ray),
         }
     }

@@ -33,7 +33,7 @@
 
 use crate::accel::triangle::WoopRay;
 use crate::accel::wide::{
-    self, ArrayStack, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, TriangleBlock, WideBvh,
+    self, ArrayStack, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, TriangleBlock, WideBvh,
     WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
 };
 use crate::ray::Ray;
@@ -300,8 +300,8 @@ pub(crate) trait PacketKernel {
     ) -> u32;
     /// The rays of `lanes` that meet any triangle of the block within their window.
     fn block_any(&self, block: &TriangleBlock, p: &PacketRays, lanes: u32) -> u32;
-    /// The kernel's single-ray closest hit, (t, primitive) (`wide::closest`).
-    fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)>;
+    /// The kernel's single-ray closest hit (`wide::closest`).
+    fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit>;
     /// The kernel's single-ray any hit (`wide::any`).
     fn single_any(&self, bvh: &WideBvh, ray: &Ray) -> bool;
     /// The barycentrics `WideBvh::finish` reports, for the rays whose closest hit `prim` is a
@@ -456,7 +456,9 @@ impl PacketKernel for ScalarPacketKernel {
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
-            if let Some((k, th)) = ScalarKernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l]) {
+            if let Some(BlockHit { lane: k, t: th, .. }) =
+                ScalarKernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l])
+            {
                 lane[l] = k as u8;
                 t.0[l] = th;
                 hits |= 1 << l;
@@ -480,7 +482,7 @@ impl PacketKernel for ScalarPacketKernel {
     }
 
     #[inline(always)]
-    fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
+    fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
         wide::closest(&ScalarKernel, bvh, ray, &mut ArrayStack::new())
     }
 
@@ -531,9 +533,7 @@ pub(crate) fn intersect<K: PacketKernel, S: PacketStack>(
         let mut out = [None; PACKET];
         for (l, out) in out.iter_mut().enumerate() {
             if p.valid & (1 << l) != 0 {
-                *out = kernel
-                    .single_closest(bvh, &rays[l])
-                    .map(|(t, prim)| bvh.finish_with(&rays[l], &p.woop(l), t, prim));
+                *out = kernel.single_closest(bvh, &rays[l]);
             }
         }
         return out;
@@ -843,7 +843,7 @@ mod tests {
                     let got = (prim[l] != u32::MAX).then(|| (t.0[l], prim[l]));
                     assert_eq!(
                         got.map(|(t, i)| (t.to_bits(), i)),
-                        expect.map(|(t, i)| (t.to_bits(), i)),
+                        expect.map(|h| (h.t.to_bits(), h.primitive)),
                         "packet {k} lane {l}: {:?}",
                         rays[l]
                     );

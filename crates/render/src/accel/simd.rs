@@ -28,9 +28,10 @@ use crate::ray::Ray;
 // Each entry point takes the `Avx2` proof (`accel/isa.rs`) that the CPU has AVX2 and FMA, so
 // the kernel is chosen once, where the `Isa` is; on other targets the proof cannot exist.
 
-/// Closest hit with the AVX2 kernels.
+/// Closest hit with the AVX2 kernels; a ray that is not valid (`wide::ray_is_valid`) meets
+/// nothing.
 #[inline]
-pub(crate) fn closest(avx2: Avx2, bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
+pub(crate) fn closest(avx2: Avx2, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
     #[cfg(target_arch = "x86_64")]
     {
         let _ = avx2;
@@ -129,29 +130,57 @@ mod x86 {
     use crate::accel::packet::{self, Lanes, PacketKernel, PacketRays, PacketStack, PACKET};
     use crate::accel::triangle::WoopRay;
     use crate::accel::wide::{
-        self, BoxPlanes, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock, WideBvh, WideNode,
+        self, BlockHit, BoxPlanes, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock, WideBvh,
+        WideNode,
         BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
     };
+    use crate::math::Vec3;
     use crate::ray::Ray;
 
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn closest(bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
-        wide::closest(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
+    pub(super) unsafe fn closest(bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
+        let ray = read_ray(ray);
+        if !wide::ray_is_valid(&ray) {
+            return None;
+        }
+        wide::closest(&Avx2Kernel, bvh, &ray, &mut UninitStack::new())
+    }
+
+    /// The ray's eight floats read one by one. Callers have most often just written the ray
+    /// (a local copy, in object space), and a load wider than one of those stores, spanning
+    /// two of them, as the compiler likes to make for the direction, cannot be forwarded
+    /// from the store buffer: a stall of a dozen cycles or more per ray, the largest single
+    /// cost of a ray that misses (`perf annotate`). Volatile reads are never merged.
+    #[inline(always)]
+    fn read_ray(ray: &Ray) -> Ray {
+        let f = |x: &f32| {
+            // SAFETY: `x` is a reference to an f32: valid and aligned for the read.
+            unsafe { std::ptr::read_volatile(x) }
+        };
+        Ray {
+            origin: Vec3::new(f(&ray.origin.x), f(&ray.origin.y), f(&ray.origin.z)),
+            direction: Vec3::new(
+                f(&ray.direction.x),
+                f(&ray.direction.y),
+                f(&ray.direction.z),
+            ),
+            t_min: f(&ray.t_min),
+            t_max: f(&ray.t_max),
+        }
     }
 
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn any(bvh: &WideBvh, ray: &Ray) -> bool {
-        wide::any(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
+        wide::any(&Avx2Kernel, bvh, &read_ray(ray), &mut UninitStack::new())
     }
 
     /// A traversal stack that is not cleared for every ray (it is 3 KB).
     struct UninitStack {
         entries: [MaybeUninit<(u32, f32)>; STACK_SIZE],
-        len: usize,
     }
 
     impl UninitStack {
@@ -159,25 +188,19 @@ mod x86 {
         fn new() -> Self {
             UninitStack {
                 entries: [const { MaybeUninit::uninit() }; STACK_SIZE],
-                len: 0,
             }
         }
     }
 
     impl Stack for UninitStack {
         #[inline(always)]
-        fn push(&mut self, child: u32, entry: f32) {
-            self.entries[self.len] = MaybeUninit::new((child, entry));
-            self.len += 1;
+        fn set(&mut self, i: usize, child: u32, entry: f32) {
+            self.entries[i] = MaybeUninit::new((child, entry));
         }
         #[inline(always)]
-        fn pop(&mut self) -> Option<(u32, f32)> {
-            if self.len == 0 {
-                return None;
-            }
-            self.len -= 1;
-            // SAFETY: every entry below `len` was written by `push`.
-            Some(unsafe { self.entries[self.len].assume_init() })
+        fn get(&self, i: usize) -> (u32, f32) {
+            // SAFETY: the walks (`wide::closest`, `wide::any`) read only entries they wrote.
+            unsafe { self.entries[i].assume_init() }
         }
     }
 
@@ -188,7 +211,21 @@ mod x86 {
         near: [usize; 3],
         far: [usize; 3],
         t_min: __m256,
+        /// No slab distance can be NaN (every reciprocal finite) and `t_min >= 0`: the
+        /// reductions may take the short path of `node_test` (see there).
+        no_nan: bool,
+        /// `inv_dir · FOLDED_FAR_SCALE`, for the far slabs of the short path.
+        inv_far: [__m256; 3],
     }
+
+    /// The short path's far slabs are (plane − origin) · (1/d · FOLDED_FAR_SCALE), one product
+    /// fewer on the walk's critical path than ((plane − origin) · 1/d) · FAR_SCALE. Each is
+    /// at least the scalar kernel's value in magnitude, same sign: the two roundings of the
+    /// folded form and the two of the scalar one move a value by at most (1 ± 2⁻²⁴)² each,
+    /// and FOLDED_FAR_SCALE / FAR_SCALE ≈ 1 + 2⁻²⁰ exceeds (1 + 2⁻²⁴)² / (1 − 2⁻²⁴)² ≈
+    /// 1 + 2⁻²². So a box's exit is never earlier than the scalar kernel's: no box it enters
+    /// is culled (boxes it culls may be entered, which changes no hit).
+    const FOLDED_FAR_SCALE: f32 = 1.0 + 16.0 * f32::EPSILON;
 
     /// The AVX2 kernel. Its methods are only reached from the `target_feature` functions
     /// above, into which they are inlined.
@@ -216,7 +253,7 @@ mod x86 {
             ray: &WoopRay,
             t_min: f32,
             t_max: f32,
-        ) -> Option<(usize, f32)> {
+        ) -> Option<BlockHit> {
             // SAFETY: as above.
             let (mask, t) = unsafe { block_test(block, ray, t_min, t_max) };
             match mask {
@@ -228,11 +265,17 @@ mod x86 {
                     while m != 0 {
                         let lane = m.trailing_zeros() as usize;
                         m &= m - 1;
-                        if t[lane] < best.1 {
-                            best = (lane, t[lane]);
+                        if t.t[lane] < best.1 {
+                            best = (lane, t.t[lane]);
                         }
                     }
-                    Some(best)
+                    let (lane, t_hit) = best;
+                    Some(BlockHit {
+                        lane,
+                        t: t_hit,
+                        b1: t.v[lane] / t.det[lane],
+                        b2: t.w[lane] / t.det[lane],
+                    })
                 }
             }
         }
@@ -276,13 +319,40 @@ mod x86 {
                 ],
                 near: p.near,
                 far: p.far,
-                t_min: _mm256_set1_ps(p.t_min),
+                // `+ 0.0` turns -0 into +0 (equal as floats), whose bits are the least
+                // non-negative integer, as the integer reductions need.
+                t_min: _mm256_set1_ps(p.t_min + 0.0),
+                no_nan: p.inv_dir.iter().all(|c| c.is_finite()) && p.t_min >= 0.0,
+                inv_far: [
+                    _mm256_set1_ps(p.inv_dir[0] * FOLDED_FAR_SCALE),
+                    _mm256_set1_ps(p.inv_dir[1] * FOLDED_FAR_SCALE),
+                    _mm256_set1_ps(p.inv_dir[2] * FOLDED_FAR_SCALE),
+                ],
             }
         }
     }
 
-    /// The scalar kernel's slab test, eight children at once, same operations in the same
-    /// order.
+    /// The scalar kernel's slab test, eight children at once: the same entry distances, and
+    /// every box the scalar kernel enters is entered.
+    ///
+    /// Two paths. Where a ray has a zero (or denormal) direction component, a slab distance
+    /// can be 0 · ∞ = NaN, and the running maximum and minimum must ignore it: the scalar
+    /// kernel's operations in its order (`max_ps(a, b)`/`min_ps(a, b)` return b when either
+    /// is NaN). Every other ray (`BoxRay::no_nan`) takes the short path, whose dependency
+    /// chain from the node's load to the mask is much shorter (the walk is latency bound):
+    /// maxima and minima as one-cycle integer operations on the floats' bits, in a tree,
+    /// after Embree's `maxi`/`mini`, and the far slabs' safety factor folded into the
+    /// reciprocals (`FOLDED_FAR_SCALE`). The entry distance is the maximum of t_min (≥ +0)
+    /// and the near slabs: non-negative floats order as their bits do, and a negative float
+    /// is a negative integer, below t_min, as it is below it as a float, so it is the float
+    /// maximum, the scalar kernel's value. The exit distance is the minimum of the far slabs,
+    /// each at least the scalar kernel's (see `FOLDED_FAR_SCALE`): with all of them ≥ +0 the
+    /// float minimum; with one negative (the box is behind the ray on that axis) some
+    /// negative value, perhaps not the least, and the box is culled, or, when its entry is
+    /// exactly 0 and a far slab −0, entered though nothing in it lies at t ≥ 0. So the
+    /// short path culls no box the scalar kernel enters and gives the same entry distances;
+    /// hits, which depend neither on the walk's order nor on extra boxes visited, are the
+    /// same bit for bit (the agreement tests compare the kernels and brute force).
     ///
     /// # Safety
     /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
@@ -294,22 +364,51 @@ mod x86 {
         // bounds; `entry` is 8 f32 (unaligned store).
         unsafe {
             macro_rules! slab {
-                ($row:expr, $axis:expr) => {
+                ($row:expr, $axis:expr, $inv:expr) => {
                     _mm256_mul_ps(
                         _mm256_sub_ps(
                             _mm256_load_ps(node.bounds.get_unchecked($row).as_ptr()),
                             r.origin[$axis],
                         ),
-                        r.inv_dir[$axis],
+                        $inv[$axis],
                     )
                 };
             }
-            let near_x = slab!(r.near[0], 0);
-            let near_y = slab!(r.near[1], 1);
-            let near_z = slab!(r.near[2], 2);
-            let far_x = slab!(r.far[0], 0);
-            let far_y = slab!(r.far[1], 1);
-            let far_z = slab!(r.far[2], 2);
+            let near_x = slab!(r.near[0], 0, r.inv_dir);
+            let near_y = slab!(r.near[1], 1, r.inv_dir);
+            let near_z = slab!(r.near[2], 2, r.inv_dir);
+            let t_max = _mm256_set1_ps(t_max);
+            if r.no_nan {
+                let far_x = slab!(r.far[0], 0, r.inv_far);
+                let far_y = slab!(r.far[1], 1, r.inv_far);
+                let far_z = slab!(r.far[2], 2, r.inv_far);
+                macro_rules! int {
+                    ($f:ident, $a:expr, $b:expr) => {
+                        _mm256_castsi256_ps($f(_mm256_castps_si256($a), _mm256_castps_si256($b)))
+                    };
+                }
+                let t0 = int!(
+                    _mm256_max_epi32,
+                    int!(_mm256_max_epi32, near_x, near_y),
+                    int!(_mm256_max_epi32, near_z, r.t_min)
+                );
+                let t1 = int!(
+                    _mm256_min_epi32,
+                    int!(_mm256_min_epi32, far_x, far_y),
+                    far_z
+                );
+                // t0 ≤ min(t1, t_max), as two comparisons: the one with t_max waits only for
+                // the entry distance.
+                let inside = _mm256_and_ps(
+                    _mm256_cmp_ps::<_CMP_LE_OQ>(t0, t_max),
+                    _mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1),
+                );
+                _mm256_storeu_ps(entry.as_mut_ptr(), t0);
+                return _mm256_movemask_ps(inside) as u32;
+            }
+            let far_x = slab!(r.far[0], 0, r.inv_dir);
+            let far_y = slab!(r.far[1], 1, r.inv_dir);
+            let far_z = slab!(r.far[2], 2, r.inv_dir);
             // `max_ps(a, b)`/`min_ps(a, b)` return b when either is NaN: with the running value
             // second, a NaN slab (a ray in a slab plane) leaves it alone, as in the scalar kernel.
             let t0 = _mm256_max_ps(
@@ -320,10 +419,7 @@ mod x86 {
                 far_z,
                 _mm256_min_ps(far_y, _mm256_min_ps(far_x, _mm256_set1_ps(f32::INFINITY))),
             );
-            let t1 = _mm256_min_ps(
-                _mm256_mul_ps(t1, _mm256_set1_ps(FAR_SCALE)),
-                _mm256_set1_ps(t_max),
-            );
+            let t1 = _mm256_min_ps(_mm256_mul_ps(t1, _mm256_set1_ps(FAR_SCALE)), t_max);
             _mm256_storeu_ps(entry.as_mut_ptr(), t0);
             _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u32
         }
@@ -344,7 +440,7 @@ mod x86 {
         ray: &WoopRay,
         t_min: f32,
         t_max: f32,
-    ) -> (u32, [f32; BLOCK]) {
+    ) -> (u32, BlockLanes) {
         // SAFETY (the whole body): the caller runs with AVX2; a row is 4 f32, 16-byte aligned
         // in the 16-byte aligned block; `out` is 4 f32 (unaligned store).
         unsafe {
@@ -386,7 +482,7 @@ mod x86 {
                 _mm_cmpeq_ps(w, zero),
             );
             if _mm_movemask_ps(any_zero) != 0 {
-                return (ZERO_EDGE, [0.0; BLOCK]);
+                return (ZERO_EDGE, BlockLanes::NONE);
             }
             let negative = _mm_or_ps(
                 _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
@@ -403,7 +499,7 @@ mod x86 {
                 _mm_cmp_ps::<_CMP_NEQ_OQ>(det, zero),
             );
             if _mm_movemask_ps(valid) == 0 {
-                return (0, [0.0; BLOCK]);
+                return (0, BlockLanes::NONE);
             }
             let t_scaled = _mm_add_ps(
                 _mm_add_ps(
@@ -418,10 +514,35 @@ mod x86 {
                 _mm_cmp_ps::<_CMP_LE_OQ>(t, _mm_set1_ps(t_max)),
             );
             let mask = _mm_movemask_ps(_mm_and_ps(valid, in_window)) as u32;
-            let mut out = [0.0f32; BLOCK];
-            _mm_storeu_ps(out.as_mut_ptr(), t);
+            if mask == 0 {
+                return (0, BlockLanes::NONE);
+            }
+            let mut out = BlockLanes::NONE;
+            _mm_storeu_ps(out.t.as_mut_ptr(), t);
+            _mm_storeu_ps(out.v.as_mut_ptr(), v);
+            _mm_storeu_ps(out.w.as_mut_ptr(), w);
+            _mm_storeu_ps(out.det.as_mut_ptr(), det);
             (mask, out)
         }
+    }
+
+    /// What `block_test` found in each lane: t, and the edge functions v (of c → a), w (of
+    /// a → b) and the determinant, from which the barycentrics `triangle::intersect` reports
+    /// are v / det and w / det.
+    struct BlockLanes {
+        t: [f32; BLOCK],
+        v: [f32; BLOCK],
+        w: [f32; BLOCK],
+        det: [f32; BLOCK],
+    }
+
+    impl BlockLanes {
+        const NONE: BlockLanes = BlockLanes {
+            t: [0.0; BLOCK],
+            v: [0.0; BLOCK],
+            w: [0.0; BLOCK],
+            det: [0.0; BLOCK],
+        };
     }
 
     /// # Safety
@@ -551,7 +672,8 @@ mod x86 {
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
-                if let Some((k, th)) = Avx2Kernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l])
+                if let Some(BlockHit { lane: k, t: th, .. }) =
+                    Avx2Kernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l])
                 {
                     lane[l] = k as u8;
                     t.0[l] = th;
@@ -582,7 +704,7 @@ mod x86 {
         }
 
         #[inline(always)]
-        fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<(f32, u32)> {
+        fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
             wide::closest(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
         }
 
@@ -720,7 +842,9 @@ mod x86 {
         while m != 0 {
             let l = m.trailing_zeros() as usize;
             m &= m - 1;
-            if let Some((k, th)) = ScalarKernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l]) {
+            if let Some(BlockHit { lane: k, t: th, .. }) =
+                ScalarKernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l])
+            {
                 lane[l] = k as u8;
                 t.0[l] = th;
                 hits |= 1 << l;

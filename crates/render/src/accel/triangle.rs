@@ -36,13 +36,12 @@ impl WoopRay {
     pub fn new(origin: Vec3, direction: Vec3) -> WoopRay {
         let d = direction.to_array();
         let a = d.map(f32::abs);
-        let kz = if a[0] >= a[1] && a[0] >= a[2] {
-            0
-        } else if a[1] >= a[2] {
-            1
-        } else {
-            2
-        };
+        // 0 where a[0] >= a[1] and a[0] >= a[2], else 1 where a[1] >= a[2], else 2: written
+        // as arithmetic on comparisons, since branches on the direction mispredict on
+        // incoherent rays.
+        let x_major = a[0] >= a[1] && a[0] >= a[2];
+        let y_over_z = a[1] >= a[2];
+        let kz = usize::from(!x_major) * (1 + usize::from(!y_over_z));
         let mut kx = if kz == 2 { 0 } else { kz + 1 };
         let mut ky = if kx == 2 { 0 } else { kx + 1 };
         if d[kz] < 0.0 {

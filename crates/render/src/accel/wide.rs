@@ -19,7 +19,10 @@
 //! straight on; two: compare; more: sort), the others wait on a stack with their entry distance,
 //! and a popped entry further than the closest hit so far is dropped. `t_max` shrinks with each
 //! hit. The box and block tests are the `Kernel`: AVX2 in `simd.rs` when the CPU has it, the
-//! scalar `ScalarKernel` here otherwise. Both compute the same thing.
+//! scalar `ScalarKernel` here otherwise. Both give the same entry distances and hits; the
+//! AVX2 box test may also enter boxes the scalar one culls, never the reverse (see
+//! `simd::node_test`), which changes no hit. A block hit carries its barycentrics, so a
+//! closest hit needs no second triangle test (`finish` serves the preliminary hits).
 
 use crate::accel::isa::Isa;
 use crate::accel::triangle::{self, WoopRay};
@@ -304,22 +307,36 @@ pub(crate) trait Kernel {
         t_max: f32,
         entry: &mut [f32; WIDTH],
     ) -> u32;
-    /// The lowest lane of the block meeting the ray at the smallest t in [t_min, t_max].
+    /// The lowest lane of the block meeting the ray at the smallest t in [t_min, t_max], with
+    /// its barycentrics (those `triangle::intersect` reports).
     fn block(
         &self,
         block: &TriangleBlock,
         ray: &WoopRay,
         t_min: f32,
         t_max: f32,
-    ) -> Option<(usize, f32)>;
+    ) -> Option<BlockHit>;
     /// Whether any lane meets the ray within [t_min, t_max].
     fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool;
 }
 
-/// The traversal stack: child references with their entry distances.
+/// A block's hit: its lane, t and barycentrics.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct BlockHit {
+    pub lane: usize,
+    pub t: f32,
+    pub b1: f32,
+    pub b2: f32,
+}
+
+/// The traversal stack: child references with their entry distances, by position. The walk
+/// keeps the stack's height in a local of its own, so that it stays in a register (a length
+/// field beside the entries was reloaded from memory after every push).
 pub(crate) trait Stack {
-    fn push(&mut self, child: u32, entry: f32);
-    fn pop(&mut self) -> Option<(u32, f32)>;
+    /// Writes entry `i` (`i < STACK_SIZE`).
+    fn set(&mut self, i: usize, child: u32, entry: f32);
+    /// Entry `i`, written by `set` before.
+    fn get(&self, i: usize) -> (u32, f32);
 }
 
 /// Entries a traversal stack needs: at most 7 per level, and the build caps the depth.
@@ -331,31 +348,24 @@ pub(crate) const MAX_DEPTH: usize = 48;
 /// A zero-initialised stack (the scalar path; the SIMD path keeps an uninitialised one).
 pub(crate) struct ArrayStack {
     entries: [(u32, f32); STACK_SIZE],
-    len: usize,
 }
 
 impl ArrayStack {
     pub(crate) fn new() -> Self {
         ArrayStack {
             entries: [(0, 0.0); STACK_SIZE],
-            len: 0,
         }
     }
 }
 
 impl Stack for ArrayStack {
     #[inline(always)]
-    fn push(&mut self, child: u32, entry: f32) {
-        self.entries[self.len] = (child, entry);
-        self.len += 1;
+    fn set(&mut self, i: usize, child: u32, entry: f32) {
+        self.entries[i] = (child, entry);
     }
     #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
-        if self.len == 0 {
-            return None;
-        }
-        self.len -= 1;
-        Some(self.entries[self.len])
+    fn get(&self, i: usize) -> (u32, f32) {
+        self.entries[i]
     }
 }
 
@@ -435,13 +445,20 @@ impl Kernel for ScalarKernel {
         ray: &WoopRay,
         t_min: f32,
         t_max: f32,
-    ) -> Option<(usize, f32)> {
-        let mut best: Option<(usize, f32)> = None;
+    ) -> Option<BlockHit> {
+        let mut best: Option<BlockHit> = None;
         for lane in 0..BLOCK {
             if let Some(h) = triangle::intersect(ray, block.triangle(lane), t_min, t_max) {
                 match best {
-                    Some((_, t)) if t <= h.t => {}
-                    _ => best = Some((lane, h.t)),
+                    Some(b) if b.t <= h.t => {}
+                    _ => {
+                        best = Some(BlockHit {
+                            lane,
+                            t: h.t,
+                            b1: h.b1,
+                            b2: h.b2,
+                        })
+                    }
                 }
             }
         }
@@ -455,7 +472,7 @@ impl Kernel for ScalarKernel {
     }
 }
 
-/// Closest hit: (t, primitive index). Generic over the kernel and the stack so that the SIMD
+/// Closest hit, with its barycentrics. Generic over the kernel and the stack so that the SIMD
 /// module instantiates it inside its `avx2` functions.
 #[inline(always)]
 pub(crate) fn closest<K: Kernel, S: Stack>(
@@ -463,113 +480,116 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
     bvh: &WideBvh,
     ray: &Ray,
     stack: &mut S,
-) -> Option<(f32, u32)> {
+) -> Option<LocalHit> {
     let box_ray = kernel.box_ray(ray);
     let woop = WoopRay::new(ray.origin, ray.direction);
     let lanes = (bvh.blocks.len() * BLOCK) as u32;
-    let mut best_t = ray.t_max;
-    let mut best_prim = u32::MAX;
+    let mut best = LocalHit {
+        t: ray.t_max,
+        primitive: u32::MAX,
+        b1: 0.0,
+        b2: 0.0,
+    };
     let mut entry = [0.0f32; WIDTH];
     let mut current = bvh.root;
-    loop {
-        if !current.is_leaf() {
+    // Entries below `sp` are waiting; the nearest of a node's children is visited first.
+    let mut sp = 0usize;
+    'walk: loop {
+        while !current.is_leaf() {
             let node = &bvh.nodes[current.0 as usize];
-            let mask = kernel.node(node, &box_ray, best_t, &mut entry);
-            if let Some(next) = choose(mask, node, &entry, stack) {
-                current = next;
+            let mask = kernel.node(node, &box_ray, best.t, &mut entry);
+            if mask == 0 {
+                break;
+            }
+            let i0 = mask.trailing_zeros() as usize;
+            let rest = mask & (mask - 1);
+            if rest == 0 {
+                current = ChildRef(node.children[i0]);
                 continue;
             }
-        } else if current != ChildRef::EMPTY {
+            let i1 = rest.trailing_zeros() as usize;
+            let rest = rest & (rest - 1);
+            if rest == 0 {
+                let (near, far) = if entry[i0] <= entry[i1] {
+                    (i0, i1)
+                } else {
+                    (i1, i0)
+                };
+                stack.set(sp, node.children[far], entry[far]);
+                sp += 1;
+                current = ChildRef(node.children[near]);
+                continue;
+            }
+            // Three or more: onto the stack sorted by entry distance, nearest on top (among
+            // equals the later slot), then the top taken.
+            let base = sp;
+            let mut m = mask;
+            while m != 0 {
+                let i = m.trailing_zeros() as usize;
+                m &= m - 1;
+                let d = entry[i];
+                let mut k = sp;
+                while k > base {
+                    let below = stack.get(k - 1);
+                    if below.1 >= d {
+                        break;
+                    }
+                    stack.set(k, below.0, below.1);
+                    k -= 1;
+                }
+                stack.set(k, node.children[i], d);
+                sp += 1;
+            }
+            sp -= 1;
+            current = ChildRef(stack.get(sp).0);
+        }
+        if current.is_leaf() && current != ChildRef::EMPTY {
             let (first, count) = current.range();
             if !current.is_shapes() {
                 for b in first..first + count {
-                    if let Some((lane, t)) = kernel.block(&bvh.blocks[b], &woop, ray.t_min, best_t)
-                    {
-                        let prim = (b * BLOCK + lane) as u32;
-                        if t < best_t || (t == best_t && bvh.earlier(prim, best_prim)) {
-                            best_t = t;
-                            best_prim = prim;
+                    if let Some(h) = kernel.block(&bvh.blocks[b], &woop, ray.t_min, best.t) {
+                        let prim = (b * BLOCK + h.lane) as u32;
+                        if h.t < best.t || (h.t == best.t && bvh.earlier(prim, best.primitive)) {
+                            best = LocalHit {
+                                t: h.t,
+                                primitive: prim,
+                                b1: h.b1,
+                                b2: h.b2,
+                            };
                         }
                     }
                 }
             } else {
                 for s in first..first + count {
                     let window = Ray {
-                        t_max: best_t,
+                        t_max: best.t,
                         ..*ray
                     };
                     if let Some(h) = bvh.shapes[s].intersect(&window) {
                         let prim = lanes + s as u32;
-                        if h.t < best_t || (h.t == best_t && bvh.earlier(prim, best_prim)) {
-                            best_t = h.t;
-                            best_prim = prim;
+                        if h.t < best.t || (h.t == best.t && bvh.earlier(prim, best.primitive)) {
+                            best = LocalHit {
+                                t: h.t,
+                                primitive: prim,
+                                b1: h.b1,
+                                b2: h.b2,
+                            };
                         }
                     }
                 }
             }
         }
         // Next entry that can still hold something nearer than the closest hit.
-        loop {
-            match stack.pop() {
-                None => return (best_prim != u32::MAX).then_some((best_t, best_prim)),
-                Some((child, t_entry)) => {
-                    if t_entry <= best_t {
-                        current = ChildRef(child);
-                        break;
-                    }
-                }
+        while sp > 0 {
+            sp -= 1;
+            let (child, t_entry) = stack.get(sp);
+            if t_entry <= best.t {
+                current = ChildRef(child);
+                continue 'walk;
             }
         }
+        return (best.primitive != u32::MAX).then_some(best);
     }
-}
-
-/// The child to visit next, the other entered children pushed farthest first.
-#[inline(always)]
-fn choose<S: Stack>(
-    mask: u32,
-    node: &WideNode,
-    entry: &[f32; WIDTH],
-    stack: &mut S,
-) -> Option<ChildRef> {
-    if mask == 0 {
-        return None;
-    }
-    let i0 = mask.trailing_zeros() as usize;
-    let rest = mask & (mask - 1);
-    if rest == 0 {
-        return Some(ChildRef(node.children[i0]));
-    }
-    let i1 = rest.trailing_zeros() as usize;
-    let rest = rest & (rest - 1);
-    if rest == 0 {
-        let (near, far) = if entry[i0] <= entry[i1] {
-            (i0, i1)
-        } else {
-            (i1, i0)
-        };
-        stack.push(node.children[far], entry[far]);
-        return Some(ChildRef(node.children[near]));
-    }
-    // Three or more: sort by entry distance, nearest last, push all but the nearest.
-    let mut sorted = [(0u32, 0.0f32); WIDTH];
-    let mut n = 0;
-    let mut m = mask;
-    while m != 0 {
-        let i = m.trailing_zeros() as usize;
-        m &= m - 1;
-        let item = (node.children[i], entry[i]);
-        let mut k = n;
-        while k > 0 && sorted[k - 1].1 < item.1 {
-            sorted[k] = sorted[k - 1];
-            k -= 1;
-        }
-        sorted[k] = item;
-        n += 1;
-    }
-    for &(child, t) in &sorted[..n - 1] {
-        stack.push(child, t);
-    }
-    Some(ChildRef(sorted[n - 1].0))
 }
 
 /// Any hit within the ray's window (shadow rays): no ordering, the first hit ends the walk.
@@ -584,6 +604,7 @@ pub(crate) fn any<K: Kernel, S: Stack>(
     let woop = WoopRay::new(ray.origin, ray.direction);
     let mut entry = [0.0f32; WIDTH];
     let mut current = bvh.root;
+    let mut sp = 0usize;
     loop {
         if !current.is_leaf() {
             let node = &bvh.nodes[current.0 as usize];
@@ -594,7 +615,8 @@ pub(crate) fn any<K: Kernel, S: Stack>(
                 while mask != 0 {
                     let i = mask.trailing_zeros() as usize;
                     mask &= mask - 1;
-                    stack.push(node.children[i], 0.0);
+                    stack.set(sp, node.children[i], 0.0);
+                    sp += 1;
                 }
                 current = ChildRef(node.children[first]);
                 continue;
@@ -615,10 +637,11 @@ pub(crate) fn any<K: Kernel, S: Stack>(
                 }
             }
         }
-        match stack.pop() {
-            None => return false,
-            Some((child, _)) => current = ChildRef(child),
+        if sp == 0 {
+            return false;
         }
+        sp -= 1;
+        current = ChildRef(stack.get(sp).0);
     }
 }
 
@@ -678,7 +701,7 @@ impl WideBvh {
     /// `intersect_preliminary` by the scalar kernel, counting what the walk does: the same
     /// traversal instantiated with a counting kernel, so the traversal that renders carries no
     /// counter. For `--stats` only.
-    pub(crate) fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<(f32, u32)> {
+    pub(crate) fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<LocalHit> {
         if !ray_is_valid(ray) {
             return None;
         }
@@ -726,7 +749,7 @@ impl Kernel for CountingKernel {
         ray: &WoopRay,
         t_min: f32,
         t_max: f32,
-    ) -> Option<(usize, f32)> {
+    ) -> Option<BlockHit> {
         self.blocks.set(self.blocks.get() + 1);
         ScalarKernel.block(block, ray, t_min, t_max)
     }

@@ -50,7 +50,7 @@ fn every_method_finds_the_brute_force_hit_ties_included() {
                     let mut counts = WalkCounts::default();
                     let counted = bvh
                         .count_closest(ray, &mut counts)
-                        .map(|(t, p)| (t, bvh.source_index(p)));
+                        .map(|h| (h.t, bvh.source_index(h.primitive)));
                     assert_eq!(counted, expected, "counting walk, ray {k}");
                     hits += expected.is_some() as usize;
                 }
