@@ -130,8 +130,8 @@ mod x86 {
     use crate::accel::packet::{self, Lanes, PacketKernel, PacketRays, PacketStack, PACKET};
     use crate::accel::triangle::WoopRay;
     use crate::accel::wide::{
-        self, BlockHit, BoxPlanes, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock, WideBvh,
-        WideNode,
+        self, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock,
+        WideBvh, WideNode,
         BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
     };
     use crate::math::Vec3;
@@ -277,6 +277,30 @@ mod x86 {
                         b2: t.w[lane] / t.det[lane],
                     })
                 }
+            }
+        }
+
+        #[inline(always)]
+        fn prefetch(&self, bvh: &WideBvh, child: ChildRef) {
+            let (lines, bytes): (*const i8, usize) = if !child.is_leaf() {
+                match bvh.nodes.get(child.0 as usize) {
+                    Some(node) => ((node as *const WideNode).cast(), 256),
+                    None => return,
+                }
+            } else if child != ChildRef::EMPTY && !child.is_shapes() {
+                match bvh.blocks.get(child.range().0) {
+                    Some(block) => ((block as *const TriangleBlock).cast(), 144),
+                    None => return,
+                }
+            } else {
+                return;
+            };
+            let mut offset = 0;
+            while offset < bytes {
+                // SAFETY: a prefetch never faults; the addresses lie inside `nodes` or
+                // `blocks` (the last line may reach past the element, still harmless).
+                unsafe { _mm_prefetch::<_MM_HINT_T0>(lines.wrapping_add(offset)) };
+                offset += 64;
             }
         }
 

@@ -318,6 +318,10 @@ pub(crate) trait Kernel {
     ) -> Option<BlockHit>;
     /// Whether any lane meets the ray within [t_min, t_max].
     fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool;
+    /// A hint that the walk will come back to `child` (put on the stack): its node or its
+    /// first triangle block may be fetched into the cache meanwhile.
+    #[inline(always)]
+    fn prefetch(&self, _bvh: &WideBvh, _child: ChildRef) {}
 }
 
 /// A block's hit: its lane, t and barycentrics.
@@ -517,6 +521,7 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
                 };
                 stack.set(sp, node.children[far], entry[far]);
                 sp += 1;
+                kernel.prefetch(bvh, ChildRef(node.children[far]));
                 current = ChildRef(node.children[near]);
                 continue;
             }
@@ -539,6 +544,7 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
                 }
                 stack.set(k, node.children[i], d);
                 sp += 1;
+                kernel.prefetch(bvh, ChildRef(node.children[i]));
             }
             sp -= 1;
             current = ChildRef(stack.get(sp).0);
