@@ -387,6 +387,9 @@ mod x86 {
         // makes them `a` or `a + 3` for an axis `a` < 3), so the unchecked row reads are in
         // bounds; `entry` is 8 f32 (unaligned store).
         unsafe {
+            // The children's line is read after the mask, which waits for the rows: ask for
+            // it now, so that on a cache miss both misses overlap.
+            _mm_prefetch::<_MM_HINT_T0>(node.children.as_ptr().cast());
             macro_rules! slab {
                 ($row:expr, $axis:expr, $inv:expr) => {
                     _mm256_mul_ps(
