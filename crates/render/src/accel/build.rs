@@ -270,14 +270,39 @@ impl Binner {
     }
 }
 
-fn find_split(prims: &[PrimRef], record: &Record, config: &Config) -> Option<Split> {
+/// The bins of a split search, per axis. Each build task keeps one and passes it down, so that
+/// a search clears only the bins it uses: most searches are over a few dozen primitives and
+/// a few bins, and clearing all of them (3.5 KiB) cost those searches more than the binning.
+struct Bins {
+    bounds: [[Box4; BINS]; 3],
+    counts: [[u32; BINS]; 3],
+}
+
+impl Bins {
+    fn new() -> Bins {
+        Bins {
+            bounds: [[Box4::EMPTY; BINS]; 3],
+            counts: [[0; BINS]; 3],
+        }
+    }
+}
+
+fn find_split(
+    prims: &[PrimRef],
+    record: &Record,
+    config: &Config,
+    scratch: &mut Bins,
+) -> Option<Split> {
     let binner = Binner::new(&record.centroids, record.len());
     let bins = binner.count;
     if binner.scale[..3].iter().all(|&s| s == 0.0) {
         return None;
     }
-    let mut bounds = [[Box4::EMPTY; BINS]; 3];
-    let mut counts = [[0u32; BINS]; 3];
+    let Bins { bounds, counts } = scratch;
+    for axis in 0..3 {
+        bounds[axis][..bins].fill(Box4::EMPTY);
+        counts[axis][..bins].fill(0);
+    }
     for p in &prims[record.start..record.end] {
         let b = binner.bins(p.centroid());
         for axis in 0..3 {
@@ -351,6 +376,7 @@ fn split_record(
     config: &Config,
     depth: usize,
     method: SplitMethod,
+    bins: &mut Bins,
 ) -> (Record, Record) {
     let (start, end) = (record.start, record.end);
     let mut sides = None;
@@ -386,7 +412,7 @@ fn split_record(
     } else {
         mid
     };
-    let make = |prims: &[PrimRef], s: usize, e: usize, measured: Option<(Box4, Box4)>| {
+    let mut make = |prims: &[PrimRef], s: usize, e: usize, measured: Option<(Box4, Box4)>| {
         let (bounds, centroids) = measured.unwrap_or_else(|| measure(&prims[s..e]));
         let mut r = Record {
             start: s,
@@ -397,7 +423,7 @@ fn split_record(
             level: record.level + 1,
         };
         if method == SplitMethod::Sah && r.len() > config.min_leaf && depth < SAH_DEPTH {
-            r.split = find_split(prims, &r, config);
+            r.split = find_split(prims, &r, config, bins);
         }
         r
     };
@@ -557,6 +583,7 @@ impl Builder {
         record: Record,
         depth: usize,
         nodes: &mut Vec<WideNode>,
+        bins: &mut Bins,
     ) -> ChildRef {
         let n = record.len();
         let config = &self.config;
@@ -601,7 +628,7 @@ impl Builder {
                 }
             }
             let Some(k) = best else { break };
-            let (left, right) = split_record(prims, &slots[k], config, depth + 1, self.method);
+            let (left, right) = split_record(prims, &slots[k], config, depth + 1, self.method, bins);
             slots[k] = left;
             slots[len] = right;
             len += 1;
@@ -635,7 +662,9 @@ impl Builder {
                 .into_par_iter()
                 .map(|(slice, child_base, local)| {
                     let mut sub = Vec::new();
-                    let root = self.subtree(slice, child_base, local, depth + 1, &mut sub);
+                    let mut bins = Bins::new();
+                    let root =
+                        self.subtree(slice, child_base, local, depth + 1, &mut sub, &mut bins);
                     Subtree { nodes: sub, root }
                 })
                 .collect();
@@ -659,7 +688,7 @@ impl Builder {
             }
         } else {
             for (slot, c) in children.iter().enumerate() {
-                let child = self.subtree(prims, base, *c, depth + 1, nodes);
+                let child = self.subtree(prims, base, *c, depth + 1, nodes, bins);
                 nodes[node_index].set_child(slot, child, &c.bounds.aabb());
             }
         }
@@ -711,11 +740,12 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
             split: None,
             level: 0,
         };
+        let mut bins = Bins::new();
         if method == SplitMethod::Sah && record.len() > config.min_leaf {
-            record.split = find_split(&prims, &record, &config);
+            record.split = find_split(&prims, &record, &config, &mut bins);
         }
         let builder = Builder { config, method };
-        builder.subtree(&mut prims, 0, record, 0, &mut nodes)
+        builder.subtree(&mut prims, 0, record, 0, &mut nodes, &mut bins)
     };
     pack(
         shapes,
