@@ -270,14 +270,39 @@ impl Binner {
     }
 }
 
-fn find_split(prims: &[PrimRef], record: &Record, config: &Config) -> Option<Split> {
+/// The bins of a split search, per axis. Each build task keeps one and passes it down, so that
+/// a search clears only the bins it uses: most searches are over a few dozen primitives and
+/// a few bins, and clearing all of them (3.5 KiB) cost those searches more than the binning.
+struct Bins {
+    bounds: [[Box4; BINS]; 3],
+    counts: [[u32; BINS]; 3],
+}
+
+impl Bins {
+    fn new() -> Bins {
+        Bins {
+            bounds: [[Box4::EMPTY; BINS]; 3],
+            counts: [[0; BINS]; 3],
+        }
+    }
+}
+
+fn find_split(
+    prims: &[PrimRef],
+    record: &Record,
+    config: &Config,
+    scratch: &mut Bins,
+) -> Option<Split> {
     let binner = Binner::new(&record.centroids, record.len());
     let bins = binner.count;
     if binner.scale[..3].iter().all(|&s| s == 0.0) {
         return None;
     }
-    let mut bounds = [[Box4::EMPTY; BINS]; 3];
-    let mut counts = [[0u32; BINS]; 3];
+    let Bins { bounds, counts } = scratch;
+    for axis in 0..3 {
+        bounds[axis][..bins].fill(Box4::EMPTY);
+        counts[axis][..bins].fill(0);
+    }
     for p in &prims[record.start..record.end] {
         let b = binner.bins(p.centroid());
         for axis in 0..3 {
@@ -351,6 +376,7 @@ fn split_record(
     config: &Config,
     depth: usize,
     method: SplitMethod,
+    bins: &mut Bins,
 ) -> (Record, Record) {
     let (start, end) = (record.start, record.end);
     let mut sides = None;
@@ -363,29 +389,10 @@ fn split_record(
         }
         (SplitMethod::SpatialMedian, _) => spatial_median(prims, record),
         (SplitMethod::Sah, Some(split)) => {
-            // Partition, measuring both sides on the way.
             let binner = Binner::new(&record.centroids, record.len());
-            let axis = split.axis;
-            let mut i = start;
-            let mut j = end;
-            let (mut left, mut left_c) = (Box4::EMPTY, Box4::EMPTY);
-            let (mut right, mut right_c) = (Box4::EMPTY, Box4::EMPTY);
-            while i < j {
-                let p = prims[i];
-                let c = p.centroid();
-                if binner.bin(c, axis) <= split.bin {
-                    left.grow_box(p.lo, p.hi);
-                    left_c.grow_point(c);
-                    i += 1;
-                } else {
-                    right.grow_box(p.lo, p.hi);
-                    right_c.grow_point(c);
-                    j -= 1;
-                    prims.swap(i, j);
-                }
-            }
-            sides = Some(((left, left_c), (right, right_c)));
-            i
+            let (left, right, mid) = partition(&mut prims[start..end], &binner, split);
+            sides = Some((left, right));
+            start + mid
         }
         (SplitMethod::Sah, None) => start,
     };
@@ -405,7 +412,7 @@ fn split_record(
     } else {
         mid
     };
-    let make = |prims: &[PrimRef], s: usize, e: usize, measured: Option<(Box4, Box4)>| {
+    let mut make = |prims: &[PrimRef], s: usize, e: usize, measured: Option<(Box4, Box4)>| {
         let (bounds, centroids) = measured.unwrap_or_else(|| measure(&prims[s..e]));
         let mut r = Record {
             start: s,
@@ -416,7 +423,7 @@ fn split_record(
             level: record.level + 1,
         };
         if method == SplitMethod::Sah && r.len() > config.min_leaf && depth < SAH_DEPTH {
-            r.split = find_split(prims, &r, config);
+            r.split = find_split(prims, &r, config, bins);
         }
         r
     };
@@ -425,6 +432,55 @@ fn split_record(
         None => (None, None),
     };
     (make(prims, start, mid, left), make(prims, mid, end, right))
+}
+
+/// Partitions `prims` by `split` (bins `0..=split.bin` of `binner` first) from both ends,
+/// swapping only the pairs that are on the wrong sides, and measures both sides on the way.
+/// Returns the (bounds, centroid bounds) of either side and where the second one starts.
+fn partition(
+    prims: &mut [PrimRef],
+    binner: &Binner,
+    split: Split,
+) -> ((Box4, Box4), (Box4, Box4), usize) {
+    let axis = split.axis;
+    let (origin, scale) = (binner.origin[axis], binner.scale[axis]);
+    // `binner.bin(c, axis) > split.bin` without the conversion: for the scaled offset x,
+    // `trunc(x.max(0).min(count - 1)) > bin` exactly when `x >= bin + 1` (NaN: false), as
+    // `bin + 1 <= count - 1`.
+    let threshold = (split.bin + 1) as f32;
+    let goes_right = |p: &PrimRef| (p.lo[axis] + p.hi[axis] - origin) * scale >= threshold;
+    let (mut left, mut left_c) = (Box4::EMPTY, Box4::EMPTY);
+    let (mut right, mut right_c) = (Box4::EMPTY, Box4::EMPTY);
+    let mut i = 0;
+    let mut j = prims.len();
+    loop {
+        while i < j && !goes_right(&prims[i]) {
+            let p = &prims[i];
+            left.grow_box(p.lo, p.hi);
+            left_c.grow_point(p.centroid());
+            i += 1;
+        }
+        while i < j && goes_right(&prims[j - 1]) {
+            let p = &prims[j - 1];
+            right.grow_box(p.lo, p.hi);
+            right_c.grow_point(p.centroid());
+            j -= 1;
+        }
+        if i == j {
+            break;
+        }
+        // `prims[i]` goes right and `prims[j - 1]` left (so i < j - 1): swap them.
+        let (a, b) = (prims[i], prims[j - 1]);
+        right.grow_box(a.lo, a.hi);
+        right_c.grow_point(a.centroid());
+        left.grow_box(b.lo, b.hi);
+        left_c.grow_point(b.centroid());
+        prims[i] = b;
+        prims[j - 1] = a;
+        i += 1;
+        j -= 1;
+    }
+    ((left, left_c), (right, right_c), i)
 }
 
 /// Puts the lower half of `record`'s primitives by centroid along `axis` first (ties in any
@@ -527,6 +583,7 @@ impl Builder {
         record: Record,
         depth: usize,
         nodes: &mut Vec<WideNode>,
+        bins: &mut Bins,
     ) -> ChildRef {
         let n = record.len();
         let config = &self.config;
@@ -571,7 +628,7 @@ impl Builder {
                 }
             }
             let Some(k) = best else { break };
-            let (left, right) = split_record(prims, &slots[k], config, depth + 1, self.method);
+            let (left, right) = split_record(prims, &slots[k], config, depth + 1, self.method, bins);
             slots[k] = left;
             slots[len] = right;
             len += 1;
@@ -605,7 +662,9 @@ impl Builder {
                 .into_par_iter()
                 .map(|(slice, child_base, local)| {
                     let mut sub = Vec::new();
-                    let root = self.subtree(slice, child_base, local, depth + 1, &mut sub);
+                    let mut bins = Bins::new();
+                    let root =
+                        self.subtree(slice, child_base, local, depth + 1, &mut sub, &mut bins);
                     Subtree { nodes: sub, root }
                 })
                 .collect();
@@ -629,7 +688,7 @@ impl Builder {
             }
         } else {
             for (slot, c) in children.iter().enumerate() {
-                let child = self.subtree(prims, base, *c, depth + 1, nodes);
+                let child = self.subtree(prims, base, *c, depth + 1, nodes, bins);
                 nodes[node_index].set_child(slot, child, &c.bounds.aabb());
             }
         }
@@ -681,11 +740,12 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
             split: None,
             level: 0,
         };
+        let mut bins = Bins::new();
         if method == SplitMethod::Sah && record.len() > config.min_leaf {
-            record.split = find_split(&prims, &record, &config);
+            record.split = find_split(&prims, &record, &config, &mut bins);
         }
         let builder = Builder { config, method };
-        builder.subtree(&mut prims, 0, record, 0, &mut nodes)
+        builder.subtree(&mut prims, 0, record, 0, &mut nodes, &mut bins)
     };
     pack(
         shapes,
@@ -763,5 +823,158 @@ fn pack(
         shapes: others,
         source: lane_source,
         isa: Isa::detect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small xorshift generator, so the tests need no crate.
+    struct Rng(u64);
+    impl Rng {
+        fn next(&mut self) -> u64 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            self.0
+        }
+        fn f32(&mut self) -> f32 {
+            (self.next() >> 40) as f32 / (1u64 << 24) as f32
+        }
+    }
+
+    fn prim(index: usize, lo: [f32; 3], hi: [f32; 3]) -> PrimRef {
+        PrimRef {
+            lo: [lo[0], lo[1], lo[2], f32::from_bits(index as u32)],
+            hi: [hi[0], hi[1], hi[2], f32::from_bits(1)],
+        }
+    }
+
+    /// Boxes of every kind the builder meets: random, flat, points, coinciding, on a grid
+    /// (centroids landing exactly on bin boundaries), far outliers.
+    fn prim_sets() -> Vec<Vec<PrimRef>> {
+        let mut r = Rng(0x9e37_79b9_7f4a_7c15);
+        let mut sets = Vec::new();
+        for n in [2usize, 5, 9, 33, 100, 1000] {
+            let random = (0..n)
+                .map(|i| {
+                    let a: [f32; 3] = std::array::from_fn(|_| r.f32() * 10.0 - 5.0);
+                    let d: [f32; 3] = std::array::from_fn(|_| r.f32());
+                    prim(i, a, std::array::from_fn(|k| a[k] + d[k]))
+                })
+                .collect();
+            sets.push(random);
+            let flat = (0..n)
+                .map(|i| {
+                    let a = [r.f32(), 0.5, r.f32()];
+                    prim(i, a, [a[0] + r.f32(), 0.5, a[2]])
+                })
+                .collect();
+            sets.push(flat);
+            let grid = (0..n)
+                .map(|i| {
+                    let p = [(i % 7) as f32, (i % 32) as f32 * 0.25, (i % 3) as f32 - 1.0];
+                    prim(i, p, p)
+                })
+                .collect();
+            sets.push(grid);
+            let mut outlier: Vec<PrimRef> = (0..n)
+                .map(|i| {
+                    let a: [f32; 3] = std::array::from_fn(|_| r.f32());
+                    prim(i, a, a)
+                })
+                .collect();
+            outlier[n / 2] = prim(n / 2, [1e30, -1e30, 3e5], [1e30, -1e30, 3e5]);
+            sets.push(outlier);
+            sets.push((0..n).map(|i| prim(i, [1.0; 3], [2.0; 3])).collect());
+        }
+        sets
+    }
+
+    fn record_of(prims: &[PrimRef]) -> Record {
+        let (bounds, centroids) = measure(prims);
+        Record {
+            start: 0,
+            end: prims.len(),
+            bounds,
+            centroids,
+            split: None,
+            level: 0,
+        }
+    }
+
+    fn same_box(a: &Box4, b: &Box4) -> bool {
+        (0..3).all(|k| a.lo[k] == b.lo[k] && a.hi[k] == b.hi[k])
+    }
+
+    /// Centroid offsets on and beside every bin boundary, below and beyond the bins, and NaN
+    /// (a box infinite both ways), under a binner of unit bins.
+    #[test]
+    fn partition_agrees_with_the_bins_on_their_boundaries() {
+        let binner = Binner {
+            origin: [0.0; 4],
+            scale: [1.0, 1.0, 1.0, 0.0],
+            count: BINS,
+        };
+        let mut offsets: Vec<f32> = vec![-1.0, -0.0, 40.0, f32::INFINITY];
+        for k in 0..=BINS {
+            let x = k as f32;
+            offsets.extend([x, x.next_down(), x.next_up(), x + 0.5]);
+        }
+        let mut set: Vec<PrimRef> = offsets
+            .iter()
+            .enumerate()
+            // Centroids are doubled: lo + hi = x.
+            .map(|(i, &x)| prim(i, [x, x * 0.5, 0.0], [0.0, x * 0.5, x]))
+            .collect();
+        let n = set.len();
+        set.push(prim(n, [f32::NEG_INFINITY; 3], [f32::INFINITY; 3]));
+        for axis in 0..3 {
+            for bin in 0..BINS - 1 {
+                let split = Split {
+                    axis,
+                    bin,
+                    cost: 0.0,
+                };
+                let mut prims = set.clone();
+                let (_, _, mid) = partition(&mut prims, &binner, split);
+                let side = |p: &PrimRef| binner.bin(p.centroid(), axis) <= bin;
+                assert!(prims[..mid].iter().all(side), "axis {axis} bin {bin}");
+                assert!(!prims[mid..].iter().any(side), "axis {axis} bin {bin}");
+            }
+        }
+    }
+
+    #[test]
+    fn partition_puts_each_primitive_on_the_side_of_its_bin_and_measures_both() {
+        for set in prim_sets() {
+            let record = record_of(&set);
+            let binner = Binner::new(&record.centroids, set.len());
+            for axis in 0..3 {
+                for bin in 0..binner.count - 1 {
+                    let split = Split {
+                        axis,
+                        bin,
+                        cost: 0.0,
+                    };
+                    let mut prims = set.clone();
+                    let (left, right, mid) = partition(&mut prims, &binner, split);
+                    let side = |p: &PrimRef| binner.bin(p.centroid(), axis) <= bin;
+                    assert!(prims[..mid].iter().all(side));
+                    assert!(!prims[mid..].iter().any(side));
+                    let mut indices: Vec<usize> = prims.iter().map(PrimRef::index).collect();
+                    indices.sort_unstable();
+                    assert!(indices.iter().copied().eq(0..set.len()));
+                    for ((b, c), range) in [(left, &prims[..mid]), (right, &prims[mid..])] {
+                        if range.is_empty() {
+                            continue;
+                        }
+                        let (mb, mc) = measure(range);
+                        assert!(same_box(&b, &mb) && same_box(&c, &mc));
+                    }
+                }
+            }
+        }
     }
 }
