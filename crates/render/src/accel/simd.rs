@@ -28,6 +28,21 @@ use crate::ray::Ray;
 // Each entry point takes the `Avx2` proof (`accel/isa.rs`) that the CPU has AVX2 and FMA, so
 // the kernel is chosen once, where the `Isa` is; on other targets the proof cannot exist.
 
+/// A hint to fetch the cache line holding the start of `value`: a prefetch (no effect on
+/// the program's results, and it never faults); nothing where there is no such instruction.
+#[inline(always)]
+pub(crate) fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: SSE is part of x86-64; a prefetch reads nothing the program sees.
+    unsafe {
+        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
+            (value as *const T).cast(),
+        )
+    };
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}
+
 /// Closest hit with the AVX2 kernels; a ray that is not valid (`wide::ray_is_valid`) meets
 /// nothing.
 #[inline]
