@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use crate::accel::build::SplitMethod;
-use crate::accel::wide::{TreeStats, WalkCounts};
+use crate::accel::wide::{TreeStats, WalkCounts, BLOCK};
 use crate::accel::{LocalHit, WideBvh, PACKET};
 use crate::bvh::Bvh;
 use crate::geometry::{Aabb, Shape};
@@ -99,9 +99,16 @@ impl Geometry {
             AccelKind::Wide => {
                 let bvh = crate::accel::build::build_with(&desc.shapes, split);
                 let materials = Materials::new(&desc.materials, &bvh.source);
-                let normals = (0..bvh.primitive_slots() as u32)
-                    .map(|p| triangle_normal(&bvh.shape(p)))
-                    .collect();
+                // Each primitive slot's `triangle_normal(&bvh.shape(p))`, read from the blocks
+                // directly rather than through a `Shape` per slot.
+                let mut normals = Vec::with_capacity(bvh.primitive_slots());
+                for block in &bvh.blocks {
+                    normals.extend((0..BLOCK).map(|lane| {
+                        let [a, b, c] = block.triangle(lane).map(Vec3::from_array);
+                        (b - a).cross(c - a).normalized()
+                    }));
+                }
+                normals.extend(bvh.shapes.iter().map(triangle_normal));
                 Geometry {
                     blas: Blas::Wide(bvh),
                     materials,
