@@ -250,6 +250,20 @@ impl WideBvh {
         b == u32::MAX || self.source[a as usize] < self.source[b as usize]
     }
 
+    /// Makes the hit (t, primitive, barycentrics) the closest so far if it is nearer than
+    /// `best`, or as near and earlier (the tie rule of `earlier`).
+    #[inline(always)]
+    pub(crate) fn keep_nearer(&self, best: &mut LocalHit, t: f32, primitive: u32, b: (f32, f32)) {
+        if t < best.t || (t == best.t && self.earlier(primitive, best.primitive)) {
+            *best = LocalHit {
+                t,
+                primitive,
+                b1: b.0,
+                b2: b.1,
+            };
+        }
+    }
+
     /// Barycentrics for the winner only (traversal keeps t and the index).
     pub(crate) fn finish(&self, ray: &Ray, t: f32, primitive: u32) -> LocalHit {
         self.finish_with(ray, &WoopRay::new(ray.origin, ray.direction), t, primitive)
@@ -554,15 +568,8 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
             if !current.is_shapes() {
                 for b in first..first + count {
                     if let Some(h) = kernel.block(&bvh.blocks[b], &woop, ray.t_min, best.t) {
-                        let prim = (b * BLOCK + h.lane) as u32;
-                        if h.t < best.t || (h.t == best.t && bvh.earlier(prim, best.primitive)) {
-                            best = LocalHit {
-                                t: h.t,
-                                primitive: prim,
-                                b1: h.b1,
-                                b2: h.b2,
-                            };
-                        }
+                        let primitive = (b * BLOCK + h.lane) as u32;
+                        bvh.keep_nearer(&mut best, h.t, primitive, (h.b1, h.b2));
                     }
                 }
             } else {
@@ -572,15 +579,7 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
                         ..*ray
                     };
                     if let Some(h) = bvh.shapes[s].intersect(&window) {
-                        let prim = lanes + s as u32;
-                        if h.t < best.t || (h.t == best.t && bvh.earlier(prim, best.primitive)) {
-                            best = LocalHit {
-                                t: h.t,
-                                primitive: prim,
-                                b1: h.b1,
-                                b2: h.b2,
-                            };
-                        }
+                        bvh.keep_nearer(&mut best, h.t, lanes + s as u32, (h.b1, h.b2));
                     }
                 }
             }
