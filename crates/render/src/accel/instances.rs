@@ -448,10 +448,11 @@ impl Instances {
     pub fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<f32> {
         if self.instances.len() == 1 {
             let inst = &self.instances[0];
-            let local = Instances::object_ray(inst, ray, ray.t_max);
-            return self.geometries[inst.geometry as usize]
-                .count_closest(&local, counts)
-                .map(|(t, _)| t);
+            let geometry = &self.geometries[inst.geometry as usize];
+            return Instances::in_object_space(inst, ray, ray.t_max, |local| {
+                geometry.count_closest(local, counts)
+            })
+            .map(|(t, _)| t);
         }
         let mut best = None;
         self.tlas.traverse(ray, |inst_index, t_limit| {
@@ -477,6 +478,19 @@ impl Instances {
     }
 
     /// The ray in an instance's object space; t means the same there (no re-normalising).
+    /// `f` of `object_ray(inst, ray, t_max)`, given the ray itself where that is the same ray
+    /// (no transform, the ray's own window): a copy of a ray its caller has just written is
+    /// read back from the store buffer, which stalls when the copy's loads straddle the
+    /// caller's stores (`perf annotate` showed it on every path-traced ray).
+    #[inline(always)]
+    fn in_object_space<R>(inst: &Instance, ray: &Ray, t_max: f32, f: impl FnOnce(&Ray) -> R) -> R {
+        if inst.transform.is_none() && t_max == ray.t_max {
+            f(ray)
+        } else {
+            f(&Instances::object_ray(inst, ray, t_max))
+        }
+    }
+
     #[inline(always)]
     fn object_ray(inst: &Instance, ray: &Ray, t_max: f32) -> Ray {
         match &inst.transform {
@@ -496,10 +510,11 @@ impl Instances {
         if self.instances.len() == 1 {
             // One instance (every stand-alone mesh): no top level to walk.
             let inst = &self.instances[0];
-            let local = Instances::object_ray(inst, ray, ray.t_max);
-            return self.geometries[inst.geometry as usize]
-                .intersect(&local)
-                .map(|h| Hit {
+            let geometry = &self.geometries[inst.geometry as usize];
+            return Instances::in_object_space(inst, ray, ray.t_max, |local| {
+                geometry.intersect(local)
+            })
+            .map(|h| Hit {
                     t: h.t,
                     instance: 0,
                     primitive: h.primitive,
@@ -533,10 +548,11 @@ impl Instances {
     pub fn intersect_preliminary(&self, ray: &Ray) -> Option<PreliminaryHit> {
         if self.instances.len() == 1 {
             let inst = &self.instances[0];
-            let local = Instances::object_ray(inst, ray, ray.t_max);
-            return self.geometries[inst.geometry as usize]
-                .intersect_preliminary(&local)
-                .map(|(t, primitive)| PreliminaryHit {
+            let geometry = &self.geometries[inst.geometry as usize];
+            return Instances::in_object_space(inst, ray, ray.t_max, |local| {
+                geometry.intersect_preliminary(local)
+            })
+            .map(|(t, primitive)| PreliminaryHit {
                     t,
                     instance: 0,
                     primitive,
@@ -589,9 +605,11 @@ impl Instances {
     pub fn occluded(&self, ray: &Ray) -> bool {
         if self.instances.len() == 1 {
             let inst = &self.instances[0];
+            let geometry = &self.geometries[inst.geometry as usize];
             return inst.casts_shadow
-                && self.geometries[inst.geometry as usize]
-                    .occluded(&Instances::object_ray(inst, ray, ray.t_max));
+                && Instances::in_object_space(inst, ray, ray.t_max, |local| {
+                    geometry.occluded(local)
+                });
         }
         let mut hit = false;
         self.tlas.traverse_any(ray, |inst_index| {
