@@ -953,18 +953,30 @@ mod tests {
         set.push(prim(n, [f32::NEG_INFINITY; 3], [f32::INFINITY; 3]));
         for axis in 0..3 {
             for bin in 0..BINS - 1 {
-                let split = Split {
-                    axis,
-                    bin,
-                    cost: 0.0,
-                };
-                let mut prims = set.clone();
-                let (_, _, mid) = partition(&mut prims, &binner, split);
-                let side = |p: &PrimRef| binner.bin(p.centroid(), axis) <= bin;
-                assert!(prims[..mid].iter().all(side), "axis {axis} bin {bin}");
-                assert!(!prims[mid..].iter().any(side), "axis {axis} bin {bin}");
+                partition_checked(&set, &binner, axis, bin);
             }
         }
+    }
+
+    /// `partition` of a copy of `set` by (axis, bin), asserting that each primitive lands on
+    /// the side `Binner::bin` gives it; returns the partitioned copy and what `partition` said.
+    fn partition_checked(
+        set: &[PrimRef],
+        binner: &Binner,
+        axis: usize,
+        bin: usize,
+    ) -> (Vec<PrimRef>, (Box4, Box4), (Box4, Box4), usize) {
+        let split = Split {
+            axis,
+            bin,
+            cost: 0.0,
+        };
+        let mut prims = set.to_vec();
+        let (left, right, mid) = partition(&mut prims, binner, split);
+        let side = |p: &PrimRef| binner.bin(p.centroid(), axis) <= bin;
+        assert!(prims[..mid].iter().all(side), "axis {axis} bin {bin}");
+        assert!(!prims[mid..].iter().any(side), "axis {axis} bin {bin}");
+        (prims, left, right, mid)
     }
 
     #[test]
@@ -974,16 +986,7 @@ mod tests {
             let binner = Binner::new(&record.centroids, set.len());
             for axis in 0..3 {
                 for bin in 0..binner.count - 1 {
-                    let split = Split {
-                        axis,
-                        bin,
-                        cost: 0.0,
-                    };
-                    let mut prims = set.clone();
-                    let (left, right, mid) = partition(&mut prims, &binner, split);
-                    let side = |p: &PrimRef| binner.bin(p.centroid(), axis) <= bin;
-                    assert!(prims[..mid].iter().all(side));
-                    assert!(!prims[mid..].iter().any(side));
+                    let (prims, left, right, mid) = partition_checked(&set, &binner, axis, bin);
                     let mut indices: Vec<usize> = prims.iter().map(PrimRef::index).collect();
                     indices.sort_unstable();
                     assert!(indices.iter().copied().eq(0..set.len()));

@@ -449,7 +449,7 @@ impl Instances {
         if self.instances.len() == 1 {
             let inst = &self.instances[0];
             let geometry = &self.geometries[inst.geometry as usize];
-            return Instances::in_object_space(inst, ray, ray.t_max, |local| {
+            return Instances::in_object_space(inst, ray, |local| {
                 geometry.count_closest(local, counts)
             })
             .map(|(t, _)| t);
@@ -477,20 +477,20 @@ impl Instances {
         self.geometries[inst.geometry as usize].source_index(hit.primitive)
     }
 
-    /// The ray in an instance's object space; t means the same there (no re-normalising).
-    /// `f` of `object_ray(inst, ray, t_max)`, given the ray itself where that is the same ray
-    /// (no transform, the ray's own window): a copy of a ray its caller has just written is
+    /// `f` of the ray in `inst`'s object space with the ray's own window: the ray itself
+    /// where the instance has no transform. A copy of a ray its caller has just written is
     /// read back from the store buffer, which stalls when the copy's loads straddle the
     /// caller's stores (`perf annotate` showed it on every path-traced ray).
     #[inline(always)]
-    fn in_object_space<R>(inst: &Instance, ray: &Ray, t_max: f32, f: impl FnOnce(&Ray) -> R) -> R {
-        if inst.transform.is_none() && t_max == ray.t_max {
+    fn in_object_space<R>(inst: &Instance, ray: &Ray, f: impl FnOnce(&Ray) -> R) -> R {
+        if inst.transform.is_none() {
             f(ray)
         } else {
-            f(&Instances::object_ray(inst, ray, t_max))
+            f(&Instances::object_ray(inst, ray, ray.t_max))
         }
     }
 
+    /// The ray in an instance's object space; t means the same there (no re-normalising).
     #[inline(always)]
     fn object_ray(inst: &Instance, ray: &Ray, t_max: f32) -> Ray {
         match &inst.transform {
@@ -511,7 +511,7 @@ impl Instances {
             // One instance (every stand-alone mesh): no top level to walk.
             let inst = &self.instances[0];
             let geometry = &self.geometries[inst.geometry as usize];
-            return Instances::in_object_space(inst, ray, ray.t_max, |local| {
+            return Instances::in_object_space(inst, ray, |local| {
                 geometry.intersect(local)
             })
             .map(|h| Hit {
@@ -549,7 +549,7 @@ impl Instances {
         if self.instances.len() == 1 {
             let inst = &self.instances[0];
             let geometry = &self.geometries[inst.geometry as usize];
-            return Instances::in_object_space(inst, ray, ray.t_max, |local| {
+            return Instances::in_object_space(inst, ray, |local| {
                 geometry.intersect_preliminary(local)
             })
             .map(|(t, primitive)| PreliminaryHit {
@@ -607,7 +607,7 @@ impl Instances {
             let inst = &self.instances[0];
             let geometry = &self.geometries[inst.geometry as usize];
             return inst.casts_shadow
-                && Instances::in_object_space(inst, ray, ray.t_max, |local| {
+                && Instances::in_object_space(inst, ray, |local| {
                     geometry.occluded(local)
                 });
         }

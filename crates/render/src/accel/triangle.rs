@@ -38,7 +38,8 @@ impl WoopRay {
         let a = d.map(f32::abs);
         // 0 where a[0] >= a[1] and a[0] >= a[2], else 1 where a[1] >= a[2], else 2: written
         // as arithmetic on comparisons, since branches on the direction mispredict on
-        // incoherent rays.
+        // incoherent rays (path-traced Cornell 256x256, 40 spp: render 0.991 -> 0.959 s,
+        // medians of 9 alternating rounds).
         let x_major = a[0] >= a[1] && a[0] >= a[2];
         let y_over_z = a[1] >= a[2];
         let kz = usize::from(!x_major) * (1 + usize::from(!y_over_z));
