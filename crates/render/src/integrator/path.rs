@@ -186,6 +186,9 @@ impl PathIntegrator {
             // Each vertex draws its numbers from its own block of dimensions, so a pixel's
             // samples are stratified against each other vertex by vertex.
             let dimension = first_dimension + DIMENSIONS_PER_VERTEX * depth;
+            // The light's and the direction's numbers do not depend on the hit: their work
+            // can run beside the traversal.
+            sampler.prepare([dimension, dimension + 3]);
             *rays += 1;
             let Some(hit) = scene.intersect_preliminary(&ray) else {
                 let background = scene.background_radiance(ray.direction);

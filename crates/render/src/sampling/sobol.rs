@@ -23,6 +23,13 @@ pub trait PathSampler {
     fn sample_1d(&mut self, dimension: u32) -> f32;
     /// Two values in [0, 1)² for dimensions `dimension` and `dimension + 1`.
     fn sample_2d(&mut self, dimension: u32) -> (f32, f32);
+    /// A hint that `dimensions` are likely drawn soon: a sampler may start their work now, so
+    /// that it overlaps whatever runs in between (the path tracer gives a vertex's dimensions
+    /// before tracing the ray that finds the vertex). No value changes.
+    #[inline(always)]
+    fn prepare(&mut self, dimensions: [u32; 2]) {
+        let _ = dimensions;
+    }
 }
 
 impl PathSampler for Rng {
@@ -108,40 +115,74 @@ impl Permutation {
     /// `(i + seed) mod 2³² mod n` without a division.
     #[inline(always)]
     pub(crate) fn apply(&self, mut i: u32) -> u32 {
-        let (n, w) = (self.n, self.w);
         loop {
-            i ^= self.seed;
-            i = i.wrapping_mul(0xe170_893d);
-            i ^= self.seed_16;
-            i ^= (i & w) >> 4;
-            i ^= self.seed_8;
-            i = i.wrapping_mul(0x0929_eb3f);
-            i ^= self.seed_23;
-            i ^= (i & w) >> 1;
-            i = i.wrapping_mul(self.multiplier);
-            i ^= (i & w) >> 11;
-            i = i.wrapping_mul(0x74dc_b303);
-            i ^= (i & w) >> 2;
-            i = i.wrapping_mul(0x9e50_1cc3);
-            i ^= (i & w) >> 2;
-            i = i.wrapping_mul(0xc860_a3df);
-            i &= w;
-            i ^= i >> 5;
+            i = self.round(i);
             // With n a power of two, i ≤ w = n − 1 here; and since n divides 2³², the final
             // (i + seed) mod 2³² mod n is a mask (n = 1 included: w = 0).
             if self.power_of_two {
-                return i.wrapping_add(self.seed) & w;
+                return i.wrapping_add(self.seed) & self.w;
             }
-            if i < n {
-                break;
+            if i < self.n {
+                return self.finish(i);
             }
         }
+    }
+
+    /// `apply` with its first two rounds taken unconditionally and the one kept chosen by a
+    /// select, not a branch: nothing to mispredict unless both rounds land at n or above (a
+    /// fraction ((w + 1 − n)/(w + 1))² of indices, under a quarter), so that work started
+    /// ahead of its use overlaps the code after it instead of being thrown away with it.
+    #[inline(always)]
+    pub(crate) fn apply_ahead(&self, i: u32) -> u32 {
+        let first = self.round(i);
+        if self.power_of_two {
+            return first.wrapping_add(self.seed) & self.w;
+        }
+        let second = self.round(first);
+        let kept = if first < self.n { first } else { second };
+        if kept < self.n {
+            self.finish(kept)
+        } else {
+            self.apply(second)
+        }
+    }
+
+    /// One pass of Kensler's rounds over the w-bit domain (a bijection of 0..=w).
+    #[inline(always)]
+    fn round(&self, mut i: u32) -> u32 {
+        let w = self.w;
+        i ^= self.seed;
+        i = i.wrapping_mul(0xe170_893d);
+        i ^= self.seed_16;
+        i ^= (i & w) >> 4;
+        i ^= self.seed_8;
+        i = i.wrapping_mul(0x0929_eb3f);
+        i ^= self.seed_23;
+        i ^= (i & w) >> 1;
+        i = i.wrapping_mul(self.multiplier);
+        i ^= (i & w) >> 11;
+        i = i.wrapping_mul(0x74dc_b303);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0x9e50_1cc3);
+        i ^= (i & w) >> 2;
+        i = i.wrapping_mul(0xc860_a3df);
+        i &= w;
+        i ^ (i >> 5)
+    }
+
+    /// `(i + seed) mod 2³² mod n` for i < n (n not a power of two), without a division.
+    #[inline(always)]
+    fn finish(&self, i: u32) -> u32 {
         match i.overflowing_add(self.seed) {
             // Past 2³², the wrapped sum is below i, so below n already.
             (wrapped, true) => wrapped,
             (_, false) => {
                 let sum = i as u64 + self.seed_mod_n as u64;
-                (if sum >= n as u64 { sum - n as u64 } else { sum }) as u32
+                (if sum >= self.n as u64 {
+                    sum - self.n as u64
+                } else {
+                    sum
+                }) as u32
             }
         }
     }
@@ -174,6 +215,7 @@ impl SobolPixel {
             rng: None,
             pixel: self,
             sample_index,
+            prepared: [(u32::MAX, 0); 2],
         }
     }
 }
@@ -186,6 +228,8 @@ pub struct SobolSampler<'a> {
     rng: Option<Rng>,
     pixel: &'a SobolPixel,
     sample_index: u32,
+    /// (dimension, shuffled index) computed ahead by `prepare`; `u32::MAX`: none.
+    prepared: [(u32, u32); 2],
 }
 
 impl SobolSampler<'_> {
@@ -194,7 +238,11 @@ impl SobolSampler<'_> {
     #[inline(always)]
     fn index_and_seeds(&self, dimension: u32) -> (u32, &DimensionSeeds) {
         let seeds = &self.pixel.dimensions[dimension as usize];
-        (seeds.permutation.apply(self.sample_index), seeds)
+        let index = match self.prepared {
+            [(d, index), _] | [_, (d, index)] if d == dimension => index,
+            _ => seeds.permutation.apply(self.sample_index),
+        };
+        (index, seeds)
     }
 
     /// The sample's PCG stream (`Rng::for_sample(seed, pixel, sample_index)`).
@@ -214,6 +262,16 @@ fn permute_mask(n: u32) -> u32 {
 }
 
 impl PathSampler for SobolSampler<'_> {
+    #[inline(always)]
+    fn prepare(&mut self, dimensions: [u32; 2]) {
+        for (slot, dimension) in self.prepared.iter_mut().zip(dimensions) {
+            if dimension < QMC_DIMENSIONS {
+                let seeds = &self.pixel.dimensions[dimension as usize];
+                *slot = (dimension, seeds.permutation.apply_ahead(self.sample_index));
+            }
+        }
+    }
+
     #[inline(always)]
     fn sample_1d(&mut self, dimension: u32) -> f32 {
         if dimension >= QMC_DIMENSIONS {
@@ -424,6 +482,39 @@ mod tests {
                         let expected = kensler_permute(i, n, p.seed);
                         assert_eq!(p.apply(i), expected, "i {i} n {n}");
                     }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn apply_ahead_is_apply() {
+        let mut rng = Rng::new(17, 5);
+        for n in (1..=70).chain([127, 128, 129, 1000, 4096, 65_537]) {
+            for _ in 0..20 {
+                let permutation = Permutation::new(n, rng.next_u32());
+                for i in (0..n.min(80)).chain((0..16).map(|_| rng.below(n))) {
+                    assert_eq!(permutation.apply_ahead(i), permutation.apply(i), "i {i} n {n}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn prepared_dimensions_give_the_same_values() {
+        // Dimensions prepared ahead (some of them never drawn, one beyond the Sobol' ones)
+        // draw exactly what unprepared ones do, whichever slot holds them.
+        for (n, pixel) in [(40, 3), (64, 8), (7, 1000)] {
+            let sobol = SobolPixel::new(9, pixel, n);
+            for s in 0..n {
+                let mut plain = sobol.sampler(s);
+                let mut prepared = sobol.sampler(s);
+                for vertex in 0..6 {
+                    let d = 2 + 6 * vertex;
+                    prepared.prepare(if vertex % 2 == 0 { [d, d + 3] } else { [d + 3, d] });
+                    assert_eq!(prepared.sample_2d(d), plain.sample_2d(d));
+                    assert_eq!(prepared.sample_1d(d + 2), plain.sample_1d(d + 2));
+                    assert_eq!(prepared.sample_2d(d + 3), plain.sample_2d(d + 3));
                 }
             }
         }
