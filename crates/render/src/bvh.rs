@@ -333,11 +333,11 @@ impl PacketInverse {
             let mask = crate::accel::simd::binary_node_lanes(
                 avx2,
                 node.min,
-            node.max,
-            &self.origin,
-            &self.inv_dir,
-            &self.t_min,
-            t_max,
+                node.max,
+                &self.origin,
+                &self.inv_dir,
+                &self.t_min,
+                t_max,
             );
             return mask & active;
         }

@@ -43,7 +43,8 @@
 //! part of the API and may change at any time.
 
 /// Modules private to the crate, public with the `bench` feature (for benchmarks and the
-/// cross-crate tests of the ray engine).
+/// cross-crate tests of the ray engine). `cargo fmt` does not look inside this macro's
+/// invocation, so it does not reach these modules: `scripts/fmt.sh` formats them.
 macro_rules! internal_modules {
     ($($(#[$attr:meta])* $name:ident;)*) => {
         $(

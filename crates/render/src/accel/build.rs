@@ -21,9 +21,7 @@ use rayon::prelude::*;
 
 use crate::accel::isa::Isa;
 use crate::accel::simd;
-use crate::accel::wide::{
-    ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH,
-};
+use crate::accel::wide::{ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
 
@@ -489,8 +487,9 @@ fn partition(
 fn object_median(prims: &mut [PrimRef], record: &Record, axis: usize) -> usize {
     let (start, end) = (record.start, record.end);
     let half = (end - start) / 2;
-    prims[start..end]
-        .select_nth_unstable_by(half, |a, b| a.centroid()[axis].total_cmp(&b.centroid()[axis]));
+    prims[start..end].select_nth_unstable_by(half, |a, b| {
+        a.centroid()[axis].total_cmp(&b.centroid()[axis])
+    });
     start + half
 }
 
@@ -629,7 +628,8 @@ impl Builder {
                 }
             }
             let Some(k) = best else { break };
-            let (left, right) = split_record(prims, &slots[k], config, depth + 1, self.method, bins);
+            let (left, right) =
+                split_record(prims, &slots[k], config, depth + 1, self.method, bins);
             slots[k] = left;
             slots[len] = right;
             len += 1;
@@ -817,13 +817,18 @@ fn pack(
         .iter()
         .enumerate()
         .flat_map(|(n, node)| {
-            node.children.iter().enumerate().filter_map(move |(slot, &c)| {
-                let c = ChildRef(c);
-                (c.is_leaf() && c != ChildRef::EMPTY).then_some((n as u32, slot as u8))
-            })
+            node.children
+                .iter()
+                .enumerate()
+                .filter_map(move |(slot, &c)| {
+                    let c = ChildRef(c);
+                    (c.is_leaf() && c != ChildRef::EMPTY).then_some((n as u32, slot as u8))
+                })
         })
         .collect();
-    let leaf_of = |nodes: &[WideNode], (n, slot): (u32, u8)| ChildRef(nodes[n as usize].children[slot as usize]);
+    let leaf_of = |nodes: &[WideNode], (n, slot): (u32, u8)| {
+        ChildRef(nodes[n as usize].children[slot as usize])
+    };
     for (i, &leaf) in leaves.iter().enumerate() {
         if let Some(&ahead) = leaves.get(i + AHEAD) {
             let (start, count) = leaf_of(&nodes, ahead).range();

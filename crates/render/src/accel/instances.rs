@@ -511,16 +511,15 @@ impl Instances {
             // One instance (every stand-alone mesh): no top level to walk.
             let inst = &self.instances[0];
             let geometry = &self.geometries[inst.geometry as usize];
-            return Instances::in_object_space(inst, ray, |local| {
-                geometry.intersect(local)
-            })
-            .map(|h| Hit {
+            return Instances::in_object_space(inst, ray, |local| geometry.intersect(local)).map(
+                |h| Hit {
                     t: h.t,
                     instance: 0,
                     primitive: h.primitive,
                     b1: h.b1,
                     b2: h.b2,
-                });
+                },
+            );
         }
         let mut best: Option<Hit> = None;
         self.tlas.traverse(ray, |inst_index, t_limit| {
@@ -553,10 +552,10 @@ impl Instances {
                 geometry.intersect_preliminary(local)
             })
             .map(|(t, primitive)| PreliminaryHit {
-                    t,
-                    instance: 0,
-                    primitive,
-                });
+                t,
+                instance: 0,
+                primitive,
+            });
         }
         let mut best: Option<PreliminaryHit> = None;
         self.tlas.traverse(ray, |inst_index, t_limit| {
@@ -607,9 +606,7 @@ impl Instances {
             let inst = &self.instances[0];
             let geometry = &self.geometries[inst.geometry as usize];
             return inst.casts_shadow
-                && Instances::in_object_space(inst, ray, |local| {
-                    geometry.occluded(local)
-                });
+                && Instances::in_object_space(inst, ray, |local| geometry.occluded(local));
         }
         let mut hit = false;
         self.tlas.traverse_any(ray, |inst_index| {
@@ -666,7 +663,9 @@ impl Instances {
                 // `object_ray` would copy the rays unchanged.
                 None => geometry.intersect_packet(rays, packet),
                 Some(_) => {
-                    let local = rays.each_ref().map(|r| Instances::object_ray(inst, r, r.t_max));
+                    let local = rays
+                        .each_ref()
+                        .map(|r| Instances::object_ray(inst, r, r.t_max));
                     geometry.intersect_packet(&local, packet)
                 }
             };
@@ -748,7 +747,9 @@ impl Instances {
                 | match inst.transform {
                     None => geometry.occluded_packet(rays, packet),
                     Some(_) => {
-                        let local = rays.each_ref().map(|r| Instances::object_ray(inst, r, r.t_max));
+                        let local = rays
+                            .each_ref()
+                            .map(|r| Instances::object_ray(inst, r, r.t_max));
                         geometry.occluded_packet(&local, packet)
                     }
                 };
@@ -761,13 +762,13 @@ impl Instances {
                 if !inst.casts_shadow {
                     return 0;
                 }
-                let local = rays.each_ref().map(|r| Instances::object_ray(inst, r, r.t_max));
+                let local = rays
+                    .each_ref()
+                    .map(|r| Instances::object_ray(inst, r, r.t_max));
                 self.geometries[inst.geometry as usize].occluded_packet(&local, reached)
             })
     }
-
 }
-
 
 /// A triangle's unit geometric normal as `Shape::normal` computes it; zero for other shapes
 /// (and for a degenerate triangle, whose normal is zero there too).

@@ -11,8 +11,8 @@
 //! fixed ray sets that measure all this.
 
 pub mod build;
-pub mod instances;
 mod dispatch;
+pub mod instances;
 pub mod isa;
 pub mod packet;
 pub mod simd;
@@ -21,9 +21,9 @@ pub mod wide;
 #[cfg(feature = "bench")]
 pub mod workload;
 
+#[cfg(any(test, feature = "bench"))]
+pub use isa::Isa;
 #[cfg(feature = "bench")]
 pub use packet::ALL_LANES;
 pub use packet::PACKET;
-#[cfg(any(test, feature = "bench"))]
-pub use isa::Isa;
 pub use wide::{LocalHit, WideBvh};

@@ -33,8 +33,8 @@
 
 use crate::accel::triangle::WoopRay;
 use crate::accel::wide::{
-    self, ArrayStack, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, TriangleBlock, WideBvh,
-    WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
+    self, ArrayStack, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, TriangleBlock,
+    WideBvh, WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
 };
 use crate::ray::Ray;
 

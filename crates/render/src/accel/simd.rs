@@ -146,8 +146,7 @@ mod x86 {
     use crate::accel::triangle::WoopRay;
     use crate::accel::wide::{
         self, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock,
-        WideBvh, WideNode,
-        BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
+        WideBvh, WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
     };
     use crate::math::Vec3;
     use crate::ray::Ray;

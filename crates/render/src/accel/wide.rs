@@ -694,8 +694,16 @@ impl WideBvh {
             let node = &self.nodes[child.0 as usize];
             for slot in 0..WIDTH {
                 let b = Aabb {
-                    min: Vec3::new(node.bounds[0][slot], node.bounds[1][slot], node.bounds[2][slot]),
-                    max: Vec3::new(node.bounds[3][slot], node.bounds[4][slot], node.bounds[5][slot]),
+                    min: Vec3::new(
+                        node.bounds[0][slot],
+                        node.bounds[1][slot],
+                        node.bounds[2][slot],
+                    ),
+                    max: Vec3::new(
+                        node.bounds[3][slot],
+                        node.bounds[4][slot],
+                        node.bounds[5][slot],
+                    ),
                 };
                 stack.push((ChildRef(node.children[slot]), b.half_area(), above + 1));
             }

@@ -8,13 +8,13 @@ use std::ops::Range;
 use crate::accel::PACKET;
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 
-use crate::light::Light;
+use crate::accel::instances::Hit;
 use crate::light::sampler::{course_light_point, LightPoint, LightSampler};
+use crate::light::Light;
 use crate::material::Material;
-use crate::math::{Frame, Color, Vec3};
+use crate::math::{Color, Frame, Vec3};
 use crate::ray::Ray;
 use crate::sampling::{mix64, sample_cosine_hemisphere, Rng};
-use crate::accel::instances::Hit;
 use crate::scene::{Scene, SurfaceInteraction, SurfaceNeeds};
 
 /// Per-sample state handed to an integrator: the sample's random stream and where the sample

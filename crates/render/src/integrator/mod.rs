@@ -19,7 +19,6 @@ use crate::math::{Color, Vec3};
 use crate::ray::Ray;
 use crate::scene::{Scene, SurfaceNeeds};
 
-
 /// One pixel as an integrator sees it.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PixelContext {

@@ -17,14 +17,14 @@
 
 use std::ops::Range;
 
-use crate::material::bsdf::Bsdf;
-use crate::math::Frame;
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 use crate::light::sampler::LightSampler;
+use crate::material::bsdf::Bsdf;
 use crate::material::{Material, MaterialId};
 use crate::math::Color;
-use crate::sampling::sobol::{PathSampler, SobolPixel};
+use crate::math::Frame;
 use crate::ray::Ray;
+use crate::sampling::sobol::{PathSampler, SobolPixel};
 use crate::scene::{Scene, SurfaceNeeds};
 
 /// Path-length controls of the path tracer.

@@ -2,7 +2,7 @@
 
 pub mod sampler;
 
-use crate::math::{Frame, Color, Vec3};
+use crate::math::{Color, Frame, Vec3};
 
 /// A light source. Emitters that are also visible geometry (shape lights, visible area lights)
 /// additionally appear in the scene as shapes with `Material::Emissive`.

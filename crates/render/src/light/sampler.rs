@@ -16,10 +16,10 @@
 #[cfg(test)]
 use crate::geometry::intersect_triangle;
 use crate::light::Light;
-#[cfg(test)]
-use crate::ray::Ray;
 use crate::material::Material;
 use crate::math::{Color, Vec3};
+#[cfg(test)]
+use crate::ray::Ray;
 use crate::sampling::warp::{
     sample_uniform_cone, sample_uniform_sphere, sample_uniform_triangle, uniform_cone_pdf,
     uniform_sphere_pdf,
@@ -504,11 +504,9 @@ impl LightSampler {
                     normal: Some(*normal),
                     pdf_area: 1.0 / area,
                 };
-                area_sample(reference, point, *radiance).map(|s| {
-                    LightSample {
-                        reachable_by_bsdf,
-                        ..s
-                    }
+                area_sample(reference, point, *radiance).map(|s| LightSample {
+                    reachable_by_bsdf,
+                    ..s
                 })
             }
             PreparedLight::Triangles { .. } => self.sample_triangles(index, reference, u),

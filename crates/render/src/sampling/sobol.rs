@@ -289,7 +289,10 @@ impl PathSampler for SobolSampler<'_> {
         }
         let (index, seeds) = self.index_and_seeds(dimension);
         let first = owen_hash(index, seeds.scramble_first);
-        let second = owen_hash(sobol_second_dimension_reversed(index), seeds.permutation.seed);
+        let second = owen_hash(
+            sobol_second_dimension_reversed(index),
+            seeds.permutation.seed,
+        );
         // Both reversed at once: reversing the 64 bits (first, second) gives (second', first').
         let reversed = ((first as u64) << 32 | second as u64).reverse_bits();
         (
@@ -494,7 +497,11 @@ mod tests {
             for _ in 0..20 {
                 let permutation = Permutation::new(n, rng.next_u32());
                 for i in (0..n.min(80)).chain((0..16).map(|_| rng.below(n))) {
-                    assert_eq!(permutation.apply_ahead(i), permutation.apply(i), "i {i} n {n}");
+                    assert_eq!(
+                        permutation.apply_ahead(i),
+                        permutation.apply(i),
+                        "i {i} n {n}"
+                    );
                 }
             }
         }
@@ -511,7 +518,11 @@ mod tests {
                 let mut prepared = sobol.sampler(s);
                 for vertex in 0..6 {
                     let d = 2 + 6 * vertex;
-                    prepared.prepare(if vertex % 2 == 0 { [d, d + 3] } else { [d + 3, d] });
+                    prepared.prepare(if vertex % 2 == 0 {
+                        [d, d + 3]
+                    } else {
+                        [d + 3, d]
+                    });
                     assert_eq!(prepared.sample_2d(d), plain.sample_2d(d));
                     assert_eq!(prepared.sample_1d(d + 2), plain.sample_1d(d + 2));
                     assert_eq!(prepared.sample_2d(d + 3), plain.sample_2d(d + 3));

@@ -89,11 +89,17 @@ pub fn invert_uniform_disk_concentric(x: f32, y: f32) -> (f32, f32) {
     let (ox, oy) = if phi < std::f32::consts::FRAC_PI_4 {
         (r, r * phi / std::f32::consts::FRAC_PI_4)
     } else if phi < 3.0 * std::f32::consts::FRAC_PI_4 {
-        (r * (std::f32::consts::FRAC_PI_2 - phi) / std::f32::consts::FRAC_PI_4, r)
+        (
+            r * (std::f32::consts::FRAC_PI_2 - phi) / std::f32::consts::FRAC_PI_4,
+            r,
+        )
     } else if phi < 5.0 * std::f32::consts::FRAC_PI_4 {
         (-r, -r * (phi - PI) / std::f32::consts::FRAC_PI_4)
     } else {
-        (-r * (3.0 * std::f32::consts::FRAC_PI_2 - phi) / std::f32::consts::FRAC_PI_4, -r)
+        (
+            -r * (3.0 * std::f32::consts::FRAC_PI_2 - phi) / std::f32::consts::FRAC_PI_4,
+            -r,
+        )
     };
     ((ox + 1.0) / 2.0, (oy + 1.0) / 2.0)
 }
@@ -108,7 +114,11 @@ pub fn uniform_sphere_pdf() -> f32 {
 #[cfg_attr(not(test), allow(dead_code))]
 pub fn invert_uniform_sphere(direction: Vec3) -> (f32, f32) {
     let phi = direction.y.atan2(direction.x);
-    let u2 = if phi < 0.0 { phi / TAU + 1.0 } else { phi / TAU };
+    let u2 = if phi < 0.0 {
+        phi / TAU + 1.0
+    } else {
+        phi / TAU
+    };
     ((1.0 - direction.z) / 2.0, u2)
 }
 
@@ -116,7 +126,14 @@ pub fn invert_uniform_sphere(direction: Vec3) -> (f32, f32) {
 #[cfg_attr(not(test), allow(dead_code))]
 pub fn invert_uniform_triangle(b1: f32, b2: f32) -> (f32, f32) {
     let s = 1.0 - b1;
-    ((s * s).clamp(0.0, 1.0), if s > 0.0 { (b2 / s).clamp(0.0, 1.0) } else { 0.0 })
+    (
+        (s * s).clamp(0.0, 1.0),
+        if s > 0.0 {
+            (b2 / s).clamp(0.0, 1.0)
+        } else {
+            0.0
+        },
+    )
 }
 
 /// A direction around +z with density (p+1)/(2π) · cos^p θ per unit solid angle: the lobe
@@ -167,14 +184,16 @@ pub fn uniform_cone_pdf(cos_theta_max: f32) -> f32 {
     1.0 / (TAU * (1.0 - cos_theta_max))
 }
 
-
-
 /// The (u1, u2) that `sample_uniform_cone` maps to the unit `direction` inside the cone.
 #[cfg_attr(not(test), allow(dead_code))]
 pub fn invert_uniform_cone(direction: Vec3, cos_theta_max: f32) -> (f32, f32) {
     let u1 = (1.0 - direction.z) / (1.0 - cos_theta_max);
     let phi = direction.y.atan2(direction.x);
-    let u2 = if phi < 0.0 { phi / TAU + 1.0 } else { phi / TAU };
+    let u2 = if phi < 0.0 {
+        phi / TAU + 1.0
+    } else {
+        phi / TAU
+    };
     (u1.clamp(0.0, 1.0), u2)
 }
 
@@ -194,12 +213,24 @@ mod tests {
                     "{what}: {u:?} came back as {a:?}"
                 );
             };
-            close(invert_cosine_hemisphere(sample_cosine_hemisphere(u.0, u.1)), "cosine");
-            close(invert_uniform_sphere(sample_uniform_sphere(u.0, u.1)), "sphere");
+            close(
+                invert_cosine_hemisphere(sample_cosine_hemisphere(u.0, u.1)),
+                "cosine",
+            );
+            close(
+                invert_uniform_sphere(sample_uniform_sphere(u.0, u.1)),
+                "sphere",
+            );
             let (b1, b2) = sample_uniform_triangle(u.0, u.1);
             close(invert_uniform_triangle(b1, b2), "triangle");
-            close(invert_phong_lobe(sample_phong_lobe(u.0, u.1, 20.0), 20.0), "phong");
-            close(invert_uniform_cone(sample_uniform_cone(u.0, u.1, 0.7), 0.7), "cone");
+            close(
+                invert_phong_lobe(sample_phong_lobe(u.0, u.1, 20.0), 20.0),
+                "phong",
+            );
+            close(
+                invert_uniform_cone(sample_uniform_cone(u.0, u.1, 0.7), 0.7),
+                "cone",
+            );
         }
     }
 

@@ -259,7 +259,11 @@ impl Scene {
                 let (b1, b2) = hit
                     .barycentrics()
                     .unwrap_or_else(|| self.accel.barycentrics(ray, &prelim));
-                let prim_hit = PrimitiveHit { t: prelim.t, b1, b2 };
+                let prim_hit = PrimitiveHit {
+                    t: prelim.t,
+                    b1,
+                    b2,
+                };
                 geom.shape(prelim.primitive).uv(local_point, &prim_hit)
             }
         };
@@ -267,7 +271,9 @@ impl Scene {
             point,
             normal: normal_at(inst, geom, prelim.primitive, local_point),
             uv,
-            material: inst.material.unwrap_or(geom.materials.get(prelim.primitive)),
+            material: inst
+                .material
+                .unwrap_or(geom.materials.get(prelim.primitive)),
         }
     }
 
