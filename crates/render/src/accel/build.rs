@@ -211,6 +211,18 @@ struct Record {
 }
 
 impl Record {
+    /// The root's record: all `len` primitives, with their (bounds, centroid bounds), unsplit.
+    fn root(len: usize, (bounds, centroids): (Box4, Box4)) -> Record {
+        Record {
+            start: 0,
+            end: len,
+            bounds,
+            centroids,
+            split: None,
+            level: 0,
+        }
+    }
+
     fn len(&self) -> usize {
         self.end - self.start
     }
@@ -733,14 +745,7 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
     let root = if prims.is_empty() {
         ChildRef::EMPTY
     } else {
-        let mut record = Record {
-            start: 0,
-            end: prims.len(),
-            bounds,
-            centroids,
-            split: None,
-            level: 0,
-        };
+        let mut record = Record::root(prims.len(), (bounds, centroids));
         let mut bins = Bins::new();
         if method == SplitMethod::Sah && record.len() > config.min_leaf {
             record.split = find_split(&prims, &record, &config, &mut bins);
@@ -918,18 +923,6 @@ mod tests {
         sets
     }
 
-    fn record_of(prims: &[PrimRef]) -> Record {
-        let (bounds, centroids) = measure(prims);
-        Record {
-            start: 0,
-            end: prims.len(),
-            bounds,
-            centroids,
-            split: None,
-            level: 0,
-        }
-    }
-
     fn same_box(a: &Box4, b: &Box4) -> bool {
         (0..3).all(|k| a.lo[k] == b.lo[k] && a.hi[k] == b.hi[k])
     }
@@ -987,7 +980,7 @@ mod tests {
     #[test]
     fn partition_puts_each_primitive_on_the_side_of_its_bin_and_measures_both() {
         for set in prim_sets() {
-            let record = record_of(&set);
+            let record = Record::root(set.len(), measure(&set));
             let binner = Binner::new(&record.centroids, set.len());
             for axis in 0..3 {
                 for bin in 0..binner.count - 1 {
