@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
-# The preview window's suite (crates/cli/tests/preview.rs): the Xvfb tests need Xvfb and xwd.
-#   crates/cli/preview-ci.sh install   apt-get xvfb and x11-apps if missing (idempotent)
+# The preview window's suite (crates/cli/tests/preview.rs): the Xvfb tests need Xvfb.
+#   crates/cli/preview-ci.sh install   apt-get xvfb if missing (idempotent)
 #   crates/cli/preview-ci.sh test      run the suite; ends with "preview: N passed, N failed"
 # Under CI=1 a missing tool fails the tests instead of skipping them.
 set -euo pipefail
@@ -10,14 +10,13 @@ case "${1:-}" in
 install)
   missing=()
   command -v Xvfb > /dev/null || missing+=(xvfb)
-  command -v xwd > /dev/null || missing+=(x11-apps)
   if [ ${#missing[@]} -gt 0 ]; then
     SUDO=$([ "$(id -u)" = 0 ] || echo sudo)
     $SUDO apt-get update -qq
     $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -qq --no-install-recommends \
       "${missing[@]}"
   fi
-  echo "preview: Xvfb and xwd installed"
+  echo "preview: Xvfb installed"
   ;;
 test)
   log=$(mktemp)
