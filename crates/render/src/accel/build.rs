@@ -536,6 +536,18 @@ fn spatial_median(prims: &mut [PrimRef], record: &Record) -> usize {
     object_median(prims, record, first_axis)
 }
 
+/// Room for the nodes of a tree over `n` primitives, reserved before building it: more than
+/// triangle meshes take (one node per 15 to 17 triangles: the bunny 4,535 for 69,451, igea-sub4
+/// 63,094 for 1,074,744). Growing the array by doubling instead cost the igea build 1-2 %
+/// (0.385 -> 0.376 s and 0.392 -> 0.387 s, medians of 11 alternating rounds in two runs):
+/// nodes are 64-byte aligned, which Rust's system allocator grows by allocating anew and
+/// copying, so every doubling wrote the nodes again into pages never touched (3,000 of the
+/// build's page faults). Room not used is address space only; fewer primitives per node
+/// (other shapes, mixed leaves) just grow as before.
+fn node_capacity(n: usize) -> usize {
+    n / 12 + 1
+}
+
 /// Nodes of a subtree: inner references are indices into `nodes`; leaves still name primitive
 /// ranges (global positions in the primitive array), turned into blocks by `pack`.
 struct Subtree {
@@ -674,7 +686,7 @@ impl Builder {
             let subtrees: Vec<Subtree> = slices
                 .into_par_iter()
                 .map(|(slice, child_base, local)| {
-                    let mut sub = Vec::new();
+                    let mut sub = Vec::with_capacity(node_capacity(slice.len()));
                     let mut bins = Bins::new();
                     let root =
                         self.subtree(slice, child_base, local, depth + 1, &mut sub, &mut bins);
@@ -741,7 +753,7 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         || (Box4::EMPTY, Box4::EMPTY),
         |a, b| (a.0.union(b.0), a.1.union(b.1)),
     );
-    let mut nodes = Vec::new();
+    let mut nodes = Vec::with_capacity(node_capacity(prims.len()));
     let root = if prims.is_empty() {
         ChildRef::EMPTY
     } else {
