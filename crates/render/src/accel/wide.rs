@@ -69,27 +69,21 @@ impl WideNode {
         self.children[slot] = child.0;
     }
 
+    /// The box of child `slot` (an empty slot's is empty: min +∞, max −∞).
+    pub(crate) fn child_bounds(&self, slot: usize) -> Aabb {
+        let plane = |p: usize| self.bounds[p][slot];
+        Aabb {
+            min: Vec3::new(plane(0), plane(1), plane(2)),
+            max: Vec3::new(plane(3), plane(4), plane(5)),
+        }
+    }
+
     /// The union of the children's boxes.
     #[cfg(any(test, feature = "bench"))]
     pub fn bounds(&self) -> Aabb {
-        let mut b = Aabb::EMPTY;
-        for slot in 0..WIDTH {
-            if self.children[slot] != ChildRef::EMPTY.0 {
-                b = b.union(Aabb {
-                    min: Vec3::new(
-                        self.bounds[0][slot],
-                        self.bounds[1][slot],
-                        self.bounds[2][slot],
-                    ),
-                    max: Vec3::new(
-                        self.bounds[3][slot],
-                        self.bounds[4][slot],
-                        self.bounds[5][slot],
-                    ),
-                });
-            }
-        }
-        b
+        (0..WIDTH)
+            .filter(|&slot| self.children[slot] != ChildRef::EMPTY.0)
+            .fold(Aabb::EMPTY, |b, slot| b.union(self.child_bounds(slot)))
     }
 }
 
@@ -693,19 +687,8 @@ impl WideBvh {
             stats.sah_cost += ratio(area);
             let node = &self.nodes[child.0 as usize];
             for slot in 0..WIDTH {
-                let b = Aabb {
-                    min: Vec3::new(
-                        node.bounds[0][slot],
-                        node.bounds[1][slot],
-                        node.bounds[2][slot],
-                    ),
-                    max: Vec3::new(
-                        node.bounds[3][slot],
-                        node.bounds[4][slot],
-                        node.bounds[5][slot],
-                    ),
-                };
-                stack.push((ChildRef(node.children[slot]), b.half_area(), above + 1));
+                let area = node.child_bounds(slot).half_area();
+                stack.push((ChildRef(node.children[slot]), area, above + 1));
             }
         }
         stats
