@@ -112,7 +112,8 @@ pub struct RaysArgs {
     pub accel: AccelArg,
     /// Also count the walk (untimed, a separate counting traversal of the wide BVH): inner
     /// nodes visited and triangle blocks tested per ray, printed as `nodes_per_ray` and
-    /// `blocks_per_ray`
+    /// `blocks_per_ray`; and the tree's shape: `nodes`, `leaves` and `sah_cost` (as Embree's
+    /// `verbose=2` statistics count it: Σ node areas + Σ leaf areas · blocks, over the root's)
     #[arg(long)]
     pub count: bool,
     /// Trace in packets of eight rays (`Scene::intersect_packet`): 4x2 pixel blocks of an image
@@ -436,10 +437,15 @@ fn rays(args: &RaysArgs) -> Result<(), String> {
             scene.instances().count_closest(ray, &mut counts);
         }
         let per_ray = |n: u64| n as f64 / rays.len().max(1) as f64;
+        let tree = scene.instances().tree_stats();
         format!(
-            ", \"nodes_per_ray\": {:.3}, \"blocks_per_ray\": {:.3}",
+            ", \"nodes_per_ray\": {:.3}, \"blocks_per_ray\": {:.3}, \"nodes\": {}, \
+             \"leaves\": {}, \"sah_cost\": {:.3}",
             per_ray(counts.nodes),
-            per_ray(counts.blocks)
+            per_ray(counts.blocks),
+            tree.nodes,
+            tree.leaves,
+            tree.sah_cost
         )
     } else {
         String::new()
