@@ -6,7 +6,7 @@
 use crate::accel::isa::Isa;
 use crate::accel::packet::{self, ArrayPacketStack, ScalarPacketKernel, PACKET};
 use crate::accel::simd;
-use crate::accel::wide::{any, closest, ray_is_valid, ArrayStack, LocalHit, ScalarKernel, WideBvh};
+use crate::accel::wide::{any, closest, ArrayStack, LocalHit, ScalarKernel, WideBvh};
 use crate::ray::Ray;
 
 impl WideBvh {
@@ -25,9 +25,6 @@ impl WideBvh {
     /// `intersect` save registers and reserve the frame on every call, also on the AVX2 path.
     #[inline(never)]
     fn closest_scalar(&self, ray: &Ray) -> Option<LocalHit> {
-        if !ray_is_valid(ray) {
-            return None;
-        }
         closest(&ScalarKernel, self, ray, &mut ArrayStack::new())
     }
 
@@ -38,16 +35,20 @@ impl WideBvh {
         self.intersect(ray).map(|h| (h.t, h.primitive))
     }
 
-    /// True when any primitive meets the ray with t in `[ray.t_min, ray.t_max]`.
+    /// True when any primitive meets the ray with t in `[ray.t_min, ray.t_max]` (never for a
+    /// ray that is not valid, `wide::ray_is_valid`).
     #[inline]
     pub fn occluded(&self, ray: &Ray) -> bool {
-        if !ray_is_valid(ray) {
-            return false;
-        }
         match self.isa {
             Isa::Avx2(avx2) => simd::any(avx2, self, ray),
-            Isa::Scalar => any(&ScalarKernel, self, ray, &mut ArrayStack::new()),
+            Isa::Scalar => self.any_scalar(ray),
         }
+    }
+
+    /// The scalar kernel's any hit, out of line for the reason of `closest_scalar`.
+    #[inline(never)]
+    fn any_scalar(&self, ray: &Ray) -> bool {
+        any(&ScalarKernel, self, ray, &mut ArrayStack::new())
     }
 
     /// Closest hits of the rays in `lanes` (bit l for `rays[l]`) traced together as a packet

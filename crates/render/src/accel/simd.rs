@@ -133,6 +133,18 @@ pub(crate) fn packet_closest_any(
     unsafe { x86::packet_closest_any(bvh, p) }
 }
 
+/// What the AVX2 kernel's per-ray set-up makes of `ray`, in the scalar forms: `None` for a
+/// ray it rejects, else the box test's planes (with t_min as the kernel holds it), its far
+/// reciprocals and short-path flag, the watertight test's `WoopRay`, and the triangle test's
+/// broadcast lanes (origin[kx], origin[ky], origin[kz], sx, sy, sz). For the test that
+/// compares them with `BoxPlanes::new` and `WoopRay::new`.
+#[cfg(test)]
+pub(crate) fn prepared(avx2: Avx2, ray: &Ray) -> Option<x86::Prepared> {
+    let _ = avx2;
+    // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
+    unsafe { x86::prepared(ray) }
+}
+
 /// The slab test of the binary BVH (`bvh::RayInverse::hits`) for eight rays against one node,
 /// the same operations lane by lane: the mask of rays that hit it within [t_min, t_max]. For
 /// the top level's packet traversal (`Bvh::traverse_packet`).
@@ -216,51 +228,23 @@ mod x86 {
     use crate::accel::packet::{self, Lanes, PacketKernel, PacketRays, PacketStack, PACKET};
     use crate::accel::triangle::WoopRay;
     use crate::accel::wide::{
-        self, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock,
-        WideBvh, WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
+        self, BlockHit, ChildRef, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock, WideBvh,
+        WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
     };
-    use crate::math::Vec3;
     use crate::ray::Ray;
 
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn closest(bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
-        let ray = read_ray(ray);
-        if !wide::ray_is_valid(&ray) {
-            return None;
-        }
-        wide::closest(&Avx2Kernel, bvh, &ray, &mut UninitStack::new())
-    }
-
-    /// The ray's eight floats read one by one. Callers have most often just written the ray
-    /// (a local copy, in object space), and a load wider than one of those stores, spanning
-    /// two of them, as the compiler likes to make for the direction, cannot be forwarded
-    /// from the store buffer: a stall of a dozen cycles or more per ray, the largest single
-    /// cost of a ray that misses (`perf annotate`). Volatile reads are never merged.
-    #[inline(always)]
-    fn read_ray(ray: &Ray) -> Ray {
-        let f = |x: &f32| {
-            // SAFETY: `x` is a reference to an f32: valid and aligned for the read.
-            unsafe { std::ptr::read_volatile(x) }
-        };
-        Ray {
-            origin: Vec3::new(f(&ray.origin.x), f(&ray.origin.y), f(&ray.origin.z)),
-            direction: Vec3::new(
-                f(&ray.direction.x),
-                f(&ray.direction.y),
-                f(&ray.direction.z),
-            ),
-            t_min: f(&ray.t_min),
-            t_max: f(&ray.t_max),
-        }
+        wide::closest(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
     }
 
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn any(bvh: &WideBvh, ray: &Ray) -> bool {
-        wide::any(&Avx2Kernel, bvh, &read_ray(ray), &mut UninitStack::new())
+        wide::any(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
     }
 
     /// A traversal stack that is not cleared for every ray (it is 3 KB).
@@ -318,11 +302,12 @@ mod x86 {
 
     impl Kernel for Avx2Kernel {
         type BoxRay = BoxRay;
+        type TriRay = TriRay;
 
         #[inline(always)]
-        fn box_ray(&self, ray: &Ray) -> BoxRay {
+        fn prepare(&self, ray: &Ray) -> Option<(BoxRay, TriRay)> {
             // SAFETY: only called inside `closest`/`any` above, on a CPU with AVX2.
-            unsafe { box_ray(&BoxPlanes::new(ray)) }
+            unsafe { prepare(ray) }
         }
 
         #[inline(always)]
@@ -335,7 +320,7 @@ mod x86 {
         fn block(
             &self,
             block: &TriangleBlock,
-            ray: &WoopRay,
+            ray: &TriRay,
             t_min: f32,
             t_max: f32,
         ) -> Option<BlockHit> {
@@ -343,7 +328,7 @@ mod x86 {
             let (mask, t) = unsafe { block_test(block, ray, t_min, t_max) };
             match mask {
                 0 => None,
-                ZERO_EDGE => ScalarKernel.block(block, ray, t_min, t_max),
+                ZERO_EDGE => ScalarKernel.block(block, &ray.woop, t_min, t_max),
                 _ => {
                     let mut best = (0usize, f32::INFINITY);
                     let mut m = mask;
@@ -390,12 +375,12 @@ mod x86 {
         }
 
         #[inline(always)]
-        fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool {
+        fn block_any(&self, block: &TriangleBlock, ray: &TriRay, t_min: f32, t_max: f32) -> bool {
             // SAFETY: as above.
             let (mask, _) = unsafe { block_test(block, ray, t_min, t_max) };
             match mask {
                 0 => false,
-                ZERO_EDGE => ScalarKernel.block_any(block, ray, t_min, t_max),
+                ZERO_EDGE => ScalarKernel.block_any(block, &ray.woop, t_min, t_max),
                 _ => true,
             }
         }
@@ -409,35 +394,115 @@ mod x86 {
     // the features, their intrinsics are compiled for AVX2 there, with the ray's constants
     // in registers for the whole walk. Hence `unsafe`: they must only be reached from there.
 
+    /// Per-ray constants of the watertight test (`WoopRay`'s) broadcast to four lanes, and
+    /// the scalar form, for blocks with a zero edge function.
+    struct TriRay {
+        /// origin[kx], origin[ky], origin[kz].
+        origin: [__m128; 3],
+        /// sx, sy, sz.
+        shear: [__m128; 3],
+        woop: WoopRay,
+    }
+
+    impl TriRay {
+        /// The lanes of a `WoopRay` at hand (a packet's ray taken alone).
+        #[inline(always)]
+        fn new(woop: WoopRay) -> TriRay {
+            // SAFETY: SSE is part of x86-64.
+            unsafe {
+                TriRay {
+                    origin: [woop.kx, woop.ky, woop.kz].map(|k| _mm_set1_ps(woop.origin[k])),
+                    shear: [woop.sx, woop.sy, woop.sz].map(|s| _mm_set1_ps(s)),
+                    woop,
+                }
+            }
+        }
+    }
+
+    /// `ray_is_valid`, `BoxPlanes::new` and `WoopRay::new` in one pass of 4-lane operations,
+    /// every constant the value the scalar code gives. Set up this way, a ray costs a third of
+    /// the instructions it took through the scalar constructors (whose per-axis arrays the
+    /// compiler kept on the stack and read back by index, waiting on its own stores).
+    ///
+    /// The ray's eight floats are read one by one: callers have most often just written the
+    /// ray (a local copy, in object space), and a load wider than one of those stores, spanning
+    /// two of them, cannot be forwarded from the store buffer: a stall of a dozen cycles or
+    /// more per ray. Volatile reads are never merged.
+    ///
     /// # Safety
     /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
     #[inline(always)]
-    unsafe fn box_ray(p: &BoxPlanes) -> BoxRay {
-        // SAFETY: the caller runs with AVX2.
+    unsafe fn prepare(ray: &Ray) -> Option<(BoxRay, TriRay)> {
+        // SAFETY: the caller runs with AVX2; each volatile read is of an f32 field of `ray`.
         unsafe {
-            BoxRay {
-                origin: [
-                    _mm256_set1_ps(p.origin[0]),
-                    _mm256_set1_ps(p.origin[1]),
-                    _mm256_set1_ps(p.origin[2]),
-                ],
-                inv_dir: [
-                    _mm256_set1_ps(p.inv_dir[0]),
-                    _mm256_set1_ps(p.inv_dir[1]),
-                    _mm256_set1_ps(p.inv_dir[2]),
-                ],
-                near: p.near,
-                far: p.far,
+            let f = |x: &f32| std::ptr::read_volatile(x);
+            let (ox, oy, oz) = (f(&ray.origin.x), f(&ray.origin.y), f(&ray.origin.z));
+            let (dx, dy, dz) = (
+                f(&ray.direction.x),
+                f(&ray.direction.y),
+                f(&ray.direction.z),
+            );
+            let (t_min, t_max) = (f(&ray.t_min), f(&ray.t_max));
+            // Lane 3 is padding, finite and positive.
+            let o = _mm_setr_ps(ox, oy, oz, 0.0);
+            let d = _mm_setr_ps(dx, dy, dz, 1.0);
+            let magnitude = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
+            let infinity = _mm_set1_ps(f32::INFINITY);
+            let finite = |v: __m128| _mm_cmplt_ps(_mm_and_ps(v, magnitude), infinity);
+            // `ray_is_valid`: a finite origin and direction (NaN compares false), and
+            // t_min <= t_max.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            if _mm_movemask_ps(_mm_and_ps(finite(o), finite(d))) != 0b1111 || !(t_min <= t_max) {
+                return None;
+            }
+            // `BoxPlanes::new`: 1/d per axis (the same IEEE division), the slab rows chosen
+            // by the sign bits.
+            let inv = _mm_div_ps(_mm_set1_ps(1.0), d);
+            let sign = _mm_movemask_ps(d) as usize;
+            let near: [usize; 3] =
+                std::array::from_fn(|a| if sign >> a & 1 != 0 { a + 3 } else { a });
+            let far: [usize; 3] =
+                std::array::from_fn(|a| if sign >> a & 1 != 0 { a } else { a + 3 });
+            let inv_far = _mm_mul_ps(inv, _mm_set1_ps(FOLDED_FAR_SCALE));
+            macro_rules! wide {
+                ($v:expr, $lane:expr) => {
+                    _mm256_broadcastss_ps(_mm_permute_ps::<{ $lane * 0b01_01_01_01 }>($v))
+                };
+            }
+            let box_ray = BoxRay {
+                origin: [wide!(o, 0), wide!(o, 1), wide!(o, 2)],
+                inv_dir: [wide!(inv, 0), wide!(inv, 1), wide!(inv, 2)],
+                near,
+                far,
                 // `+ 0.0` turns -0 into +0 (equal as floats), whose bits are the least
                 // non-negative integer, as the integer reductions need.
-                t_min: _mm256_set1_ps(p.t_min + 0.0),
-                no_nan: p.inv_dir.iter().all(|c| c.is_finite()) && p.t_min >= 0.0,
-                inv_far: [
-                    _mm256_set1_ps(p.inv_dir[0] * FOLDED_FAR_SCALE),
-                    _mm256_set1_ps(p.inv_dir[1] * FOLDED_FAR_SCALE),
-                    _mm256_set1_ps(p.inv_dir[2] * FOLDED_FAR_SCALE),
-                ],
-            }
+                t_min: _mm256_set1_ps(t_min + 0.0),
+                no_nan: _mm_movemask_ps(finite(inv)) == 0b1111 && t_min >= 0.0,
+                inv_far: [wide!(inv_far, 0), wide!(inv_far, 1), wide!(inv_far, 2)],
+            };
+            // `WoopRay::new`: the axes from the same comparisons, then the lanes picked by
+            // index in registers: sz = 1/d[kz] (the division above), sx = d[kx]·sz,
+            // sy = d[ky]·sz.
+            let below_zero = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) as u32;
+            let [kx, ky, kz] = WoopRay::axes([dx.abs(), dy.abs(), dz.abs()], below_zero);
+            let pick = |v: __m128, k: usize| _mm_permutevar_ps(v, _mm_set1_epi32(k as i32));
+            let sz = pick(inv, kz);
+            let sx = _mm_mul_ps(pick(d, kx), sz);
+            let sy = _mm_mul_ps(pick(d, ky), sz);
+            let tri_ray = TriRay {
+                origin: [pick(o, kx), pick(o, ky), pick(o, kz)],
+                shear: [sx, sy, sz],
+                woop: WoopRay {
+                    origin: [ox, oy, oz],
+                    kx,
+                    ky,
+                    kz,
+                    sx: _mm_cvtss_f32(sx),
+                    sy: _mm_cvtss_f32(sy),
+                    sz: _mm_cvtss_f32(sz),
+                },
+            };
+            Some((box_ray, tri_ray))
         }
     }
 
@@ -549,7 +614,7 @@ mod x86 {
     #[inline(always)]
     unsafe fn block_test(
         block: &TriangleBlock,
-        ray: &WoopRay,
+        ray: &TriRay,
         t_min: f32,
         t_max: f32,
     ) -> (u32, BlockLanes) {
@@ -561,13 +626,9 @@ mod x86 {
                     _mm_load_ps(block.v[$corner][$axis].as_ptr())
                 };
             }
-            let (kx, ky, kz) = (ray.kx, ray.ky, ray.kz);
-            let ox = _mm_set1_ps(ray.origin[kx]);
-            let oy = _mm_set1_ps(ray.origin[ky]);
-            let oz = _mm_set1_ps(ray.origin[kz]);
-            let sx = _mm_set1_ps(ray.sx);
-            let sy = _mm_set1_ps(ray.sy);
-            let sz = _mm_set1_ps(ray.sz);
+            let (kx, ky, kz) = (ray.woop.kx, ray.woop.ky, ray.woop.kz);
+            let [ox, oy, oz] = ray.origin;
+            let [sx, sy, sz] = ray.shear;
             // `WoopRay::shear`: a = v − o, then x = a[kx] − sx·a[kz], y = a[ky] − sy·a[kz].
             macro_rules! shear {
                 ($corner:expr) => {{
@@ -785,7 +846,7 @@ mod x86 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
                 if let Some(BlockHit { lane: k, t: th, .. }) =
-                    Avx2Kernel.block(block, &p.woop(l), p.t_min.0[l], t_max.0[l])
+                    Avx2Kernel.block(block, &TriRay::new(p.woop(l)), p.t_min.0[l], t_max.0[l])
                 {
                     lane[l] = k as u8;
                     t.0[l] = th;
@@ -808,7 +869,8 @@ mod x86 {
             while m != 0 {
                 let l = m.trailing_zeros() as usize;
                 m &= m - 1;
-                if Avx2Kernel.block_any(block, &p.woop(l), p.t_min.0[l], p.t_max.0[l]) {
+                if Avx2Kernel.block_any(block, &TriRay::new(p.woop(l)), p.t_min.0[l], p.t_max.0[l])
+                {
                     hits |= 1 << l;
                 }
             }
@@ -1200,6 +1262,50 @@ mod x86 {
         _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t0, t1)) as u8
     }
 
+    /// See `simd::prepared`.
+    #[cfg(test)]
+    pub(crate) struct Prepared {
+        pub planes: crate::accel::wide::BoxPlanes,
+        pub inv_far: [f32; 3],
+        pub no_nan: bool,
+        pub woop: WoopRay,
+        pub lanes: [[f32; 4]; 6],
+    }
+
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[cfg(test)]
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn prepared(ray: &Ray) -> Option<Prepared> {
+        let (b, t) = prepare(ray)?;
+        let first = |v: __m256| _mm256_cvtss_f32(v);
+        let lanes = |v: __m128| {
+            let mut out = [0.0f32; 4];
+            _mm_storeu_ps(out.as_mut_ptr(), v);
+            out
+        };
+        Some(Prepared {
+            planes: crate::accel::wide::BoxPlanes {
+                origin: b.origin.map(first),
+                inv_dir: b.inv_dir.map(first),
+                near: b.near,
+                far: b.far,
+                t_min: first(b.t_min),
+            },
+            inv_far: b.inv_far.map(first),
+            no_nan: b.no_nan,
+            woop: t.woop,
+            lanes: [
+                lanes(t.origin[0]),
+                lanes(t.origin[1]),
+                lanes(t.origin[2]),
+                lanes(t.shear[0]),
+                lanes(t.shear[1]),
+                lanes(t.shear[2]),
+            ],
+        })
+    }
+
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[cfg(test)]
@@ -1212,5 +1318,126 @@ mod x86 {
             packet::closest(&Avx2PacketKernel, bvh, p, &mut UninitPacketStack::new()),
             packet::any(&Avx2PacketKernel, bvh, p, &mut UninitPacketStack::new()),
         )
+    }
+
+    /// The per-ray constants `prepare` makes, against the scalar constructors, bit for bit.
+    #[cfg(test)]
+    mod tests {
+        use crate::accel::isa::Avx2;
+        use crate::accel::simd::prepared;
+        use crate::accel::triangle::WoopRay;
+        use crate::accel::wide::{ray_is_valid, BoxPlanes};
+        use crate::math::Vec3;
+        use crate::ray::Ray;
+
+        /// Directions with zero, negative-zero, equal-magnitude, tiny and huge components;
+        /// origins likewise; windows empty, negative, infinite; NaN and ∞ anywhere.
+        fn rays() -> Vec<Ray> {
+            let values = [
+                0.0,
+                -0.0,
+                1.0,
+                -1.0,
+                0.5,
+                -2.0,
+                3.0e-39,
+                -1.0e30,
+                7.0,
+                f32::NAN,
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+            ];
+            let mut r = crate::testing::rng(97);
+            let mut rays = Vec::new();
+            for (i, &a) in values.iter().enumerate() {
+                for &b in &values {
+                    for &c in &values[..9] {
+                        let o = Vec3::new(values[(i + 3) % values.len()], c, a);
+                        for d in [Vec3::new(a, b, c), Vec3::new(c, a, b), Vec3::new(b, c, a)] {
+                            for (t_min, t_max) in [(0.0, f32::INFINITY), (-0.0, 1.0), (1.0, 0.5)] {
+                                rays.push(Ray {
+                                    origin: o,
+                                    direction: d,
+                                    t_min,
+                                    t_max,
+                                });
+                            }
+                        }
+                    }
+                }
+            }
+            for _ in 0..20_000 {
+                let o = crate::testing::random_unit(&mut r) * 10.0;
+                let d = crate::testing::random_unit(&mut r);
+                // Ties in magnitude between components, and exact zeros.
+                let d = match rays.len() % 4 {
+                    0 => Vec3::new(d.x, -d.x, d.z),
+                    1 => Vec3::new(d.x, 0.0, d.z),
+                    _ => d,
+                };
+                rays.push(Ray::new(o, d));
+                rays.push(Ray {
+                    t_min: 1.0e-3,
+                    ..Ray::new(o, d)
+                });
+            }
+            rays
+        }
+
+        #[test]
+        fn set_up_matches_the_scalar_constructors() {
+            let Some(avx2) = Avx2::detect() else {
+                assert!(std::env::var_os("CI").is_none(), "CI machines have AVX2");
+                println!("SKIPPED: no AVX2");
+                return;
+            };
+            let bits3 = |v: [f32; 3]| v.map(f32::to_bits);
+            let (mut valid, mut short) = (0, 0);
+            for ray in rays() {
+                let got = prepared(avx2, &ray);
+                assert_eq!(got.is_some(), ray_is_valid(&ray), "{ray:?}");
+                let Some(got) = got else { continue };
+                valid += 1;
+                let p = BoxPlanes::new(&ray);
+                assert_eq!(bits3(got.planes.origin), bits3(p.origin), "{ray:?}");
+                assert_eq!(bits3(got.planes.inv_dir), bits3(p.inv_dir), "{ray:?}");
+                assert_eq!(
+                    (got.planes.near, got.planes.far),
+                    (p.near, p.far),
+                    "{ray:?}"
+                );
+                assert_eq!(got.planes.t_min.to_bits(), (p.t_min + 0.0).to_bits());
+                let far = p.inv_dir.map(|c| c * super::FOLDED_FAR_SCALE);
+                assert_eq!(bits3(got.inv_far), bits3(far), "{ray:?}");
+                let no_nan = p.inv_dir.iter().all(|c| c.is_finite()) && p.t_min >= 0.0;
+                assert_eq!(got.no_nan, no_nan, "{ray:?}");
+                short += usize::from(no_nan);
+                let w = WoopRay::new(ray.origin, ray.direction);
+                let g = got.woop;
+                assert_eq!((g.kx, g.ky, g.kz), (w.kx, w.ky, w.kz), "{ray:?}");
+                assert_eq!(bits3(g.origin), bits3(w.origin), "{ray:?}");
+                assert_eq!(
+                    bits3([g.sx, g.sy, g.sz]),
+                    bits3([w.sx, w.sy, w.sz]),
+                    "{ray:?}"
+                );
+                let expected = [
+                    w.origin[w.kx],
+                    w.origin[w.ky],
+                    w.origin[w.kz],
+                    w.sx,
+                    w.sy,
+                    w.sz,
+                ];
+                for (lanes, e) in got.lanes.iter().zip(expected) {
+                    assert_eq!(lanes.map(f32::to_bits), [e.to_bits(); 4], "{ray:?}");
+                }
+            }
+            // Both outcomes of each test were met.
+            assert!(
+                valid > 40_000 && short > 40_000 && short < valid,
+                "{valid} {short}"
+            );
+        }
     }
 }

@@ -35,19 +35,8 @@ impl WoopRay {
     #[inline]
     pub fn new(origin: Vec3, direction: Vec3) -> WoopRay {
         let d = direction.to_array();
-        let a = d.map(f32::abs);
-        // 0 where a[0] >= a[1] and a[0] >= a[2], else 1 where a[1] >= a[2], else 2: written
-        // as arithmetic on comparisons, since branches on the direction mispredict on
-        // incoherent rays (path-traced Cornell 256x256, 40 spp: render 0.991 -> 0.959 s,
-        // medians of 9 alternating rounds).
-        let x_major = a[0] >= a[1] && a[0] >= a[2];
-        let y_over_z = a[1] >= a[2];
-        let kz = usize::from(!x_major) * (1 + usize::from(!y_over_z));
-        let mut kx = if kz == 2 { 0 } else { kz + 1 };
-        let mut ky = if kx == 2 { 0 } else { kx + 1 };
-        if d[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
+        let below_zero = (0..3).fold(0, |m, i| m | (u32::from(d[i] < 0.0) << i));
+        let [kx, ky, kz] = WoopRay::axes(d.map(f32::abs), below_zero);
         let sz = 1.0 / d[kz];
         WoopRay {
             origin: origin.to_array(),
@@ -58,6 +47,26 @@ impl WoopRay {
             sy: d[ky] * sz,
             sz,
         }
+    }
+
+    /// The axes `[kx, ky, kz]` of the sheared frame for a direction whose components have the
+    /// absolute values `a`, bit i of `below_zero` set where component i is below zero (the
+    /// SIMD kernels' per-ray set-up calls it too, with the masks they compute).
+    #[inline(always)]
+    pub fn axes(a: [f32; 3], below_zero: u32) -> [usize; 3] {
+        // 0 where a[0] >= a[1] and a[0] >= a[2], else 1 where a[1] >= a[2], else 2: written
+        // as arithmetic on comparisons, since branches on the direction mispredict on
+        // incoherent rays (path-traced Cornell 256x256, 40 spp: render 0.991 -> 0.959 s,
+        // medians of 9 alternating rounds).
+        let x_major = a[0] >= a[1] && a[0] >= a[2];
+        let y_over_z = a[1] >= a[2];
+        let kz = usize::from(!x_major) * (1 + usize::from(!y_over_z));
+        let mut kx = if kz == 2 { 0 } else { kz + 1 };
+        let mut ky = if kx == 2 { 0 } else { kx + 1 };
+        if below_zero >> kz & 1 != 0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        [kx, ky, kz]
     }
 
     /// A vertex in the sheared frame: (x, y) in the plane across the ray, and its offset along

@@ -305,7 +305,10 @@ pub(crate) fn ray_is_valid(ray: &Ray) -> bool {
 pub(crate) trait Kernel {
     /// Per-ray constants of the box test.
     type BoxRay;
-    fn box_ray(&self, ray: &Ray) -> Self::BoxRay;
+    /// Per-ray constants of the triangle test (`WoopRay`'s, in the kernel's form).
+    type TriRay;
+    /// Both sets of constants, or `None` for a ray that meets nothing (`ray_is_valid`).
+    fn prepare(&self, ray: &Ray) -> Option<(Self::BoxRay, Self::TriRay)>;
     /// Tests the ray against a node's eight boxes within [t_min, t_max]: the bit mask of the
     /// children entered, and each child's entry distance in `entry`.
     fn node(
@@ -320,12 +323,12 @@ pub(crate) trait Kernel {
     fn block(
         &self,
         block: &TriangleBlock,
-        ray: &WoopRay,
+        ray: &Self::TriRay,
         t_min: f32,
         t_max: f32,
     ) -> Option<BlockHit>;
     /// Whether any lane meets the ray within [t_min, t_max].
-    fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool;
+    fn block_any(&self, block: &TriangleBlock, ray: &Self::TriRay, t_min: f32, t_max: f32) -> bool;
     /// A hint that the walk will come back to `child` (put on the stack): its node or its
     /// first triangle block may be fetched into the cache meanwhile.
     #[inline(always)]
@@ -422,10 +425,11 @@ pub(crate) struct ScalarKernel;
 
 impl Kernel for ScalarKernel {
     type BoxRay = BoxPlanes;
+    type TriRay = WoopRay;
 
     #[inline(always)]
-    fn box_ray(&self, ray: &Ray) -> BoxPlanes {
-        BoxPlanes::new(ray)
+    fn prepare(&self, ray: &Ray) -> Option<(BoxPlanes, WoopRay)> {
+        ray_is_valid(ray).then(|| (BoxPlanes::new(ray), WoopRay::new(ray.origin, ray.direction)))
     }
 
     #[inline(always)]
@@ -484,8 +488,9 @@ impl Kernel for ScalarKernel {
     }
 }
 
-/// Closest hit, with its barycentrics. Generic over the kernel and the stack so that the SIMD
-/// module instantiates it inside its `avx2` functions.
+/// Closest hit, with its barycentrics; `None` also for a ray that is not valid
+/// (`ray_is_valid`). Generic over the kernel and the stack so that the SIMD module instantiates
+/// it inside its `avx2` functions.
 #[inline(always)]
 pub(crate) fn closest<K: Kernel, S: Stack>(
     kernel: &K,
@@ -493,8 +498,7 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
     ray: &Ray,
     stack: &mut S,
 ) -> Option<LocalHit> {
-    let box_ray = kernel.box_ray(ray);
-    let woop = WoopRay::new(ray.origin, ray.direction);
+    let (box_ray, woop) = kernel.prepare(ray)?;
     let lanes = (bvh.blocks.len() * BLOCK) as u32;
     let mut best = LocalHit {
         t: ray.t_max,
@@ -591,7 +595,8 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
     }
 }
 
-/// Any hit within the ray's window (shadow rays): no ordering, the first hit ends the walk.
+/// Any hit within the ray's window (shadow rays): no ordering, the first hit ends the walk;
+/// `false` for a ray that is not valid.
 #[inline(always)]
 pub(crate) fn any<K: Kernel, S: Stack>(
     kernel: &K,
@@ -599,8 +604,9 @@ pub(crate) fn any<K: Kernel, S: Stack>(
     ray: &Ray,
     stack: &mut S,
 ) -> bool {
-    let box_ray = kernel.box_ray(ray);
-    let woop = WoopRay::new(ray.origin, ray.direction);
+    let Some((box_ray, woop)) = kernel.prepare(ray) else {
+        return false;
+    };
     let mut entry = [0.0f32; WIDTH];
     let mut current = bvh.root;
     let mut sp = 0usize;
@@ -729,9 +735,10 @@ struct CountingKernel {
 
 impl Kernel for CountingKernel {
     type BoxRay = BoxPlanes;
+    type TriRay = WoopRay;
 
-    fn box_ray(&self, ray: &Ray) -> BoxPlanes {
-        ScalarKernel.box_ray(ray)
+    fn prepare(&self, ray: &Ray) -> Option<(BoxPlanes, WoopRay)> {
+        ScalarKernel.prepare(ray)
     }
 
     fn node(&self, node: &WideNode, r: &BoxPlanes, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
