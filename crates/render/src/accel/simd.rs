@@ -329,24 +329,8 @@ mod x86 {
             match mask {
                 0 => None,
                 ZERO_EDGE => ScalarKernel.block(block, &ray.woop, t_min, t_max),
-                _ => {
-                    let mut best = (0usize, f32::INFINITY);
-                    let mut m = mask;
-                    while m != 0 {
-                        let lane = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        if t.t[lane] < best.1 {
-                            best = (lane, t.t[lane]);
-                        }
-                    }
-                    let (lane, t_hit) = best;
-                    Some(BlockHit {
-                        lane,
-                        t: t_hit,
-                        b1: t.v[lane] / t.det[lane],
-                        b2: t.w[lane] / t.det[lane],
-                    })
-                }
+                // SAFETY: as above; some lane is hit.
+                _ => Some(unsafe { t.nearest() }),
             }
         }
 
@@ -657,20 +641,12 @@ mod x86 {
             if _mm_movemask_ps(any_zero) != 0 {
                 return (ZERO_EDGE, BlockLanes::NONE);
             }
-            let negative = _mm_or_ps(
-                _mm_or_ps(_mm_cmplt_ps(u, zero), _mm_cmplt_ps(v, zero)),
-                _mm_cmplt_ps(w, zero),
-            );
-            let positive = _mm_or_ps(
-                _mm_or_ps(_mm_cmpgt_ps(u, zero), _mm_cmpgt_ps(v, zero)),
-                _mm_cmpgt_ps(w, zero),
-            );
             let det = _mm_add_ps(_mm_add_ps(u, v), w);
             // Not on both sides of an edge, and a non-zero (ordered: not NaN) determinant.
-            let valid = _mm_andnot_ps(
-                _mm_and_ps(negative, positive),
-                _mm_cmp_ps::<_CMP_NEQ_OQ>(det, zero),
-            );
+            // With no edge function zero, "some negative and some positive" is "two sign bits
+            // differ": where u, v or w is NaN, so is det, and the lane is out either way.
+            let signs_differ = _mm_or_ps(_mm_xor_ps(u, v), _mm_xor_ps(v, w));
+            let valid = _mm_blendv_ps(_mm_cmp_ps::<_CMP_NEQ_OQ>(det, zero), zero, signs_differ);
             if _mm_movemask_ps(valid) == 0 {
                 return (0, BlockLanes::NONE);
             }
@@ -686,37 +662,68 @@ mod x86 {
                 _mm_cmp_ps::<_CMP_GE_OQ>(t, _mm_set1_ps(t_min)),
                 _mm_cmp_ps::<_CMP_LE_OQ>(t, _mm_set1_ps(t_max)),
             );
-            let mask = _mm_movemask_ps(_mm_and_ps(valid, in_window)) as u32;
+            let hit = _mm_and_ps(valid, in_window);
+            let mask = _mm_movemask_ps(hit) as u32;
             if mask == 0 {
                 return (0, BlockLanes::NONE);
             }
-            let mut out = BlockLanes::NONE;
-            _mm_storeu_ps(out.t.as_mut_ptr(), t);
-            _mm_storeu_ps(out.v.as_mut_ptr(), v);
-            _mm_storeu_ps(out.w.as_mut_ptr(), w);
-            _mm_storeu_ps(out.det.as_mut_ptr(), det);
-            (mask, out)
+            (mask, BlockLanes { hit, t, v, w, det })
         }
     }
 
-    /// What `block_test` found in each lane: t, and the edge functions v (of c → a), w (of
-    /// a → b) and the determinant, from which the barycentrics `triangle::intersect` reports
-    /// are v / det and w / det.
+    /// What `block_test` found in each lane: whether it is hit (all bits), t, and the edge
+    /// functions v (of c → a), w (of a → b) and the determinant, from which the barycentrics
+    /// `triangle::intersect` reports are v / det and w / det. In registers.
+    #[derive(Clone, Copy)]
     struct BlockLanes {
-        t: [f32; BLOCK],
-        v: [f32; BLOCK],
-        w: [f32; BLOCK],
-        det: [f32; BLOCK],
+        hit: __m128,
+        t: __m128,
+        v: __m128,
+        w: __m128,
+        det: __m128,
     }
 
     impl BlockLanes {
         const NONE: BlockLanes = BlockLanes {
-            t: [0.0; BLOCK],
-            v: [0.0; BLOCK],
-            w: [0.0; BLOCK],
-            det: [0.0; BLOCK],
+            hit: ZERO4,
+            t: ZERO4,
+            v: ZERO4,
+            w: ZERO4,
+            det: ZERO4,
         };
+
+        /// The lowest lane hit at the smallest t (the scalar kernel's choice), and its
+        /// barycentrics: a minimum over the lanes in two steps, no branch on the lanes.
+        ///
+        /// # Safety
+        /// Only inside the `target_feature(enable = "avx2,fma")` functions above, with at
+        /// least one lane hit.
+        #[inline(always)]
+        unsafe fn nearest(&self) -> BlockHit {
+            // SAFETY: the caller runs with AVX2.
+            unsafe {
+                // Lanes not hit count as +∞; a hit's t is never NaN (it passed the window).
+                let t = _mm_blendv_ps(_mm_set1_ps(f32::INFINITY), self.t, self.hit);
+                let m = _mm_min_ps(t, _mm_shuffle_ps::<0b10_11_00_01>(t, t));
+                let m = _mm_min_ps(m, _mm_shuffle_ps::<0b01_00_11_10>(m, m));
+                let at_min = _mm_movemask_ps(_mm_and_ps(_mm_cmpeq_ps(t, m), self.hit)) as u32;
+                let lane = at_min.trailing_zeros() as usize;
+                let pick =
+                    |v: __m128| _mm_cvtss_f32(_mm_permutevar_ps(v, _mm_set1_epi32(lane as i32)));
+                let det = pick(self.det);
+                BlockHit {
+                    lane,
+                    t: _mm_cvtss_f32(m),
+                    b1: pick(self.v) / det,
+                    b2: pick(self.w) / det,
+                }
+            }
+        }
     }
+
+    /// Four zero lanes, as a constant.
+    // SAFETY: an `__m128` is 16 bytes of any bits; zero bits are the floats +0.
+    const ZERO4: __m128 = unsafe { std::mem::transmute::<[f32; 4], __m128>([0.0; 4]) };
 
     /// # Safety
     /// The CPU must have AVX2 and FMA.
