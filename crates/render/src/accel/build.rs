@@ -28,12 +28,7 @@ use crate::math::Vec3;
 /// Below this depth the SAH (or the spatial median) chooses splits; deeper, median splits by
 /// count finish the job in at most log₂(2²⁷) more levels.
 const SAH_DEPTH: usize = 20;
-pub(crate) const BINS: usize = 32;
-/// How far ahead (in primitives, 1 KiB) the loops over a range of primitives (binning,
-/// partitioning) prefetch: ranges bigger than the L2 cache were read at two thirds of the speed
-/// of those inside it, the hardware's prefetching alone not keeping up (igea-sub4's build
-/// 0.348 -> 0.321 s with it in the binning loop; 0.327 s at 16, 0.320 s at 64).
-pub(crate) const STREAM_AHEAD: usize = 32;
+const BINS: usize = 32;
 /// Subtrees with more primitives than this are built as parallel tasks.
 const PARALLEL_THRESHOLD: usize = 4096;
 
@@ -119,9 +114,9 @@ impl Config {
 /// A primitive's box; `lo[3]` holds its index (as bits), `hi[3]` whether it is a triangle.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-pub(crate) struct PrimRef {
-    pub(crate) lo: [f32; 4],
-    pub(crate) hi: [f32; 4],
+struct PrimRef {
+    lo: [f32; 4],
+    hi: [f32; 4],
 }
 
 impl PrimRef {
@@ -145,13 +140,11 @@ impl PrimRef {
     }
 }
 
-/// Box as two 4-lane arrays (lane 3 unused, but for a bin's count: see `Bins`), for
-/// branch-free min/max the compiler vectorises.
-#[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(C, align(16))]
-pub(crate) struct Box4 {
-    pub(crate) lo: [f32; 4],
-    pub(crate) hi: [f32; 4],
+/// Box as two 4-lane arrays (lane 3 unused), for branch-free min/max the compiler vectorises.
+#[derive(Clone, Copy, Debug)]
+struct Box4 {
+    lo: [f32; 4],
+    hi: [f32; 4],
 }
 
 #[inline(always)]
@@ -246,13 +239,12 @@ struct Split {
 
 /// Maps centroids to bins on each axis.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Binner {
-    pub(crate) origin: [f32; 4],
-    /// Zero in lane 3 and on axes whose centroids all coincide.
-    pub(crate) scale: [f32; 4],
+struct Binner {
+    origin: [f32; 4],
+    scale: [f32; 4],
     /// Bins in use: fewer for small ranges, as Embree's `BinMapping` does (4 + n/20, at most
     /// `BINS`), which costs little quality and saves most of the sweep on small ranges.
-    pub(crate) count: usize,
+    count: usize,
 }
 
 impl Binner {
@@ -289,59 +281,22 @@ impl Binner {
     }
 }
 
-/// The bins of a split search, per axis: each bin's box, with the number of primitives in it
-/// as the bits of `lo[3]` (see `bin_prims`). Each build task keeps one and passes it down, so
-/// that a search clears only the bins it uses: most searches are over a few dozen primitives
-/// and a few bins, and clearing all of them (3 KiB) cost those searches more than the binning.
-pub(crate) struct Bins {
-    pub(crate) bounds: [[Box4; BINS]; 3],
+/// The bins of a split search, per axis. Each build task keeps one and passes it down, so that
+/// a search clears only the bins it uses: most searches are over a few dozen primitives and
+/// a few bins, and clearing all of them (3.5 KiB) cost those searches more than the binning.
+struct Bins {
+    bounds: [[Box4; BINS]; 3],
+    counts: [[u32; BINS]; 3],
 }
 
 impl Bins {
-    /// An empty bin: an empty box, no primitives.
-    pub(crate) const EMPTY: Box4 = Box4 {
-        lo: [f32::INFINITY, f32::INFINITY, f32::INFINITY, 0.0],
-        hi: [f32::NEG_INFINITY; 4],
-    };
-
     fn new() -> Bins {
         Bins {
-            bounds: [[Bins::EMPTY; BINS]; 3],
-        }
-    }
-
-    /// The number of primitives in bin `bin` of `axis`.
-    #[inline(always)]
-    fn count(&self, axis: usize, bin: usize) -> usize {
-        self.bounds[axis][bin].lo[3].to_bits() as usize
-    }
-}
-
-/// Puts each primitive of `prims` into its centroid's bin on every axis (`Binner::bin`),
-/// growing the bin's box by the primitive's and counting it in the bin's `lo[3]`, whose bits
-/// are the count (lanes 0 to 2 as `Box4::grow_box`; `bins` cleared to `Bins::EMPTY` first).
-/// The count lives in the box rather than in an array of its own so that a bin is one
-/// read-modify-write of two 16-byte rows: consecutive primitives mostly share their bins, and
-/// three more read-modify-writes per primitive, on counters elsewhere, made the loop wait on
-/// the memory it had just written (igea-sub4's build 0.352 -> 0.333 s with `simd::bin_prims`).
-/// The portable definition, used where there is no SSE2, and by the test of `simd::bin_prims`.
-#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
-fn bin_prims_portable(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
-    for p in prims {
-        let b = binner.bins(p.centroid());
-        for (axis, &bin) in b.iter().enumerate() {
-            let bx = &mut bins.bounds[axis][bin];
-            let count = bx.lo[3].to_bits() + 1;
-            bx.grow_box(p.lo, p.hi);
-            bx.lo[3] = f32::from_bits(count);
+            bounds: [[Box4::EMPTY; BINS]; 3],
+            counts: [[0; BINS]; 3],
         }
     }
 }
-
-#[cfg(not(target_arch = "x86_64"))]
-use bin_prims_portable as bin_prims;
-#[cfg(target_arch = "x86_64")]
-use simd::bin_prims;
 
 fn find_split(
     prims: &[PrimRef],
@@ -354,12 +309,20 @@ fn find_split(
     if binner.scale[..3].iter().all(|&s| s == 0.0) {
         return None;
     }
-    for axis_bins in &mut scratch.bounds {
-        axis_bins[..bins].fill(Bins::EMPTY);
+    let Bins { bounds, counts } = scratch;
+    for axis in 0..3 {
+        bounds[axis][..bins].fill(Box4::EMPTY);
+        counts[axis][..bins].fill(0);
     }
-    bin_prims(&prims[record.start..record.end], &binner, scratch);
+    for p in &prims[record.start..record.end] {
+        let b = binner.bins(p.centroid());
+        for axis in 0..3 {
+            bounds[axis][b[axis]].grow_box(p.lo, p.hi);
+            counts[axis][b[axis]] += 1;
+        }
+    }
     let mut best: Option<Split> = None;
-    for (axis, bounds) in scratch.bounds.iter().enumerate() {
+    for axis in 0..3 {
         if binner.scale[axis] == 0.0 {
             continue;
         }
@@ -367,8 +330,8 @@ fn find_split(
         let mut acc = Box4::EMPTY;
         let mut count = 0usize;
         for i in (1..bins).rev() {
-            acc = acc.union(bounds[i]);
-            count += scratch.count(axis, i);
+            acc = acc.union(bounds[axis][i]);
+            count += counts[axis][i] as usize;
             right_cost[i] = if count > 0 {
                 acc.half_area() * config.blocks(count)
             } else {
@@ -378,8 +341,8 @@ fn find_split(
         let mut acc = Box4::EMPTY;
         let mut count = 0usize;
         for i in 0..bins - 1 {
-            acc = acc.union(bounds[i]);
-            count += scratch.count(axis, i);
+            acc = acc.union(bounds[axis][i]);
+            count += counts[axis][i] as usize;
             if count == 0 {
                 continue;
             }
@@ -503,14 +466,12 @@ fn partition(
     let mut j = prims.len();
     loop {
         while i < j && !goes_right(&prims[i]) {
-            simd::prefetch_index(prims, i + STREAM_AHEAD);
             let p = &prims[i];
             left.grow_box(p.lo, p.hi);
             left_c.grow_point(p.centroid());
             i += 1;
         }
         while i < j && goes_right(&prims[j - 1]) {
-            simd::prefetch_index(prims, (j - 1).saturating_sub(STREAM_AHEAD));
             let p = &prims[j - 1];
             right.grow_box(p.lo, p.hi);
             right_c.grow_point(p.centroid());
@@ -978,10 +939,10 @@ mod tests {
         (0..3).all(|k| a.lo[k] == b.lo[k] && a.hi[k] == b.hi[k])
     }
 
-    /// A binner of unit bins from 0, and primitives whose centroid offsets lie on and beside
-    /// every bin boundary, below and beyond the bins, at ±0 and ∞, and NaN (a box infinite
-    /// both ways).
-    fn boundary_set() -> (Binner, Vec<PrimRef>) {
+    /// Centroid offsets on and beside every bin boundary, below and beyond the bins, and NaN
+    /// (a box infinite both ways), under a binner of unit bins.
+    #[test]
+    fn partition_agrees_with_the_bins_on_their_boundaries() {
         let binner = Binner {
             origin: [0.0; 4],
             scale: [1.0, 1.0, 1.0, 0.0],
@@ -1000,12 +961,6 @@ mod tests {
             .collect();
         let n = set.len();
         set.push(prim(n, [f32::NEG_INFINITY; 3], [f32::INFINITY; 3]));
-        (binner, set)
-    }
-
-    #[test]
-    fn partition_agrees_with_the_bins_on_their_boundaries() {
-        let (binner, set) = boundary_set();
         for axis in 0..3 {
             for bin in 0..BINS - 1 {
                 partition_checked(&set, &binner, axis, bin);
@@ -1032,41 +987,6 @@ mod tests {
         assert!(prims[..mid].iter().all(side), "axis {axis} bin {bin}");
         assert!(!prims[mid..].iter().any(side), "axis {axis} bin {bin}");
         (prims, left, right, mid)
-    }
-
-    /// `bin_prims` (SSE2 on x86-64) gives the portable definition's bins bit for bit, and
-    /// that definition counts in each bin the primitives `Binner::bin` puts there and bounds
-    /// them.
-    #[test]
-    fn binning_agrees_with_its_definition() {
-        let mut cases: Vec<(Binner, Vec<PrimRef>)> = prim_sets()
-            .into_iter()
-            .map(|set| (Binner::new(&measure(&set).1, set.len()), set))
-            .collect();
-        cases.push(boundary_set());
-        let bits = |b: &Box4| (b.lo.map(f32::to_bits), b.hi.map(f32::to_bits));
-        for (binner, set) in cases {
-            let mut fast = Bins::new();
-            let mut portable = Bins::new();
-            bin_prims(&set, &binner, &mut fast);
-            bin_prims_portable(&set, &binner, &mut portable);
-            for axis in 0..3 {
-                for bin in 0..binner.count {
-                    let (f, p) = (&fast.bounds[axis][bin], &portable.bounds[axis][bin]);
-                    assert_eq!(bits(f), bits(p), "axis {axis} bin {bin}");
-                    let inside: Vec<&PrimRef> = set
-                        .iter()
-                        .filter(|q| binner.bin(q.centroid(), axis) == bin)
-                        .collect();
-                    assert_eq!(portable.count(axis, bin), inside.len());
-                    let mut expected = Box4::EMPTY;
-                    for q in inside {
-                        expected.grow_box(q.lo, q.hi);
-                    }
-                    assert!(same_box(p, &expected), "axis {axis} bin {bin}");
-                }
-            }
-        }
     }
 
     #[test]

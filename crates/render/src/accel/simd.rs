@@ -18,8 +18,6 @@
 // Elsewhere than x86_64 the entry points only match on the uninhabited proof.
 #![cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
 
-#[cfg(target_arch = "x86_64")]
-use crate::accel::build::{Binner, Bins, PrimRef, STREAM_AHEAD};
 use crate::accel::isa::Avx2;
 #[cfg(test)]
 use crate::accel::packet;
@@ -43,23 +41,6 @@ pub(crate) fn prefetch<T>(value: &T) {
     };
     #[cfg(not(target_arch = "x86_64"))]
     let _ = value;
-}
-
-/// A hint to fetch the cache line of `slice[index]`, where `index` may lie past the end: the
-/// address is only formed (`wrapping_add`) and prefetched, never read. For loops streaming
-/// through arrays bigger than the caches, a fixed distance ahead.
-#[inline(always)]
-pub(crate) fn prefetch_index<T>(slice: &[T], index: usize) {
-    #[cfg(target_arch = "x86_64")]
-    // SAFETY: SSE is part of x86-64; a prefetch reads nothing the program sees and never
-    // faults, whatever the address.
-    unsafe {
-        std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(
-            slice.as_ptr().wrapping_add(index).cast(),
-        )
-    };
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (slice, index);
 }
 
 /// Closest hit with the AVX2 kernels; a ray that is not valid (`wide::ray_is_valid`) meets
@@ -166,58 +147,6 @@ pub(crate) fn binary_node_lanes(
     }
     #[cfg(not(target_arch = "x86_64"))]
     match avx2 {}
-}
-
-/// `build::bin_prims_portable` with SSE2 (part of x86-64, so no detection): the same bins,
-/// boxes and counts. The compiler's code for the portable loop assembled each box row from
-/// scalar loads and shuffles and kept a branch per axis for NaN; here a primitive's three bins
-/// are five vector operations and each bin one read-modify-write of each 16-byte row, the
-/// count added in the row's last lane (igea-sub4's build 0.352 -> 0.333 s, medians of 7
-/// alternating rounds, the same tree).
-#[cfg(target_arch = "x86_64")]
-pub(crate) fn bin_prims(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
-    use std::arch::x86_64::*;
-    // SAFETY: SSE2 is part of x86-64. Every load and store is of a `[f32; 4]` borrowed here
-    // (a `PrimRef`'s row or a bin's), read or written whole.
-    unsafe {
-        let origin = _mm_loadu_ps(binner.origin.as_ptr());
-        let scale = _mm_loadu_ps(binner.scale.as_ptr());
-        let last = _mm_set1_ps((binner.count - 1) as f32);
-        let zero = _mm_setzero_ps();
-        let one = _mm_set_epi32(1, 0, 0, 0);
-        for (i, p) in prims.iter().enumerate() {
-            prefetch_index(prims, i + STREAM_AHEAD);
-            let lo = _mm_loadu_ps(p.lo.as_ptr());
-            let hi = _mm_loadu_ps(p.hi.as_ptr());
-            // `Binner::bin` on the three axes at once: `max_ps(x, 0)` is 0 for NaN x, as
-            // `f32::max(x, 0.0)`; after the clamp the truncation is `as i32`'s.
-            let x = _mm_mul_ps(_mm_sub_ps(_mm_add_ps(lo, hi), origin), scale);
-            let b = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, zero), last));
-            let b = [
-                _mm_cvtsi128_si32(b) as usize,
-                _mm_cvtsi128_si32(_mm_shuffle_epi32::<0x55>(b)) as usize,
-                _mm_cvtsi128_si32(_mm_shuffle_epi32::<0xaa>(b)) as usize,
-            ];
-            for (axis, &bin) in b.iter().enumerate() {
-                let bx = &mut bins.bounds[axis][bin];
-                let old = _mm_loadu_ps(bx.lo.as_ptr());
-                // `min_ps(a, b)` is `if a < b { a } else { b }`, as `Box4::grow_box`.
-                let grown = _mm_min_ps(old, lo);
-                let counted = _mm_castsi128_ps(_mm_add_epi32(_mm_castps_si128(old), one));
-                // [grown0, grown1, grown2, counted3], built so as to be one store: the next
-                // primitive's load of the row is then served from that store.
-                let high = _mm_shuffle_ps::<0b11_11_10_10>(grown, counted);
-                _mm_storeu_ps(
-                    bx.lo.as_mut_ptr(),
-                    _mm_shuffle_ps::<0b10_00_01_00>(grown, high),
-                );
-                _mm_storeu_ps(
-                    bx.hi.as_mut_ptr(),
-                    _mm_max_ps(_mm_loadu_ps(bx.hi.as_ptr()), hi),
-                );
-            }
-        }
-    }
 }
 
 #[cfg(target_arch = "x86_64")]
