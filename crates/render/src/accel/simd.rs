@@ -206,6 +206,8 @@ mod x86 {
     struct BoxRay {
         origin: [__m256; 3],
         inv_dir: [__m256; 3],
+        /// The rows of each axis's near and far planes (`BoxPlanes::near`/`far`), as byte
+        /// offsets into `WideNode::bounds` (32 per row).
         near: [usize; 3],
         far: [usize; 3],
         t_min: __m256,
@@ -257,7 +259,7 @@ mod x86 {
             let (mask, t) = unsafe { block_test(block, ray, t_min, t_max) };
             match mask {
                 0 => None,
-                ZERO_EDGE => ScalarKernel.block(block, &ray.woop, t_min, t_max),
+                ZERO_EDGE => ScalarKernel.block(block, &ray.woop(), t_min, t_max),
                 // SAFETY: as above; some lane is hit.
                 _ => Some(unsafe { t.nearest() }),
             }
@@ -293,7 +295,7 @@ mod x86 {
             let (mask, _) = unsafe { block_test(block, ray, t_min, t_max) };
             match mask {
                 0 => false,
-                ZERO_EDGE => ScalarKernel.block_any(block, &ray.woop, t_min, t_max),
+                ZERO_EDGE => ScalarKernel.block_any(block, &ray.woop(), t_min, t_max),
                 _ => true,
             }
         }
@@ -314,7 +316,8 @@ mod x86 {
         origin: [__m128; 3],
         /// sx, sy, sz.
         shear: [__m128; 3],
-        woop: WoopRay,
+        /// kx, ky, kz as byte offsets of a corner's rows in a `TriangleBlock` (16 per axis).
+        rows: [usize; 3],
     }
 
     impl TriRay {
@@ -326,7 +329,32 @@ mod x86 {
                 TriRay {
                     origin: [woop.kx, woop.ky, woop.kz].map(|k| _mm_set1_ps(woop.origin[k])),
                     shear: [woop.sx, woop.sy, woop.sz].map(|s| _mm_set1_ps(s)),
-                    woop,
+                    rows: [woop.kx, woop.ky, woop.kz].map(|k| k * 4 * BLOCK),
+                }
+            }
+        }
+
+        /// The scalar form, for blocks with a zero edge function: every field is in the lanes
+        /// (kx, ky, kz are a permutation of the axes, so the origin is whole), rather than
+        /// stored beside them for the few rays that need it.
+        #[inline(always)]
+        fn woop(&self) -> WoopRay {
+            // SAFETY: SSE is part of x86-64.
+            unsafe {
+                let [kx, ky, kz] = self.rows.map(|r| r / (4 * BLOCK));
+                let mut origin = [0.0; 3];
+                for (&k, lanes) in [kx, ky, kz].iter().zip(&self.origin) {
+                    origin[k] = _mm_cvtss_f32(*lanes);
+                }
+                let [sx, sy, sz] = self.shear.map(|lanes| _mm_cvtss_f32(lanes));
+                WoopRay {
+                    origin,
+                    kx,
+                    ky,
+                    kz,
+                    sx,
+                    sy,
+                    sz,
                 }
             }
         }
@@ -385,8 +413,8 @@ mod x86 {
             let box_ray = BoxRay {
                 origin: [wide!(o, 0), wide!(o, 1), wide!(o, 2)],
                 inv_dir: [wide!(inv, 0), wide!(inv, 1), wide!(inv, 2)],
-                near,
-                far,
+                near: near.map(|row| row * 4 * WIDTH),
+                far: far.map(|row| row * 4 * WIDTH),
                 // `+ 0.0` turns -0 into +0 (equal as floats), whose bits are the least
                 // non-negative integer, as the integer reductions need.
                 t_min: _mm256_set1_ps(t_min + 0.0),
@@ -405,15 +433,7 @@ mod x86 {
             let tri_ray = TriRay {
                 origin: [pick(o, kx), pick(o, ky), pick(o, kz)],
                 shear: [sx, sy, sz],
-                woop: WoopRay {
-                    origin: [ox, oy, oz],
-                    kx,
-                    ky,
-                    kz,
-                    sx: _mm_cvtss_f32(sx),
-                    sy: _mm_cvtss_f32(sy),
-                    sz: _mm_cvtss_f32(sz),
-                },
+                rows: [kx, ky, kz].map(|k| k * 4 * BLOCK),
             };
             Some((box_ray, tri_ray))
         }
@@ -446,20 +466,18 @@ mod x86 {
     #[inline(always)]
     unsafe fn node_test(node: &WideNode, r: &BoxRay, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
         // SAFETY: the caller runs with AVX2 and FMA. Each row is 8 f32 inside the 64-byte
-        // aligned node, so 32-byte aligned; `near`/`far` are rows 0 to 5 (`BoxPlanes::new`
-        // makes them `a` or `a + 3` for an axis `a` < 3), so the unchecked row reads are in
-        // bounds; `entry` is 8 f32 (unaligned store).
+        // aligned node, so 32-byte aligned; `near`/`far` are the byte offsets of rows 0 to 5
+        // (`prepare` makes them from `a` or `a + 3` for an axis `a` < 3), so the row reads are
+        // in bounds; `entry` is 8 f32 (unaligned store).
         unsafe {
             // The children's line is read after the mask, which waits for the rows: ask for
             // it now, so that on a cache miss both misses overlap.
             _mm_prefetch::<_MM_HINT_T0>(node.children.as_ptr().cast());
+            let rows = node.bounds.as_ptr().cast::<u8>();
             macro_rules! slab {
                 ($row:expr, $axis:expr, $inv:expr) => {
                     _mm256_mul_ps(
-                        _mm256_sub_ps(
-                            _mm256_load_ps(node.bounds.get_unchecked($row).as_ptr()),
-                            r.origin[$axis],
-                        ),
+                        _mm256_sub_ps(_mm256_load_ps(rows.add($row).cast()), r.origin[$axis]),
                         $inv[$axis],
                     )
                 };
@@ -532,14 +550,15 @@ mod x86 {
         t_max: f32,
     ) -> (u32, BlockLanes) {
         // SAFETY (the whole body): the caller runs with AVX2; a row is 4 f32, 16-byte aligned
-        // in the 16-byte aligned block; `out` is 4 f32 (unaligned store).
+        // in the 16-byte aligned block, and `rows` are 0, 16 or 32 bytes (axes below 3, as
+        // `WoopRay::axes` and `TriRay::new` make them) into a corner's 48.
         unsafe {
             macro_rules! load {
-                ($corner:expr, $axis:expr) => {
-                    _mm_load_ps(block.v[$corner][$axis].as_ptr())
+                ($corner:expr, $row:expr) => {
+                    _mm_load_ps(block.v[$corner].as_ptr().cast::<u8>().add($row).cast())
                 };
             }
-            let (kx, ky, kz) = (ray.woop.kx, ray.woop.ky, ray.woop.kz);
+            let [kx, ky, kz] = ray.rows;
             let [ox, oy, oz] = ray.origin;
             let [sx, sy, sz] = ray.shear;
             // `WoopRay::shear`: a = v − o, then x = a[kx] − sx·a[kz], y = a[ky] − sy·a[kz].
@@ -1224,13 +1243,13 @@ mod x86 {
             planes: crate::accel::wide::BoxPlanes {
                 origin: b.origin.map(first),
                 inv_dir: b.inv_dir.map(first),
-                near: b.near,
-                far: b.far,
+                near: b.near.map(|offset| offset / (4 * WIDTH)),
+                far: b.far.map(|offset| offset / (4 * WIDTH)),
                 t_min: first(b.t_min),
             },
             inv_far: b.inv_far.map(first),
             no_nan: b.no_nan,
-            woop: t.woop,
+            woop: t.woop(),
             lanes: [
                 lanes(t.origin[0]),
                 lanes(t.origin[1]),
