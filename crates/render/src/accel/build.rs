@@ -28,7 +28,7 @@ use crate::math::Vec3;
 /// Below this depth the SAH (or the spatial median) chooses splits; deeper, median splits by
 /// count finish the job in at most log₂(2²⁷) more levels.
 const SAH_DEPTH: usize = 20;
-const BINS: usize = 32;
+pub(crate) const BINS: usize = 32;
 /// Subtrees with more primitives than this are built as parallel tasks.
 const PARALLEL_THRESHOLD: usize = 4096;
 
@@ -114,9 +114,9 @@ impl Config {
 /// A primitive's box; `lo[3]` holds its index (as bits), `hi[3]` whether it is a triangle.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-struct PrimRef {
-    lo: [f32; 4],
-    hi: [f32; 4],
+pub(crate) struct PrimRef {
+    pub(crate) lo: [f32; 4],
+    pub(crate) hi: [f32; 4],
 }
 
 impl PrimRef {
@@ -142,9 +142,9 @@ impl PrimRef {
 
 /// Box as two 4-lane arrays (lane 3 unused), for branch-free min/max the compiler vectorises.
 #[derive(Clone, Copy, Debug)]
-struct Box4 {
-    lo: [f32; 4],
-    hi: [f32; 4],
+pub(crate) struct Box4 {
+    pub(crate) lo: [f32; 4],
+    pub(crate) hi: [f32; 4],
 }
 
 #[inline(always)]
@@ -239,12 +239,13 @@ struct Split {
 
 /// Maps centroids to bins on each axis.
 #[derive(Clone, Copy, Debug)]
-struct Binner {
-    origin: [f32; 4],
-    scale: [f32; 4],
+pub(crate) struct Binner {
+    pub(crate) origin: [f32; 4],
+    /// Zero in lane 3 and on axes whose centroids all coincide.
+    pub(crate) scale: [f32; 4],
     /// Bins in use: fewer for small ranges, as Embree's `BinMapping` does (4 + n/20, at most
     /// `BINS`), which costs little quality and saves most of the sweep on small ranges.
-    count: usize,
+    pub(crate) count: usize,
 }
 
 impl Binner {
@@ -284,9 +285,9 @@ impl Binner {
 /// The bins of a split search, per axis. Each build task keeps one and passes it down, so that
 /// a search clears only the bins it uses: most searches are over a few dozen primitives and
 /// a few bins, and clearing all of them (3.5 KiB) cost those searches more than the binning.
-struct Bins {
-    bounds: [[Box4; BINS]; 3],
-    counts: [[u32; BINS]; 3],
+pub(crate) struct Bins {
+    pub(crate) bounds: [[Box4; BINS]; 3],
+    pub(crate) counts: [[u32; BINS]; 3],
 }
 
 impl Bins {
@@ -297,6 +298,25 @@ impl Bins {
         }
     }
 }
+
+/// Puts each primitive of `prims` into its centroid's bin on every axis (`Binner::bin`),
+/// growing the bin's box by the primitive's and counting it (`bins` cleared first). The
+/// portable definition; `simd::bin_prims` is the same with SSE2 on x86-64.
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+fn bin_prims_portable(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
+    for p in prims {
+        let b = binner.bins(p.centroid());
+        for (axis, &bin) in b.iter().enumerate() {
+            bins.bounds[axis][bin].grow_box(p.lo, p.hi);
+            bins.counts[axis][bin] += 1;
+        }
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+use bin_prims_portable as bin_prims;
+#[cfg(target_arch = "x86_64")]
+use simd::bin_prims;
 
 fn find_split(
     prims: &[PrimRef],
@@ -309,18 +329,12 @@ fn find_split(
     if binner.scale[..3].iter().all(|&s| s == 0.0) {
         return None;
     }
-    let Bins { bounds, counts } = scratch;
     for axis in 0..3 {
-        bounds[axis][..bins].fill(Box4::EMPTY);
-        counts[axis][..bins].fill(0);
+        scratch.bounds[axis][..bins].fill(Box4::EMPTY);
+        scratch.counts[axis][..bins].fill(0);
     }
-    for p in &prims[record.start..record.end] {
-        let b = binner.bins(p.centroid());
-        for axis in 0..3 {
-            bounds[axis][b[axis]].grow_box(p.lo, p.hi);
-            counts[axis][b[axis]] += 1;
-        }
-    }
+    bin_prims(&prims[record.start..record.end], &binner, scratch);
+    let Bins { bounds, counts } = scratch;
     let mut best: Option<Split> = None;
     for axis in 0..3 {
         if binner.scale[axis] == 0.0 {
@@ -964,6 +978,66 @@ mod tests {
         for axis in 0..3 {
             for bin in 0..BINS - 1 {
                 partition_checked(&set, &binner, axis, bin);
+            }
+        }
+    }
+
+    /// `bin_prims` (SSE2 on x86-64) gives the portable definition's bins bit for bit, and that
+    /// definition counts in each bin the primitives `Binner::bin` puts there and bounds them:
+    /// on the sets of the partition tests and on centroids on and beside every bin boundary,
+    /// at ±0 and ±∞, and NaN.
+    #[test]
+    fn binning_agrees_with_its_definition() {
+        let mut cases: Vec<(Binner, Vec<PrimRef>)> = prim_sets()
+            .into_iter()
+            .map(|set| (Binner::new(&measure(&set).1, set.len()), set))
+            .collect();
+        let unit = Binner {
+            origin: [0.0; 4],
+            scale: [1.0, 1.0, 1.0, 0.0],
+            count: BINS,
+        };
+        let mut edges: Vec<PrimRef> = (0..=BINS as i32 + 1)
+            .flat_map(|b| {
+                let x = b as f32;
+                [x.next_down(), x, x.next_up()]
+            })
+            .chain([0.0, -0.0, -1.0, f32::INFINITY, f32::NEG_INFINITY])
+            .enumerate()
+            .map(|(i, x)| prim(i, [x, 0.5 * x, 0.0], [0.0, 0.5 * x, x]))
+            .collect();
+        let n = edges.len();
+        edges.push(prim(n, [f32::NEG_INFINITY; 3], [f32::INFINITY; 3]));
+        cases.push((unit, edges));
+        // Boxes at +0 and -0 alone, in both orders: which zero a bin keeps is the order of
+        // the minimum's operands.
+        let zeros = [prim(0, [0.0; 3], [0.0; 3]), prim(1, [-0.0; 3], [-0.0; 3])];
+        cases.push((unit, zeros.to_vec()));
+        cases.push((unit, vec![zeros[1], zeros[0]]));
+        let bits = |b: &Box4| (b.lo.map(f32::to_bits), b.hi.map(f32::to_bits));
+        for (binner, set) in cases {
+            let (mut fast, mut portable) = (Bins::new(), Bins::new());
+            bin_prims(&set, &binner, &mut fast);
+            bin_prims_portable(&set, &binner, &mut portable);
+            for axis in 0..3 {
+                for bin in 0..binner.count {
+                    let (f, p) = (&fast.bounds[axis][bin], &portable.bounds[axis][bin]);
+                    assert_eq!(
+                        (bits(f), fast.counts[axis][bin]),
+                        (bits(p), portable.counts[axis][bin]),
+                        "axis {axis} bin {bin}"
+                    );
+                    let inside: Vec<&PrimRef> = set
+                        .iter()
+                        .filter(|q| binner.bin(q.centroid(), axis) == bin)
+                        .collect();
+                    assert_eq!(portable.counts[axis][bin] as usize, inside.len());
+                    let mut expected = Box4::EMPTY;
+                    for q in inside {
+                        expected.grow_box(q.lo, q.hi);
+                    }
+                    assert!(same_box(p, &expected), "axis {axis} bin {bin}");
+                }
             }
         }
     }

@@ -18,6 +18,8 @@
 // Elsewhere than x86_64 the entry points only match on the uninhabited proof.
 #![cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
 
+#[cfg(target_arch = "x86_64")]
+use crate::accel::build::{Binner, Bins, PrimRef};
 use crate::accel::isa::Avx2;
 #[cfg(test)]
 use crate::accel::packet;
@@ -124,6 +126,58 @@ pub(crate) fn prepared(avx2: Avx2, ray: &Ray) -> Option<x86::Prepared> {
     let _ = avx2;
     // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
     unsafe { x86::prepared(ray) }
+}
+
+/// `build::bin_prims_portable` with SSE2 (part of x86-64, so no detection): the same bins,
+/// boxes and counts (`binning_agrees_with_its_definition`). The compiler's code for the
+/// portable loop took about 50 instructions a primitive, a branch per axis for NaN and the
+/// three bins one at a time; here the bins are five vector operations, and each bin's box
+/// one load, minimum or maximum and store per row. The counts stay in arrays of their own:
+/// a count kept in the box's spare lane put an integer add and two shuffles on the chain
+/// through a bin that consecutive primitives share, and the build got slower on Zen 4.
+#[cfg(target_arch = "x86_64")]
+pub(crate) fn bin_prims(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE2 is part of x86-64. Every load and store is of a `[f32; 4]` borrowed here
+    // (a `PrimRef`'s row or a bin's), read or written whole.
+    unsafe {
+        let origin = _mm_loadu_ps(binner.origin.as_ptr());
+        let scale = _mm_loadu_ps(binner.scale.as_ptr());
+        let last = _mm_set1_ps((binner.count - 1) as f32);
+        let zero = _mm_setzero_ps();
+        // Lane 3 of a primitive's rows holds bits (its index, whether it is a triangle), not
+        // coordinates: cleared before any arithmetic, as the portable centroid has it 0.
+        let xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+        for p in prims {
+            let lo = _mm_loadu_ps(p.lo.as_ptr());
+            let hi = _mm_loadu_ps(p.hi.as_ptr());
+            // `Binner::bin` on the three axes at once: `max_ps(x, 0)` is 0 for NaN x, as
+            // `f32::max(x, 0.0)`; after the clamp the truncation is `as i32`'s.
+            let x = _mm_mul_ps(
+                _mm_sub_ps(_mm_and_ps(_mm_add_ps(lo, hi), xyz), origin),
+                scale,
+            );
+            let b = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, zero), last));
+            let b = [
+                _mm_cvtsi128_si32(b) as usize,
+                _mm_cvtsi128_si32(_mm_shuffle_epi32::<0x55>(b)) as usize,
+                _mm_cvtsi128_si32(_mm_shuffle_epi32::<0xaa>(b)) as usize,
+            ];
+            for (axis, &bin) in b.iter().enumerate() {
+                let bx = &mut bins.bounds[axis][bin];
+                // `min_ps(a, b)` is `if a < b { a } else { b }`, as `Box4::grow_box`.
+                _mm_storeu_ps(
+                    bx.lo.as_mut_ptr(),
+                    _mm_min_ps(_mm_loadu_ps(bx.lo.as_ptr()), lo),
+                );
+                _mm_storeu_ps(
+                    bx.hi.as_mut_ptr(),
+                    _mm_max_ps(_mm_loadu_ps(bx.hi.as_ptr()), hi),
+                );
+                bins.counts[axis][bin] += 1;
+            }
+        }
+    }
 }
 
 /// The slab test of the binary BVH (`bvh::RayInverse::hits`) for eight rays against one node,
