@@ -256,14 +256,44 @@ mod x86 {
         }
     }
 
+    /// The byte offsets in `WideNode::bounds` of the near and far rows of x, y and z.
+    struct SlabRows {
+        near: [usize; 3],
+        far: [usize; 3],
+    }
+
+    /// `SlabRows` by the direction's sign bits (bit a set: axis a negative), `BoxPlanes::new`'s
+    /// choice: the min row near and the max row far on a non-negative axis, the reverse on a
+    /// negative one. Looked up once per ray instead of computing six offsets.
+    const SLAB_ROWS: [SlabRows; 8] = {
+        let mut table = [const {
+            SlabRows {
+                near: [0; 3],
+                far: [0; 3],
+            }
+        }; 8];
+        let mut sign = 0;
+        while sign < 8 {
+            let mut a = 0;
+            while a < 3 {
+                let negative = sign >> a & 1 != 0;
+                let (near, far) = if negative { (a + 3, a) } else { (a, a + 3) };
+                table[sign].near[a] = near * 4 * WIDTH;
+                table[sign].far[a] = far * 4 * WIDTH;
+                a += 1;
+            }
+            sign += 1;
+        }
+        table
+    };
+
     /// Per-ray constants of the box test, broadcast to 8 lanes.
     struct BoxRay {
         origin: [__m256; 3],
         inv_dir: [__m256; 3],
         /// The rows of each axis's near and far planes (`BoxPlanes::near`/`far`), as byte
-        /// offsets into `WideNode::bounds` (32 per row).
-        near: [usize; 3],
-        far: [usize; 3],
+        /// offsets into `WideNode::bounds`: `SLAB_ROWS`' entry for the direction's signs.
+        rows: &'static SlabRows,
         t_min: __m256,
         /// No slab distance can be NaN (every reciprocal finite) and `t_min >= 0`: the
         /// reductions may take the short path of `node_test` (see there).
@@ -453,11 +483,7 @@ mod x86 {
             // `BoxPlanes::new`: 1/d per axis (the same IEEE division), the slab rows chosen
             // by the sign bits.
             let inv = _mm_div_ps(_mm_set1_ps(1.0), d);
-            let sign = _mm_movemask_ps(d) as usize;
-            let near: [usize; 3] =
-                std::array::from_fn(|a| if sign >> a & 1 != 0 { a + 3 } else { a });
-            let far: [usize; 3] =
-                std::array::from_fn(|a| if sign >> a & 1 != 0 { a } else { a + 3 });
+            let sign = _mm_movemask_ps(d) as usize & 0b111;
             let inv_far = _mm_mul_ps(inv, _mm_set1_ps(FOLDED_FAR_SCALE));
             macro_rules! wide {
                 ($v:expr, $lane:expr) => {
@@ -467,8 +493,7 @@ mod x86 {
             let box_ray = BoxRay {
                 origin: [wide!(o, 0), wide!(o, 1), wide!(o, 2)],
                 inv_dir: [wide!(inv, 0), wide!(inv, 1), wide!(inv, 2)],
-                near: near.map(|row| row * 4 * WIDTH),
-                far: far.map(|row| row * 4 * WIDTH),
+                rows: &SLAB_ROWS[sign],
                 // `+ 0.0` turns -0 into +0 (equal as floats), whose bits are the least
                 // non-negative integer, as the integer reductions need.
                 t_min: _mm256_set1_ps(t_min + 0.0),
@@ -520,9 +545,9 @@ mod x86 {
     #[inline(always)]
     unsafe fn node_test(node: &WideNode, r: &BoxRay, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
         // SAFETY: the caller runs with AVX2 and FMA. Each row is 8 f32 inside the 64-byte
-        // aligned node, so 32-byte aligned; `near`/`far` are the byte offsets of rows 0 to 5
-        // (`prepare` makes them from `a` or `a + 3` for an axis `a` < 3), so the row reads are
-        // in bounds; `entry` is 8 f32 (unaligned store).
+        // aligned node, so 32-byte aligned; `rows` holds the byte offsets of rows 0 to 5
+        // (`SLAB_ROWS` makes them from `a` or `a + 3` for an axis `a` < 3), so the row reads
+        // are in bounds; `entry` is 8 f32 (unaligned store).
         unsafe {
             // The children's line is read after the mask, which waits for the rows: ask for
             // it now, so that on a cache miss both misses overlap.
@@ -536,14 +561,14 @@ mod x86 {
                     )
                 };
             }
-            let near_x = slab!(r.near[0], 0, r.inv_dir);
-            let near_y = slab!(r.near[1], 1, r.inv_dir);
-            let near_z = slab!(r.near[2], 2, r.inv_dir);
+            let near_x = slab!(r.rows.near[0], 0, r.inv_dir);
+            let near_y = slab!(r.rows.near[1], 1, r.inv_dir);
+            let near_z = slab!(r.rows.near[2], 2, r.inv_dir);
             let t_max = _mm256_set1_ps(t_max);
             if r.no_nan {
-                let far_x = slab!(r.far[0], 0, r.inv_far);
-                let far_y = slab!(r.far[1], 1, r.inv_far);
-                let far_z = slab!(r.far[2], 2, r.inv_far);
+                let far_x = slab!(r.rows.far[0], 0, r.inv_far);
+                let far_y = slab!(r.rows.far[1], 1, r.inv_far);
+                let far_z = slab!(r.rows.far[2], 2, r.inv_far);
                 macro_rules! int {
                     ($f:ident, $a:expr, $b:expr) => {
                         _mm256_castsi256_ps($f(_mm256_castps_si256($a), _mm256_castps_si256($b)))
@@ -568,9 +593,9 @@ mod x86 {
                 _mm256_storeu_ps(entry.as_mut_ptr(), t0);
                 return _mm256_movemask_ps(inside) as u32;
             }
-            let far_x = slab!(r.far[0], 0, r.inv_dir);
-            let far_y = slab!(r.far[1], 1, r.inv_dir);
-            let far_z = slab!(r.far[2], 2, r.inv_dir);
+            let far_x = slab!(r.rows.far[0], 0, r.inv_dir);
+            let far_y = slab!(r.rows.far[1], 1, r.inv_dir);
+            let far_z = slab!(r.rows.far[2], 2, r.inv_dir);
             // `max_ps(a, b)`/`min_ps(a, b)` return b when either is NaN: with the running value
             // second, a NaN slab (a ray in a slab plane) leaves it alone, as in the scalar kernel.
             let t0 = _mm256_max_ps(
@@ -1297,8 +1322,8 @@ mod x86 {
             planes: crate::accel::wide::BoxPlanes {
                 origin: b.origin.map(first),
                 inv_dir: b.inv_dir.map(first),
-                near: b.near.map(|offset| offset / (4 * WIDTH)),
-                far: b.far.map(|offset| offset / (4 * WIDTH)),
+                near: b.rows.near.map(|offset| offset / (4 * WIDTH)),
+                far: b.rows.far.map(|offset| offset / (4 * WIDTH)),
                 t_min: first(b.t_min),
             },
             inv_far: b.inv_far.map(first),
