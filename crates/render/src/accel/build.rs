@@ -28,7 +28,7 @@ use crate::math::Vec3;
 /// Below this depth the SAH (or the spatial median) chooses splits; deeper, median splits by
 /// count finish the job in at most log₂(2²⁷) more levels.
 const SAH_DEPTH: usize = 20;
-pub(crate) const BINS: usize = 32;
+const BINS: usize = 32;
 /// Subtrees with more primitives than this are built as parallel tasks.
 const PARALLEL_THRESHOLD: usize = 4096;
 
@@ -114,9 +114,9 @@ impl Config {
 /// A primitive's box; `lo[3]` holds its index (as bits), `hi[3]` whether it is a triangle.
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(32))]
-pub(crate) struct PrimRef {
-    pub(crate) lo: [f32; 4],
-    pub(crate) hi: [f32; 4],
+struct PrimRef {
+    lo: [f32; 4],
+    hi: [f32; 4],
 }
 
 impl PrimRef {
@@ -142,9 +142,9 @@ impl PrimRef {
 
 /// Box as two 4-lane arrays (lane 3 unused), for branch-free min/max the compiler vectorises.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Box4 {
-    pub(crate) lo: [f32; 4],
-    pub(crate) hi: [f32; 4],
+struct Box4 {
+    lo: [f32; 4],
+    hi: [f32; 4],
 }
 
 #[inline(always)]
@@ -239,13 +239,13 @@ struct Split {
 
 /// Maps centroids to bins on each axis.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Binner {
-    pub(crate) origin: [f32; 4],
+struct Binner {
+    origin: [f32; 4],
     /// Zero in lane 3 and on axes whose centroids all coincide.
-    pub(crate) scale: [f32; 4],
+    scale: [f32; 4],
     /// Bins in use: fewer for small ranges, as Embree's `BinMapping` does (4 + n/20, at most
     /// `BINS`), which costs little quality and saves most of the sweep on small ranges.
-    pub(crate) count: usize,
+    count: usize,
 }
 
 impl Binner {
@@ -285,9 +285,9 @@ impl Binner {
 /// The bins of a split search, per axis. Each build task keeps one and passes it down, so that
 /// a search clears only the bins it uses: most searches are over a few dozen primitives and
 /// a few bins, and clearing all of them (3.5 KiB) cost those searches more than the binning.
-pub(crate) struct Bins {
-    pub(crate) bounds: [[Box4; BINS]; 3],
-    pub(crate) counts: [[u32; BINS]; 3],
+struct Bins {
+    bounds: [[Box4; BINS]; 3],
+    counts: [[u32; BINS]; 3],
 }
 
 impl Bins {
@@ -301,7 +301,7 @@ impl Bins {
 
 /// Puts each primitive of `prims` into its centroid's bin on every axis (`Binner::bin`),
 /// growing the bin's box by the primitive's and counting it (`bins` cleared first). The
-/// portable definition; `simd::bin_prims` is the same with SSE2 on x86-64.
+/// portable definition; `bin_prims` is the same with SSE2 on x86-64.
 #[cfg_attr(target_arch = "x86_64", allow(dead_code))]
 fn bin_prims_portable(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
     for p in prims {
@@ -315,8 +315,23 @@ fn bin_prims_portable(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
 
 #[cfg(not(target_arch = "x86_64"))]
 use bin_prims_portable as bin_prims;
+
+/// `bin_prims_portable` with the SSE2 pieces of `simd.rs`: the same bins, boxes and counts
+/// (`binning_agrees_with_its_definition`), about half the instructions a primitive. The counts
+/// stay in arrays of their own: a count kept in the box's spare lane put an integer add and two
+/// shuffles on the chain through a bin that consecutive primitives share.
 #[cfg(target_arch = "x86_64")]
-use simd::bin_prims;
+fn bin_prims(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
+    let last = (binner.count - 1) as f32;
+    for p in prims {
+        let b = simd::centroid_bins(&p.lo, &p.hi, &binner.origin, &binner.scale, last);
+        for (axis, &bin) in b.iter().enumerate() {
+            let bx = &mut bins.bounds[axis][bin];
+            simd::grow_rows(&mut bx.lo, &mut bx.hi, &p.lo, &p.hi);
+            bins.counts[axis][bin] += 1;
+        }
+    }
+}
 
 fn find_split(
     prims: &[PrimRef],

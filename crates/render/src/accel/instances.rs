@@ -696,7 +696,7 @@ impl Instances {
         let mut packet = 0u8;
         for (l, ray) in rays.iter().enumerate() {
             if lanes & (1 << l) != 0 {
-                if crate::accel::packet::ray_is_valid(ray) {
+                if crate::accel::wide::ray_is_valid(ray) {
                     packet |= 1 << l;
                 } else {
                     out[l] = self.intersect(ray);
@@ -784,7 +784,7 @@ impl Instances {
         let mut packet = 0u8;
         for (l, ray) in rays.iter().enumerate() {
             if lanes & (1 << l) != 0 {
-                if crate::accel::packet::ray_is_valid(ray) {
+                if crate::accel::wide::ray_is_valid(ray) {
                     packet |= 1 << l;
                 } else if self.occluded(ray) {
                     out |= 1 << l;

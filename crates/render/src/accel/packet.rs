@@ -32,6 +32,7 @@
 //! over both, like `wide::closest`.
 
 use crate::accel::triangle::WoopRay;
+use crate::accel::wide::ray_is_valid;
 use crate::accel::wide::{
     self, ArrayStack, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, TriangleBlock,
     WideBvh, WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
@@ -91,12 +92,6 @@ pub(crate) struct PacketRays<'a> {
     /// Lanes holding valid rays (finite, non-empty window) among those asked for.
     pub valid: u32,
     pub interval: Option<Interval>,
-}
-
-/// Rays with NaN or infinite components, or an empty window, meet nothing (as in `wide.rs`).
-#[inline(always)]
-pub(crate) fn ray_is_valid(ray: &Ray) -> bool {
-    ray.origin.is_finite() && ray.direction.is_finite() && ray.t_min <= ray.t_max
 }
 
 impl<'a> PacketRays<'a> {

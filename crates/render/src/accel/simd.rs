@@ -18,8 +18,6 @@
 // Elsewhere than x86_64 the entry points only match on the uninhabited proof.
 #![cfg_attr(not(target_arch = "x86_64"), allow(unused_variables))]
 
-#[cfg(target_arch = "x86_64")]
-use crate::accel::build::{Binner, Bins, PrimRef};
 use crate::accel::isa::Avx2;
 #[cfg(test)]
 use crate::accel::packet;
@@ -128,55 +126,64 @@ pub(crate) fn prepared(avx2: Avx2, ray: &Ray) -> Option<x86::Prepared> {
     unsafe { x86::prepared(ray) }
 }
 
-/// `build::bin_prims_portable` with SSE2 (part of x86-64, so no detection): the same bins,
-/// boxes and counts (`binning_agrees_with_its_definition`). The compiler's code for the
-/// portable loop took about 50 instructions a primitive, a branch per axis for NaN and the
-/// three bins one at a time; here the bins are five vector operations, and each bin's box
-/// one load, minimum or maximum and store per row. The counts stay in arrays of their own:
-/// a count kept in the box's spare lane put an integer add and two shuffles on the chain
-/// through a bin that consecutive primitives share, and the build got slower on Zen 4.
+/// `Binner::bin` on the three axes at once for a primitive with box rows `lo`, `hi` (lane 3
+/// holds bits, not a coordinate): the same bins as the portable code, with SSE2 (part of
+/// x86-64, so no detection). The compiler's code for the portable form took a branch per axis
+/// for NaN and the three bins one at a time; here they are six vector operations. For
+/// `build::bin_prims` (`binning_agrees_with_its_definition` checks it bit for bit).
 #[cfg(target_arch = "x86_64")]
-pub(crate) fn bin_prims(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
+#[inline(always)]
+pub(crate) fn centroid_bins(
+    lo: &[f32; 4],
+    hi: &[f32; 4],
+    origin: &[f32; 4],
+    scale: &[f32; 4],
+    last: f32,
+) -> [usize; 3] {
     use std::arch::x86_64::*;
-    // SAFETY: SSE2 is part of x86-64. Every load and store is of a `[f32; 4]` borrowed here
-    // (a `PrimRef`'s row or a bin's), read or written whole.
+    // SAFETY: SSE2 is part of x86-64; every load is of a `[f32; 4]` borrowed here.
     unsafe {
-        let origin = _mm_loadu_ps(binner.origin.as_ptr());
-        let scale = _mm_loadu_ps(binner.scale.as_ptr());
-        let last = _mm_set1_ps((binner.count - 1) as f32);
-        let zero = _mm_setzero_ps();
-        // Lane 3 of a primitive's rows holds bits (its index, whether it is a triangle), not
-        // coordinates: cleared before any arithmetic, as the portable centroid has it 0.
+        // Lane 3 cleared before any arithmetic, as the portable centroid has it 0.
         let xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
-        for p in prims {
-            let lo = _mm_loadu_ps(p.lo.as_ptr());
-            let hi = _mm_loadu_ps(p.hi.as_ptr());
-            // `Binner::bin` on the three axes at once: `max_ps(x, 0)` is 0 for NaN x, as
-            // `f32::max(x, 0.0)`; after the clamp the truncation is `as i32`'s.
-            let x = _mm_mul_ps(
-                _mm_sub_ps(_mm_and_ps(_mm_add_ps(lo, hi), xyz), origin),
-                scale,
-            );
-            let b = _mm_cvttps_epi32(_mm_min_ps(_mm_max_ps(x, zero), last));
-            let b = [
-                _mm_cvtsi128_si32(b) as usize,
-                _mm_cvtsi128_si32(_mm_shuffle_epi32::<0x55>(b)) as usize,
-                _mm_cvtsi128_si32(_mm_shuffle_epi32::<0xaa>(b)) as usize,
-            ];
-            for (axis, &bin) in b.iter().enumerate() {
-                let bx = &mut bins.bounds[axis][bin];
-                // `min_ps(a, b)` is `if a < b { a } else { b }`, as `Box4::grow_box`.
-                _mm_storeu_ps(
-                    bx.lo.as_mut_ptr(),
-                    _mm_min_ps(_mm_loadu_ps(bx.lo.as_ptr()), lo),
-                );
-                _mm_storeu_ps(
-                    bx.hi.as_mut_ptr(),
-                    _mm_max_ps(_mm_loadu_ps(bx.hi.as_ptr()), hi),
-                );
-                bins.counts[axis][bin] += 1;
-            }
-        }
+        let c = _mm_and_ps(
+            _mm_add_ps(_mm_loadu_ps(lo.as_ptr()), _mm_loadu_ps(hi.as_ptr())),
+            xyz,
+        );
+        let x = _mm_mul_ps(
+            _mm_sub_ps(c, _mm_loadu_ps(origin.as_ptr())),
+            _mm_loadu_ps(scale.as_ptr()),
+        );
+        // `max_ps(x, 0)` is 0 for NaN x, as `f32::max(x, 0.0)`; after the clamp the
+        // truncation is `as i32`'s.
+        let b = _mm_cvttps_epi32(_mm_min_ps(
+            _mm_max_ps(x, _mm_setzero_ps()),
+            _mm_set1_ps(last),
+        ));
+        [
+            _mm_cvtsi128_si32(b) as usize,
+            _mm_cvtsi128_si32(_mm_shuffle_epi32::<0x55>(b)) as usize,
+            _mm_cvtsi128_si32(_mm_shuffle_epi32::<0xaa>(b)) as usize,
+        ]
+    }
+}
+
+/// `Box4::grow_box` on a box's rows with SSE2: one load, minimum or maximum and store per
+/// row (`min_ps(a, b)` is `if a < b { a } else { b }`, as the portable form).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn grow_rows(
+    box_lo: &mut [f32; 4],
+    box_hi: &mut [f32; 4],
+    lo: &[f32; 4],
+    hi: &[f32; 4],
+) {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE2 is part of x86-64; every load and store is of a `[f32; 4]` borrowed here.
+    unsafe {
+        let grown = _mm_min_ps(_mm_loadu_ps(box_lo.as_ptr()), _mm_loadu_ps(lo.as_ptr()));
+        _mm_storeu_ps(box_lo.as_mut_ptr(), grown);
+        let grown = _mm_max_ps(_mm_loadu_ps(box_hi.as_ptr()), _mm_loadu_ps(hi.as_ptr()));
+        _mm_storeu_ps(box_hi.as_mut_ptr(), grown);
     }
 }
 
@@ -262,9 +269,8 @@ mod x86 {
         far: [usize; 3],
     }
 
-    /// `SlabRows` by the direction's sign bits (bit a set: axis a negative), `BoxPlanes::new`'s
-    /// choice: the min row near and the max row far on a non-negative axis, the reverse on a
-    /// negative one. Looked up once per ray instead of computing six offsets.
+    /// `SlabRows` by the direction's sign bits (bit a set: axis a negative), as
+    /// `wide::slab_rows` gives them. Looked up once per ray instead of computing six offsets.
     const SLAB_ROWS: [SlabRows; 8] = {
         let mut table = [const {
             SlabRows {
@@ -276,8 +282,7 @@ mod x86 {
         while sign < 8 {
             let mut a = 0;
             while a < 3 {
-                let negative = sign >> a & 1 != 0;
-                let (near, far) = if negative { (a + 3, a) } else { (a, a + 3) };
+                let (near, far) = wide::slab_rows(a, sign >> a & 1 != 0);
                 table[sign].near[a] = near * 4 * WIDTH;
                 table[sign].far[a] = far * 4 * WIDTH;
                 a += 1;
@@ -393,8 +398,9 @@ mod x86 {
     // the features, their intrinsics are compiled for AVX2 there, with the ray's constants
     // in registers for the whole walk. Hence `unsafe`: they must only be reached from there.
 
-    /// Per-ray constants of the watertight test (`WoopRay`'s) broadcast to four lanes, and
-    /// the scalar form, for blocks with a zero edge function.
+    /// Per-ray constants of the watertight test (`WoopRay`'s) broadcast to four lanes, with
+    /// the sheared frame's axes as row offsets; `woop` rebuilds the scalar form for blocks
+    /// with a zero edge function.
     struct TriRay {
         /// origin[kx], origin[ky], origin[kz].
         origin: [__m128; 3],
@@ -445,9 +451,10 @@ mod x86 {
     }
 
     /// `ray_is_valid`, `BoxPlanes::new` and `WoopRay::new` in one pass of 4-lane operations,
-    /// every constant the value the scalar code gives. Set up this way, a ray costs a third of
-    /// the instructions it took through the scalar constructors (whose per-axis arrays the
-    /// compiler kept on the stack and read back by index, waiting on its own stores).
+    /// every constant the value the scalar code gives. Through the scalar constructors the
+    /// compiler kept their per-axis arrays on the stack and read them back by index, waiting
+    /// on its own stores (`d[kx]`, `d[ky]` held 18 % of a missing ray's samples); rays that
+    /// miss the bunny went from 40 to 44 Mrays/s with this alone (bench/README, fifth pass).
     ///
     /// The ray's eight floats are read one by one: callers have most often just written the
     /// ray (a local copy, in object space), and a load wider than one of those stores, spanning

@@ -395,6 +395,18 @@ pub(crate) struct BoxPlanes {
     pub t_min: f32,
 }
 
+/// The rows of `WideNode::bounds` holding axis `axis`'s near and far planes for a ray whose
+/// direction component there is negative (sign bit set) or not: (min, max) rows, or the
+/// reverse. `BoxPlanes::new` and the AVX2 kernel's row table both take them from here.
+#[inline(always)]
+pub(crate) const fn slab_rows(axis: usize, negative: bool) -> (usize, usize) {
+    if negative {
+        (axis + 3, axis)
+    } else {
+        (axis, axis + 3)
+    }
+}
+
 /// Scale on the far distance of a box so that rounding in the slab test never culls a box the
 /// ray touches (after pbrt-v4's `1 + 2γ₃`; the binary BVH does the same).
 pub(crate) const FAR_SCALE: f32 = 1.0 + 8.0 * f32::EPSILON;
@@ -407,9 +419,10 @@ impl BoxPlanes {
         // slab plane then makes 0 · ∞ = NaN there, which the min/max order of the kernels
         // ignores (the plane counts as inside, as it must for watertightness).
         let inv_dir = d.map(|c| 1.0 / c);
-        let negative = d.map(|c| c.is_sign_negative());
-        let near = std::array::from_fn(|a| if negative[a] { a + 3 } else { a });
-        let far = std::array::from_fn(|a| if negative[a] { a } else { a + 3 });
+        let rows: [(usize, usize); 3] =
+            std::array::from_fn(|a| slab_rows(a, d[a].is_sign_negative()));
+        let near = rows.map(|(near, _)| near);
+        let far = rows.map(|(_, far)| far);
         BoxPlanes {
             origin: ray.origin.to_array(),
             inv_dir,
@@ -704,9 +717,6 @@ impl WideBvh {
     /// traversal instantiated with a counting kernel, so the traversal that renders carries no
     /// counter. For `--stats` only.
     pub(crate) fn count_closest(&self, ray: &Ray, counts: &mut WalkCounts) -> Option<LocalHit> {
-        if !ray_is_valid(ray) {
-            return None;
-        }
         let kernel = CountingKernel {
             nodes: std::cell::Cell::new(0),
             blocks: std::cell::Cell::new(0),
