@@ -29,6 +29,7 @@ use crate::math::Vec3;
 /// count finish the job in at most log₂(2²⁷) more levels.
 const SAH_DEPTH: usize = 20;
 const BINS: usize = 32;
+const _: () = assert!(BINS.is_power_of_two());
 /// Subtrees with more primitives than this are built as parallel tasks.
 const PARALLEL_THRESHOLD: usize = 4096;
 
@@ -166,6 +167,8 @@ impl Box4 {
         self.lo = min4(self.lo, lo);
         self.hi = max4(self.hi, hi);
     }
+    /// (On x86-64 `simd::measure_rows` does this; the tests keep the definition.)
+    #[cfg(any(test, not(target_arch = "x86_64")))]
     #[inline(always)]
     fn grow_point(&mut self, p: [f32; 4]) {
         self.grow_box(p, p);
@@ -233,6 +236,8 @@ struct Split {
     axis: usize,
     /// Bins 0..=bin go left.
     bin: usize,
+    /// How many primitives go left (the binning's count, which `partition` checks).
+    left: usize,
     /// SAH of the children: Σ half area · blocks.
     cost: f32,
 }
@@ -326,6 +331,9 @@ fn bin_prims(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
     for p in prims {
         let b = simd::centroid_bins(&p.lo, &p.hi, &binner.origin, &binner.scale, last);
         for (axis, &bin) in b.iter().enumerate() {
+            // `bin < count <= BINS`, a power of two: the mask changes nothing but spares the
+            // bounds checks.
+            let bin = bin & (BINS - 1);
             let bx = &mut bins.bounds[axis][bin];
             simd::grow_rows(&mut bx.lo, &mut bx.hi, &p.lo, &p.hi);
             bins.counts[axis][bin] += 1;
@@ -377,7 +385,12 @@ fn find_split(
             }
             let cost = acc.half_area() * config.blocks(count) + right_cost[i + 1];
             if cost.is_finite() && best.is_none_or_cheaper(cost) {
-                best = Some(Split { axis, bin: i, cost });
+                best = Some(Split {
+                    axis,
+                    bin: i,
+                    left: count,
+                    cost,
+                });
             }
         }
     }
@@ -399,13 +412,28 @@ impl CheaperThan for Option<Split> {
 
 /// Bounds and centroid bounds of a range.
 fn measure(prims: &[PrimRef]) -> (Box4, Box4) {
-    let mut bounds = Box4::EMPTY;
-    let mut centroids = Box4::EMPTY;
-    for p in prims {
-        bounds.grow_box(p.lo, p.hi);
-        centroids.grow_point(p.centroid());
+    measure_in_order(prims.iter())
+}
+
+/// `measure` taking the primitives in `order`: which of +0 and -0 a box keeps where both
+/// occur depends on it.
+#[inline(always)]
+fn measure_in_order<'a>(order: impl Iterator<Item = &'a PrimRef>) -> (Box4, Box4) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        let [lo, hi, c_lo, c_hi] = simd::measure_rows(order.map(|p| (&p.lo, &p.hi)));
+        (Box4 { lo, hi }, Box4 { lo: c_lo, hi: c_hi })
     }
-    (bounds, centroids)
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let mut bounds = Box4::EMPTY;
+        let mut centroids = Box4::EMPTY;
+        for p in order {
+            bounds.grow_box(p.lo, p.hi);
+            centroids.grow_point(p.centroid());
+        }
+        (bounds, centroids)
+    }
 }
 
 /// Splits a record in two by `method`. With the SAH: by its split, else at the median by count
@@ -474,9 +502,24 @@ fn split_record(
     (make(prims, start, mid, left), make(prims, mid, end, right))
 }
 
-/// Partitions `prims` by `split` (bins `0..=split.bin` of `binner` first) from both ends,
-/// swapping only the pairs that are on the wrong sides, and measures both sides on the way.
-/// Returns the (bounds, centroid bounds) of either side and where the second one starts.
+/// Primitives `partition` looks at in one pass of its branch-free scans.
+const SCAN: usize = 64;
+
+/// Partitions `prims` by `split` (bins `0..=split.bin` of `binner` first) and measures both
+/// sides. Returns the (bounds, centroid bounds) of either side and where the second one
+/// starts.
+///
+/// The arrangement is Hoare's (`partition_reference`): the k-th primitive of the left part
+/// going right, counted from the left, trades places with the k-th of the right part going
+/// left, counted from the right; everything else stays. Where the sides change at random,
+/// Hoare's two scanning loops end on a mispredicted branch every few primitives (a quarter of
+/// the igea build's time went there), so here the misplaced positions are collected in blocks
+/// of `SCAN` without a branch per primitive (`slot = p; n += misplaced`), after
+/// BlockQuicksort (Edelkamp and Weiß, 2016), then swapped pairwise. The left part's size is
+/// the binning's count (`Split::left`); should it be off, the scans would not end together,
+/// and the count is taken again. The sides are measured afterwards in Hoare's order (the left
+/// part upwards, the right part downwards), so the boxes are bit for bit the same, signed
+/// zeros included.
 fn partition(
     prims: &mut [PrimRef],
     binner: &Binner,
@@ -487,6 +530,79 @@ fn partition(
     // `binner.bin(c, axis) > split.bin` without the conversion: for the scaled offset x,
     // `trunc(x.max(0).min(count - 1)) > bin` exactly when `x >= bin + 1` (NaN: false), as
     // `bin + 1 <= count - 1`.
+    let threshold = (split.bin + 1) as f32;
+    let goes_right = |p: &PrimRef| (p.lo[axis] + p.hi[axis] - origin) * scale >= threshold;
+    let mid = if swap_misplaced(prims, split.left, goes_right) {
+        split.left
+    } else {
+        let mid = prims.iter().map(|p| usize::from(!goes_right(p))).sum();
+        let done = swap_misplaced(prims, mid, goes_right);
+        debug_assert!(done);
+        mid
+    };
+    let left = measure(&prims[..mid]);
+    let right = measure_in_order(prims[mid..].iter().rev());
+    (left, right, mid)
+}
+
+/// Swaps Hoare's pairs (see `partition`) for a left part of `mid` primitives: true when both
+/// parts had as many misplaced primitives, i.e. `mid` was the number going left.
+#[inline(always)]
+fn swap_misplaced(
+    prims: &mut [PrimRef],
+    mid: usize,
+    goes_right: impl Fn(&PrimRef) -> bool,
+) -> bool {
+    let n = prims.len();
+    if mid > n {
+        return false;
+    }
+    // Positions of misplaced primitives waiting to be swapped: `left[sl..nl]` ascending in
+    // [0, mid), `right[sr..nr]` descending in [mid, n); `i` and `j` bound what is scanned.
+    let (mut left, mut right) = ([0u32; SCAN], [0u32; SCAN]);
+    let (mut sl, mut nl, mut sr, mut nr) = (0, 0, 0, 0);
+    let (mut i, mut j) = (0, n);
+    loop {
+        while sl == nl && i < mid {
+            let end = (i + SCAN).min(mid);
+            (sl, nl) = (0, 0);
+            for (k, p) in prims[i..end].iter().enumerate() {
+                left[nl] = (i + k) as u32;
+                nl += usize::from(goes_right(p));
+            }
+            i = end;
+        }
+        while sr == nr && j > mid {
+            let start = j.saturating_sub(SCAN).max(mid);
+            (sr, nr) = (0, 0);
+            for (k, p) in prims[start..j].iter().rev().enumerate() {
+                right[nr] = (j - 1 - k) as u32;
+                nr += usize::from(!goes_right(p));
+            }
+            j = start;
+        }
+        let pairs = (nl - sl).min(nr - sr);
+        if pairs == 0 {
+            // One side is scanned to its end with nothing waiting: so must the other be.
+            return sl == nl && sr == nr && i == mid && j == mid;
+        }
+        for (&a, &b) in left[sl..sl + pairs].iter().zip(&right[sr..sr + pairs]) {
+            prims.swap(a as usize, b as usize);
+        }
+        sl += pairs;
+        sr += pairs;
+    }
+}
+
+/// Hoare's partition from both ends, measuring on the way: the definition `partition` keeps.
+#[cfg(test)]
+fn partition_reference(
+    prims: &mut [PrimRef],
+    binner: &Binner,
+    split: Split,
+) -> ((Box4, Box4), (Box4, Box4), usize) {
+    let axis = split.axis;
+    let (origin, scale) = (binner.origin[axis], binner.scale[axis]);
     let threshold = (split.bin + 1) as f32;
     let goes_right = |p: &PrimRef| (p.lo[axis] + p.hi[axis] - origin) * scale >= threshold;
     let (mut left, mut left_c) = (Box4::EMPTY, Box4::EMPTY);
@@ -960,6 +1076,19 @@ mod tests {
             outlier[n / 2] = prim(n / 2, [1e30, -1e30, 3e5], [1e30, -1e30, 3e5]);
             sets.push(outlier);
             sets.push((0..n).map(|i| prim(i, [1.0; 3], [2.0; 3])).collect());
+            // Signed zeros everywhere: which one a box keeps depends on the order it grows in.
+            let signed_zeros = (0..n)
+                .map(|i| {
+                    let zero = |r: &mut Rng| if r.next() & 1 == 0 { 0.0 } else { -0.0 };
+                    let lo: [f32; 3] = std::array::from_fn(|_| zero(&mut r));
+                    let hi: [f32; 3] = std::array::from_fn(|k| match r.next() % 3 {
+                        0 => lo[k] + 1.0,
+                        _ => zero(&mut r),
+                    });
+                    prim(i, lo, hi)
+                })
+                .collect();
+            sets.push(signed_zeros);
         }
         sets
     }
@@ -1058,24 +1187,53 @@ mod tests {
     }
 
     /// `partition` of a copy of `set` by (axis, bin), asserting that each primitive lands on
-    /// the side `Binner::bin` gives it; returns the partitioned copy and what `partition` said.
+    /// the side `Binner::bin` gives it and that the arrangement and the boxes (their bits) are
+    /// those of `partition_reference`, also when the left count it is given is off; returns
+    /// the partitioned copy and what `partition` said.
     fn partition_checked(
         set: &[PrimRef],
         binner: &Binner,
         axis: usize,
         bin: usize,
     ) -> (Vec<PrimRef>, (Box4, Box4), (Box4, Box4), usize) {
-        let split = Split {
+        let side = |p: &PrimRef| binner.bin(p.centroid(), axis) <= bin;
+        let left = set.iter().filter(|p| side(p)).count();
+        let split = |left| Split {
             axis,
             bin,
+            left,
             cost: 0.0,
         };
-        let mut prims = set.to_vec();
-        let (left, right, mid) = partition(&mut prims, binner, split);
-        let side = |p: &PrimRef| binner.bin(p.centroid(), axis) <= bin;
-        assert!(prims[..mid].iter().all(side), "axis {axis} bin {bin}");
-        assert!(!prims[mid..].iter().any(side), "axis {axis} bin {bin}");
-        (prims, left, right, mid)
+        let mut expected = set.to_vec();
+        let reference = partition_reference(&mut expected, binner, split(left));
+        let bits = |b: &Box4| (b.lo.map(f32::to_bits), b.hi.map(f32::to_bits));
+        let mut result = None;
+        for given in [
+            left,
+            left + 1,
+            left.saturating_sub(1),
+            0,
+            set.len(),
+            usize::MAX,
+        ] {
+            let mut prims = set.to_vec();
+            let (l, r, mid) = partition(&mut prims, binner, split(given));
+            assert!(prims[..mid].iter().all(side), "axis {axis} bin {bin}");
+            assert!(!prims[mid..].iter().any(side), "axis {axis} bin {bin}");
+            let order = |v: &[PrimRef]| v.iter().map(PrimRef::index).collect::<Vec<_>>();
+            assert_eq!(
+                order(&prims),
+                order(&expected),
+                "axis {axis} bin {bin} given {given}"
+            );
+            assert_eq!(mid, reference.2);
+            for (got, want) in [(l, reference.0), (r, reference.1)] {
+                assert_eq!(bits(&got.0), bits(&want.0), "axis {axis} bin {bin}");
+                assert_eq!(bits(&got.1), bits(&want.1), "axis {axis} bin {bin}");
+            }
+            result.get_or_insert((prims, l, r, mid));
+        }
+        result.expect("one partition")
     }
 
     #[test]

@@ -187,6 +187,40 @@ pub(crate) fn grow_rows(
     }
 }
 
+/// `build::measure`'s loop with SSE2: the boxes of `rows` (each primitive's lo and hi rows)
+/// and of their doubled centroids (`lo + hi`, lane 3 zero), grown in the order given, as
+/// [bounds lo, bounds hi, centroids lo, centroids hi]. The same values as the portable loop,
+/// `min_ps(box, row)` being `if box < row { box } else { row }` (`Box4::grow_box`); the
+/// compiler's code for that loop took the centroid's lanes apart with shuffles. Lane 3 is
+/// cleared before the addition (it holds an index's bits, a subnormal float).
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub(crate) fn measure_rows<'a>(
+    rows: impl Iterator<Item = (&'a [f32; 4], &'a [f32; 4])>,
+) -> [[f32; 4]; 4] {
+    use std::arch::x86_64::*;
+    // SAFETY: SSE2 is part of x86-64; every load is of a `[f32; 4]` borrowed here, every
+    // store into the local array.
+    unsafe {
+        let xyz = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+        let (mut lo, mut hi) = (_mm_set1_ps(f32::INFINITY), _mm_set1_ps(f32::NEG_INFINITY));
+        let (mut c_lo, mut c_hi) = (lo, hi);
+        for (l, h) in rows {
+            let (l, h) = (_mm_loadu_ps(l.as_ptr()), _mm_loadu_ps(h.as_ptr()));
+            lo = _mm_min_ps(lo, l);
+            hi = _mm_max_ps(hi, h);
+            let c = _mm_add_ps(_mm_and_ps(l, xyz), _mm_and_ps(h, xyz));
+            c_lo = _mm_min_ps(c_lo, c);
+            c_hi = _mm_max_ps(c_hi, c);
+        }
+        let mut out = [[0.0f32; 4]; 4];
+        for (row, v) in out.iter_mut().zip([lo, hi, c_lo, c_hi]) {
+            _mm_storeu_ps(row.as_mut_ptr(), v);
+        }
+        out
+    }
+}
+
 /// The slab test of the binary BVH (`bvh::RayInverse::hits`) for eight rays against one node,
 /// the same operations lane by lane: the mask of rays that hit it within [t_min, t_max]. For
 /// the top level's packet traversal (`Bvh::traverse_packet`).
