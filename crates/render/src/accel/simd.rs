@@ -339,6 +339,9 @@ mod x86 {
         no_nan: bool,
         /// `inv_dir · FOLDED_FAR_SCALE`, for the far slabs of the short path.
         inv_far: [__m256; 3],
+        /// The direction and its reciprocals in lanes 0-2 (lane 3: 1), for `prepare_tri`.
+        d: __m128,
+        inv: __m128,
     }
 
     /// The short path's far slabs are (plane − origin) · (1/d · FOLDED_FAR_SCALE), one product
@@ -359,9 +362,15 @@ mod x86 {
         type TriRay = TriRay;
 
         #[inline(always)]
-        fn prepare(&self, ray: &Ray) -> Option<(BoxRay, TriRay)> {
+        fn prepare_box(&self, ray: &Ray) -> Option<BoxRay> {
             // SAFETY: only called inside `closest`/`any` above, on a CPU with AVX2.
-            unsafe { prepare(ray) }
+            unsafe { prepare_box(ray) }
+        }
+
+        #[inline(always)]
+        fn prepare_tri(&self, ray: &Ray, box_ray: &BoxRay) -> TriRay {
+            // SAFETY: as above.
+            unsafe { prepare_tri(ray, box_ray) }
         }
 
         #[inline(always)]
@@ -484,11 +493,11 @@ mod x86 {
         }
     }
 
-    /// `ray_is_valid`, `BoxPlanes::new` and `WoopRay::new` in one pass of 4-lane operations,
-    /// every constant the value the scalar code gives. Through the scalar constructors the
-    /// compiler kept their per-axis arrays on the stack and read them back by index, waiting
-    /// on its own stores (`d[kx]`, `d[ky]` held 18 % of a missing ray's samples); rays that
-    /// miss the bunny went from 40 to 44 Mrays/s with this alone (bench/README, fifth pass).
+    /// `ray_is_valid` and `BoxPlanes::new` in one pass of 4-lane operations, every constant
+    /// the value the scalar code gives. Through the scalar constructors the compiler kept their
+    /// per-axis arrays on the stack and read them back by index, waiting on its own stores
+    /// (`d[kx]`, `d[ky]` held 18 % of a missing ray's samples); rays that miss the bunny went
+    /// from 40 to 44 Mrays/s with this alone (bench/README, fifth pass).
     ///
     /// The ray's eight floats are read one by one: callers have most often just written the
     /// ray (a local copy, in object space), and a load wider than one of those stores, spanning
@@ -498,7 +507,7 @@ mod x86 {
     /// # Safety
     /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
     #[inline(always)]
-    unsafe fn prepare(ray: &Ray) -> Option<(BoxRay, TriRay)> {
+    unsafe fn prepare_box(ray: &Ray) -> Option<BoxRay> {
         // SAFETY: the caller runs with AVX2; each volatile read is of an f32 field of `ray`.
         unsafe {
             let f = |x: &f32| std::ptr::read_volatile(x);
@@ -531,7 +540,7 @@ mod x86 {
                     _mm256_broadcastss_ps(_mm_permute_ps::<{ $lane * 0b01_01_01_01 }>($v))
                 };
             }
-            let box_ray = BoxRay {
+            Some(BoxRay {
                 origin: [wide!(o, 0), wide!(o, 1), wide!(o, 2)],
                 inv_dir: [wide!(inv, 0), wide!(inv, 1), wide!(inv, 2)],
                 rows: &SLAB_ROWS[sign],
@@ -540,22 +549,36 @@ mod x86 {
                 t_min: _mm256_set1_ps(t_min + 0.0),
                 no_nan: _mm_movemask_ps(finite(inv)) == 0b1111 && t_min >= 0.0,
                 inv_far: [wide!(inv_far, 0), wide!(inv_far, 1), wide!(inv_far, 2)],
-            };
-            // `WoopRay::new`: the axes from the same comparisons, then the lanes picked by
-            // index in registers: sz = 1/d[kz] (the division above), sx = d[kx]·sz,
-            // sy = d[ky]·sz.
+                d,
+                inv,
+            })
+        }
+    }
+
+    /// `WoopRay::new` for a ray `prepare_box` passed, with its direction and reciprocals: the
+    /// axes from the same comparisons, then the lanes picked by index in registers:
+    /// sz = 1/d[kz] (`prepare_box`'s division), sx = d[kx]·sz, sy = d[ky]·sz.
+    ///
+    /// # Safety
+    /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
+    #[inline(always)]
+    unsafe fn prepare_tri(ray: &Ray, box_ray: &BoxRay) -> TriRay {
+        // SAFETY: the caller runs with AVX2.
+        unsafe {
+            let (d, inv) = (box_ray.d, box_ray.inv);
+            let o = _mm_setr_ps(ray.origin.x, ray.origin.y, ray.origin.z, 0.0);
             let below_zero = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) as u32;
-            let [kx, ky, kz] = WoopRay::axes([dx.abs(), dy.abs(), dz.abs()], below_zero);
+            let a = ray.direction.to_array().map(f32::abs);
+            let [kx, ky, kz] = WoopRay::axes(a, below_zero);
             let pick = |v: __m128, k: usize| _mm_permutevar_ps(v, _mm_set1_epi32(k as i32));
             let sz = pick(inv, kz);
             let sx = _mm_mul_ps(pick(d, kx), sz);
             let sy = _mm_mul_ps(pick(d, ky), sz);
-            let tri_ray = TriRay {
+            TriRay {
                 origin: [pick(o, kx), pick(o, ky), pick(o, kz)],
                 shear: [sx, sy, sz],
                 rows: [kx, ky, kz].map(|k| k * 4 * BLOCK),
-            };
-            Some((box_ray, tri_ray))
+            }
         }
     }
 
@@ -1352,7 +1375,8 @@ mod x86 {
     #[cfg(test)]
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn prepared(ray: &Ray) -> Option<Prepared> {
-        let (b, t) = prepare(ray)?;
+        let b = prepare_box(ray)?;
+        let t = prepare_tri(ray, &b);
         let first = |v: __m256| _mm256_cvtss_f32(v);
         let lanes = |v: __m128| {
             let mut out = [0.0f32; 4];
@@ -1395,7 +1419,8 @@ mod x86 {
         )
     }
 
-    /// The per-ray constants `prepare` makes, against the scalar constructors, bit for bit.
+    /// The per-ray constants `prepare_box` and `prepare_tri` make, against the scalar
+    /// constructors, bit for bit.
     #[cfg(test)]
     mod tests {
         use crate::accel::isa::Avx2;

@@ -307,8 +307,11 @@ pub(crate) trait Kernel {
     type BoxRay;
     /// Per-ray constants of the triangle test (`WoopRay`'s, in the kernel's form).
     type TriRay;
-    /// Both sets of constants, or `None` for a ray that meets nothing (`ray_is_valid`).
-    fn prepare(&self, ray: &Ray) -> Option<(Self::BoxRay, Self::TriRay)>;
+    /// The box test's constants, or `None` for a ray that meets nothing (`ray_is_valid`).
+    fn prepare_box(&self, ray: &Ray) -> Option<Self::BoxRay>;
+    /// The triangle test's constants of a valid ray (`box_ray` its box test's): made when the
+    /// walk reaches its first leaf, so that rays missing every leaf never pay for them.
+    fn prepare_tri(&self, ray: &Ray, box_ray: &Self::BoxRay) -> Self::TriRay;
     /// Tests the ray against a node's eight boxes within [t_min, t_max]: the bit mask of the
     /// children entered, and each child's entry distance in `entry`.
     fn node(
@@ -441,8 +444,13 @@ impl Kernel for ScalarKernel {
     type TriRay = WoopRay;
 
     #[inline(always)]
-    fn prepare(&self, ray: &Ray) -> Option<(BoxPlanes, WoopRay)> {
-        ray_is_valid(ray).then(|| (BoxPlanes::new(ray), WoopRay::new(ray.origin, ray.direction)))
+    fn prepare_box(&self, ray: &Ray) -> Option<BoxPlanes> {
+        ray_is_valid(ray).then(|| BoxPlanes::new(ray))
+    }
+
+    #[inline(always)]
+    fn prepare_tri(&self, ray: &Ray, _: &BoxPlanes) -> WoopRay {
+        WoopRay::new(ray.origin, ray.direction)
     }
 
     #[inline(always)]
@@ -501,9 +509,95 @@ impl Kernel for ScalarKernel {
     }
 }
 
+/// Walks down from `current` through inner nodes, nearest child first, the others onto the
+/// stack (sorted by entry distance, nearest on top), until `current` is a leaf: true then;
+/// false where the ray enters none of a node's children. `sp` is the stack's height.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn descend<K: Kernel, S: Stack>(
+    kernel: &K,
+    bvh: &WideBvh,
+    box_ray: &K::BoxRay,
+    t_max: f32,
+    current: &mut ChildRef,
+    sp: &mut usize,
+    stack: &mut S,
+    entry: &mut [f32; WIDTH],
+) -> bool {
+    while !current.is_leaf() {
+        let node = &bvh.nodes[current.0 as usize];
+        let mask = kernel.node(node, box_ray, t_max, entry);
+        if mask == 0 {
+            return false;
+        }
+        let i0 = mask.trailing_zeros() as usize;
+        let rest = mask & (mask - 1);
+        if rest == 0 {
+            *current = ChildRef(node.children[i0]);
+            continue;
+        }
+        let i1 = rest.trailing_zeros() as usize;
+        let rest = rest & (rest - 1);
+        if rest == 0 {
+            let (near, far) = if entry[i0] <= entry[i1] {
+                (i0, i1)
+            } else {
+                (i1, i0)
+            };
+            stack.set(*sp, node.children[far], entry[far]);
+            *sp += 1;
+            kernel.prefetch(bvh, ChildRef(node.children[far]));
+            *current = ChildRef(node.children[near]);
+            continue;
+        }
+        // Three or more: onto the stack sorted by entry distance, nearest on top (among
+        // equals the later slot), then the top taken.
+        let base = *sp;
+        let mut m = mask;
+        while m != 0 {
+            let i = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let d = entry[i];
+            let mut k = *sp;
+            while k > base {
+                let below = stack.get(k - 1);
+                if below.1 >= d {
+                    break;
+                }
+                stack.set(k, below.0, below.1);
+                k -= 1;
+            }
+            stack.set(k, node.children[i], d);
+            *sp += 1;
+            kernel.prefetch(bvh, ChildRef(node.children[i]));
+        }
+        *sp -= 1;
+        *current = ChildRef(stack.get(*sp).0);
+    }
+    true
+}
+
+/// The next waiting entry that can still hold something within `t_max` (entries beyond it
+/// are dropped), or `None` when the stack runs out.
+#[inline(always)]
+fn pop<S: Stack>(stack: &S, sp: &mut usize, t_max: f32) -> Option<ChildRef> {
+    while *sp > 0 {
+        *sp -= 1;
+        let (child, t_entry) = stack.get(*sp);
+        if t_entry <= t_max {
+            return Some(ChildRef(child));
+        }
+    }
+    None
+}
+
 /// Closest hit, with its barycentrics; `None` also for a ray that is not valid
 /// (`ray_is_valid`). Generic over the kernel and the stack so that the SIMD module instantiates
 /// it inside its `avx2` functions.
+///
+/// In two phases: down to the first leaf with the box test's constants alone, then, with the
+/// triangle test's made (`Kernel::prepare_tri`), the rest of the walk. A ray that reaches no
+/// leaf (most that miss the mesh) never makes them.
 #[inline(always)]
 pub(crate) fn closest<K: Kernel, S: Stack>(
     kernel: &K,
@@ -511,7 +605,28 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
     ray: &Ray,
     stack: &mut S,
 ) -> Option<LocalHit> {
-    let (box_ray, woop) = kernel.prepare(ray)?;
+    let box_ray = kernel.prepare_box(ray)?;
+    let mut entry = [0.0f32; WIDTH];
+    let mut current = bvh.root;
+    // Entries below `sp` are waiting; the nearest of a node's children is visited first.
+    let mut sp = 0usize;
+    loop {
+        let leaf = descend(
+            kernel,
+            bvh,
+            &box_ray,
+            ray.t_max,
+            &mut current,
+            &mut sp,
+            stack,
+            &mut entry,
+        );
+        if leaf && current != ChildRef::EMPTY {
+            break;
+        }
+        current = pop(stack, &mut sp, ray.t_max)?;
+    }
+    let woop = kernel.prepare_tri(ray, &box_ray);
     let lanes = (bvh.blocks.len() * BLOCK) as u32;
     let mut best = LocalHit {
         t: ray.t_max,
@@ -519,97 +634,84 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
         b1: 0.0,
         b2: 0.0,
     };
-    let mut entry = [0.0f32; WIDTH];
-    let mut current = bvh.root;
-    // Entries below `sp` are waiting; the nearest of a node's children is visited first.
-    let mut sp = 0usize;
-    'walk: loop {
-        while !current.is_leaf() {
-            let node = &bvh.nodes[current.0 as usize];
-            let mask = kernel.node(node, &box_ray, best.t, &mut entry);
-            if mask == 0 {
+    loop {
+        // `current` is a leaf, not empty.
+        let (first, count) = current.range();
+        if !current.is_shapes() {
+            for b in first..first + count {
+                if let Some(h) = kernel.block(&bvh.blocks[b], &woop, ray.t_min, best.t) {
+                    let primitive = (b * BLOCK + h.lane) as u32;
+                    bvh.keep_nearer(&mut best, h.t, primitive, (h.b1, h.b2));
+                }
+            }
+        } else {
+            for s in first..first + count {
+                let window = Ray {
+                    t_max: best.t,
+                    ..*ray
+                };
+                if let Some(h) = bvh.shapes[s].intersect(&window) {
+                    bvh.keep_nearer(&mut best, h.t, lanes + s as u32, (h.b1, h.b2));
+                }
+            }
+        }
+        loop {
+            let Some(next) = pop(stack, &mut sp, best.t) else {
+                return (best.primitive != u32::MAX).then_some(best);
+            };
+            current = next;
+            let leaf = descend(
+                kernel,
+                bvh,
+                &box_ray,
+                best.t,
+                &mut current,
+                &mut sp,
+                stack,
+                &mut entry,
+            );
+            if leaf && current != ChildRef::EMPTY {
                 break;
             }
-            let i0 = mask.trailing_zeros() as usize;
-            let rest = mask & (mask - 1);
-            if rest == 0 {
-                current = ChildRef(node.children[i0]);
-                continue;
-            }
-            let i1 = rest.trailing_zeros() as usize;
-            let rest = rest & (rest - 1);
-            if rest == 0 {
-                let (near, far) = if entry[i0] <= entry[i1] {
-                    (i0, i1)
-                } else {
-                    (i1, i0)
-                };
-                stack.set(sp, node.children[far], entry[far]);
-                sp += 1;
-                kernel.prefetch(bvh, ChildRef(node.children[far]));
-                current = ChildRef(node.children[near]);
-                continue;
-            }
-            // Three or more: onto the stack sorted by entry distance, nearest on top (among
-            // equals the later slot), then the top taken.
-            let base = sp;
-            let mut m = mask;
-            while m != 0 {
-                let i = m.trailing_zeros() as usize;
-                m &= m - 1;
-                let d = entry[i];
-                let mut k = sp;
-                while k > base {
-                    let below = stack.get(k - 1);
-                    if below.1 >= d {
-                        break;
-                    }
-                    stack.set(k, below.0, below.1);
-                    k -= 1;
-                }
-                stack.set(k, node.children[i], d);
-                sp += 1;
-                kernel.prefetch(bvh, ChildRef(node.children[i]));
-            }
-            sp -= 1;
-            current = ChildRef(stack.get(sp).0);
         }
-        if current.is_leaf() && current != ChildRef::EMPTY {
-            let (first, count) = current.range();
-            if !current.is_shapes() {
-                for b in first..first + count {
-                    if let Some(h) = kernel.block(&bvh.blocks[b], &woop, ray.t_min, best.t) {
-                        let primitive = (b * BLOCK + h.lane) as u32;
-                        bvh.keep_nearer(&mut best, h.t, primitive, (h.b1, h.b2));
-                    }
-                }
-            } else {
-                for s in first..first + count {
-                    let window = Ray {
-                        t_max: best.t,
-                        ..*ray
-                    };
-                    if let Some(h) = bvh.shapes[s].intersect(&window) {
-                        bvh.keep_nearer(&mut best, h.t, lanes + s as u32, (h.b1, h.b2));
-                    }
-                }
-            }
-        }
-        // Next entry that can still hold something nearer than the closest hit.
-        while sp > 0 {
-            sp -= 1;
-            let (child, t_entry) = stack.get(sp);
-            if t_entry <= best.t {
-                current = ChildRef(child);
-                continue 'walk;
-            }
-        }
-        return (best.primitive != u32::MAX).then_some(best);
     }
 }
 
+/// Walks down from `current` through inner nodes in any order (the other children onto the
+/// stack) until `current` is a leaf: true then; false where the ray enters no child.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn descend_any<K: Kernel, S: Stack>(
+    kernel: &K,
+    bvh: &WideBvh,
+    box_ray: &K::BoxRay,
+    t_max: f32,
+    current: &mut ChildRef,
+    sp: &mut usize,
+    stack: &mut S,
+    entry: &mut [f32; WIDTH],
+) -> bool {
+    while !current.is_leaf() {
+        let node = &bvh.nodes[current.0 as usize];
+        let mut mask = kernel.node(node, box_ray, t_max, entry);
+        if mask == 0 {
+            return false;
+        }
+        let first = mask.trailing_zeros() as usize;
+        mask &= mask - 1;
+        while mask != 0 {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            stack.set(*sp, node.children[i], 0.0);
+            *sp += 1;
+        }
+        *current = ChildRef(node.children[first]);
+    }
+    true
+}
+
 /// Any hit within the ray's window (shadow rays): no ordering, the first hit ends the walk;
-/// `false` for a ray that is not valid.
+/// `false` for a ray that is not valid. In two phases as `closest`.
 #[inline(always)]
 pub(crate) fn any<K: Kernel, S: Stack>(
     kernel: &K,
@@ -617,49 +719,68 @@ pub(crate) fn any<K: Kernel, S: Stack>(
     ray: &Ray,
     stack: &mut S,
 ) -> bool {
-    let Some((box_ray, woop)) = kernel.prepare(ray) else {
+    let Some(box_ray) = kernel.prepare_box(ray) else {
         return false;
     };
     let mut entry = [0.0f32; WIDTH];
     let mut current = bvh.root;
     let mut sp = 0usize;
+    let t_max = ray.t_max;
+    // Every entry is pushed with distance 0, so `pop` drops none of them.
     loop {
-        if !current.is_leaf() {
-            let node = &bvh.nodes[current.0 as usize];
-            let mut mask = kernel.node(node, &box_ray, ray.t_max, &mut entry);
-            if mask != 0 {
-                let first = mask.trailing_zeros() as usize;
-                mask &= mask - 1;
-                while mask != 0 {
-                    let i = mask.trailing_zeros() as usize;
-                    mask &= mask - 1;
-                    stack.set(sp, node.children[i], 0.0);
-                    sp += 1;
-                }
-                current = ChildRef(node.children[first]);
-                continue;
-            }
-        } else if current != ChildRef::EMPTY {
-            let (first, count) = current.range();
-            if !current.is_shapes() {
-                for b in first..first + count {
-                    if kernel.block_any(&bvh.blocks[b], &woop, ray.t_min, ray.t_max) {
-                        return true;
-                    }
-                }
-            } else {
-                for s in first..first + count {
-                    if bvh.shapes[s].intersect(ray).is_some() {
-                        return true;
-                    }
-                }
-            }
+        let leaf = descend_any(
+            kernel,
+            bvh,
+            &box_ray,
+            t_max,
+            &mut current,
+            &mut sp,
+            stack,
+            &mut entry,
+        );
+        if leaf && current != ChildRef::EMPTY {
+            break;
         }
-        if sp == 0 {
+        let Some(next) = pop(stack, &mut sp, f32::INFINITY) else {
             return false;
+        };
+        current = next;
+    }
+    let woop = kernel.prepare_tri(ray, &box_ray);
+    loop {
+        let (first, count) = current.range();
+        if !current.is_shapes() {
+            for b in first..first + count {
+                if kernel.block_any(&bvh.blocks[b], &woop, ray.t_min, t_max) {
+                    return true;
+                }
+            }
+        } else {
+            for s in first..first + count {
+                if bvh.shapes[s].intersect(ray).is_some() {
+                    return true;
+                }
+            }
         }
-        sp -= 1;
-        current = ChildRef(stack.get(sp).0);
+        loop {
+            let Some(next) = pop(stack, &mut sp, f32::INFINITY) else {
+                return false;
+            };
+            current = next;
+            let leaf = descend_any(
+                kernel,
+                bvh,
+                &box_ray,
+                t_max,
+                &mut current,
+                &mut sp,
+                stack,
+                &mut entry,
+            );
+            if leaf && current != ChildRef::EMPTY {
+                break;
+            }
+        }
     }
 }
 
@@ -747,8 +868,12 @@ impl Kernel for CountingKernel {
     type BoxRay = BoxPlanes;
     type TriRay = WoopRay;
 
-    fn prepare(&self, ray: &Ray) -> Option<(BoxPlanes, WoopRay)> {
-        ScalarKernel.prepare(ray)
+    fn prepare_box(&self, ray: &Ray) -> Option<BoxPlanes> {
+        ScalarKernel.prepare_box(ray)
+    }
+
+    fn prepare_tri(&self, ray: &Ray, box_ray: &BoxPlanes) -> WoopRay {
+        ScalarKernel.prepare_tri(ray, box_ray)
     }
 
     fn node(&self, node: &WideNode, r: &BoxPlanes, t_max: f32, entry: &mut [f32; WIDTH]) -> u32 {
