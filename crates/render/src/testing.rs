@@ -128,6 +128,13 @@ pub fn wide_variants(shapes: &[Shape]) -> Vec<WideBvh> {
     scalar.set_isa(Isa::Scalar);
     variants.push(scalar);
     if let Isa::Avx2(avx2) = Isa::detect() {
+        #[cfg(target_arch = "x86_64")]
+        if avx2.evex() {
+            // The walks compiled with AVX-512 as well, and the plain AVX2 ones.
+            let mut plain = built.clone();
+            plain.set_isa(Isa::Avx2(avx2.without_evex()));
+            variants.push(plain);
+        }
         let mut simd = built;
         simd.set_isa(Isa::Avx2(avx2));
         variants.push(simd);

@@ -49,9 +49,15 @@ pub(crate) fn prefetch<T>(value: &T) {
 pub(crate) fn closest(avx2: Avx2, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
     #[cfg(target_arch = "x86_64")]
     {
-        let _ = avx2;
-        // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
-        unsafe { x86::closest(bvh, ray) }
+        // SAFETY: `avx2` proves the CPU has AVX2 and FMA, and where `evex()` says so,
+        // AVX-512F and AVX-512VL.
+        unsafe {
+            if avx2.evex() {
+                x86::closest_evex(bvh, ray)
+            } else {
+                x86::closest(bvh, ray)
+            }
+        }
     }
     #[cfg(not(target_arch = "x86_64"))]
     match avx2 {}
@@ -62,9 +68,14 @@ pub(crate) fn closest(avx2: Avx2, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> 
 pub(crate) fn any(avx2: Avx2, bvh: &WideBvh, ray: &Ray) -> bool {
     #[cfg(target_arch = "x86_64")]
     {
-        let _ = avx2;
-        // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
-        unsafe { x86::any(bvh, ray) }
+        // SAFETY: as in `closest`.
+        unsafe {
+            if avx2.evex() {
+                x86::any_evex(bvh, ray)
+            } else {
+                x86::any(bvh, ray)
+            }
+        }
     }
     #[cfg(not(target_arch = "x86_64"))]
     match avx2 {}
@@ -268,6 +279,25 @@ mod x86 {
     /// The CPU must have AVX2 and FMA.
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn any(bvh: &WideBvh, ray: &Ray) -> bool {
+        wide::any(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
+    }
+
+    // The same two walks compiled with AVX-512F and AVX-512VL as well: the same intrinsics,
+    // but EVEX-encoded with 32 vector registers, so that the per-ray constants of the box and
+    // triangle tests stay in registers (bench/README, issue 14, sixth pass). Only the names
+    // ending in `_evex` may carry these features (`only_evex_kernels_need_avx512`).
+
+    /// # Safety
+    /// The CPU must have AVX2, FMA, AVX-512F and AVX-512VL.
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    pub(super) unsafe fn closest_evex(bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
+        wide::closest(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
+    }
+
+    /// # Safety
+    /// The CPU must have AVX2, FMA, AVX-512F and AVX-512VL.
+    #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
+    pub(super) unsafe fn any_evex(bvh: &WideBvh, ray: &Ray) -> bool {
         wide::any(&Avx2Kernel, bvh, ray, &mut UninitStack::new())
     }
 
@@ -1538,6 +1568,36 @@ mod x86 {
                 valid > 40_000 && short > 40_000 && short < valid,
                 "{valid} {short}"
             );
+        }
+
+        /// The `Avx2` proof covers AVX2 and FMA; AVX-512 only where `Avx2::evex` says so, and
+        /// the entry points call only the functions named `..._evex` under that check. So
+        /// every function enabling more than "avx2,fma" must be one of those (a stray feature
+        /// would run AVX-512 instructions on CPUs without them: SIGILL).
+        #[test]
+        fn only_evex_kernels_need_avx512() {
+            let source = include_str!("simd.rs");
+            let lines: Vec<&str> = source.lines().collect();
+            let mut evex = 0;
+            for (i, line) in lines.iter().enumerate() {
+                let Some(rest) = line.trim().strip_prefix("#[target_feature(enable = \"") else {
+                    continue;
+                };
+                let features = rest.split('"').next().unwrap_or_default();
+                let function = lines[i + 1..]
+                    .iter()
+                    .find(|l| l.contains("fn "))
+                    .expect("a function after the attribute");
+                match features {
+                    "avx2,fma" => assert!(!function.contains("_evex("), "{function}"),
+                    "avx2,fma,avx512f,avx512vl" => {
+                        assert!(function.contains("_evex("), "{function}");
+                        evex += 1;
+                    }
+                    other => panic!("unexpected features {other} on {function}"),
+                }
+            }
+            assert_eq!(evex, 2, "closest_evex and any_evex");
         }
     }
 }
