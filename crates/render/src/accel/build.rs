@@ -525,24 +525,29 @@ fn partition(
     binner: &Binner,
     split: Split,
 ) -> ((Box4, Box4), (Box4, Box4), usize) {
-    let axis = split.axis;
-    let (origin, scale) = (binner.origin[axis], binner.scale[axis]);
-    // `binner.bin(c, axis) > split.bin` without the conversion: for the scaled offset x,
-    // `trunc(x.max(0).min(count - 1)) > bin` exactly when `x >= bin + 1` (NaN: false), as
-    // `bin + 1 <= count - 1`.
-    let threshold = (split.bin + 1) as f32;
-    let goes_right = |p: &PrimRef| (p.lo[axis] + p.hi[axis] - origin) * scale >= threshold;
-    let mid = if swap_misplaced(prims, split.left, goes_right) {
+    let goes_right = goes_right(binner, split);
+    let mid = if swap_misplaced(prims, split.left, &goes_right) {
         split.left
     } else {
         let mid = prims.iter().map(|p| usize::from(!goes_right(p))).sum();
-        let done = swap_misplaced(prims, mid, goes_right);
+        let done = swap_misplaced(prims, mid, &goes_right);
         debug_assert!(done);
         mid
     };
     let left = measure(&prims[..mid]);
     let right = measure_in_order(prims[mid..].iter().rev());
     (left, right, mid)
+}
+
+/// Whether a primitive goes to the right side of `split`: `binner.bin(c, axis) > split.bin`
+/// without the conversion. For the scaled offset x, `trunc(x.max(0).min(count - 1)) > bin`
+/// exactly when `x >= bin + 1` (NaN: false), as `bin + 1 <= count - 1`.
+#[inline(always)]
+fn goes_right(binner: &Binner, split: Split) -> impl Fn(&PrimRef) -> bool {
+    let axis = split.axis;
+    let (origin, scale) = (binner.origin[axis], binner.scale[axis]);
+    let threshold = (split.bin + 1) as f32;
+    move |p: &PrimRef| (p.lo[axis] + p.hi[axis] - origin) * scale >= threshold
 }
 
 /// Swaps Hoare's pairs (see `partition`) for a left part of `mid` primitives: true when both
@@ -601,10 +606,7 @@ fn partition_reference(
     binner: &Binner,
     split: Split,
 ) -> ((Box4, Box4), (Box4, Box4), usize) {
-    let axis = split.axis;
-    let (origin, scale) = (binner.origin[axis], binner.scale[axis]);
-    let threshold = (split.bin + 1) as f32;
-    let goes_right = |p: &PrimRef| (p.lo[axis] + p.hi[axis] - origin) * scale >= threshold;
+    let goes_right = goes_right(binner, split);
     let (mut left, mut left_c) = (Box4::EMPTY, Box4::EMPTY);
     let (mut right, mut right_c) = (Box4::EMPTY, Box4::EMPTY);
     let mut i = 0;

@@ -509,12 +509,14 @@ impl Kernel for ScalarKernel {
     }
 }
 
-/// Walks down from `current` through inner nodes, nearest child first, the others onto the
-/// stack (sorted by entry distance, nearest on top), until `current` is a leaf: true then;
-/// false where the ray enters none of a node's children. `sp` is the stack's height.
+/// Walks down from `current` through inner nodes until `current` is a leaf: true then; false
+/// where the ray enters none of a node's children within `t_max`. `ORDERED`: the nearest
+/// child first, the others onto the stack sorted by entry distance, nearest on top;
+/// otherwise the first child in slot order, the others pushed as they come. `sp` is the
+/// stack's height.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn descend<K: Kernel, S: Stack>(
+fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
     kernel: &K,
     bvh: &WideBvh,
     box_ray: &K::BoxRay,
@@ -526,11 +528,22 @@ fn descend<K: Kernel, S: Stack>(
 ) -> bool {
     while !current.is_leaf() {
         let node = &bvh.nodes[current.0 as usize];
-        let mask = kernel.node(node, box_ray, t_max, entry);
+        let mut mask = kernel.node(node, box_ray, t_max, entry);
         if mask == 0 {
             return false;
         }
         let i0 = mask.trailing_zeros() as usize;
+        if !ORDERED {
+            mask &= mask - 1;
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                stack.set(*sp, node.children[i], 0.0);
+                *sp += 1;
+            }
+            *current = ChildRef(node.children[i0]);
+            continue;
+        }
         let rest = mask & (mask - 1);
         if rest == 0 {
             *current = ChildRef(node.children[i0]);
@@ -553,10 +566,9 @@ fn descend<K: Kernel, S: Stack>(
         // Three or more: onto the stack sorted by entry distance, nearest on top (among
         // equals the later slot), then the top taken.
         let base = *sp;
-        let mut m = mask;
-        while m != 0 {
-            let i = m.trailing_zeros() as usize;
-            m &= m - 1;
+        while mask != 0 {
+            let i = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
             let d = entry[i];
             let mut k = *sp;
             while k > base {
@@ -577,18 +589,52 @@ fn descend<K: Kernel, S: Stack>(
     true
 }
 
-/// The next waiting entry that can still hold something within `t_max` (entries beyond it
-/// are dropped), or `None` when the stack runs out.
+/// The next waiting entry whose entry distance is within `limit` (those beyond are dropped),
+/// or `None` when the stack runs out.
 #[inline(always)]
-fn pop<S: Stack>(stack: &S, sp: &mut usize, t_max: f32) -> Option<ChildRef> {
+fn pop<S: Stack>(stack: &S, sp: &mut usize, limit: f32) -> Option<ChildRef> {
     while *sp > 0 {
         *sp -= 1;
         let (child, t_entry) = stack.get(*sp);
-        if t_entry <= t_max {
+        if t_entry <= limit {
             return Some(ChildRef(child));
         }
     }
     None
+}
+
+/// On to the walk's next leaf that is not empty: down from `current` (`descend`), and where
+/// that reaches none, from the next entry within `limit` (`pop`), and so on; with `after_leaf`,
+/// from the next entry first. False when the stack runs out.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn next_leaf<K: Kernel, S: Stack, const ORDERED: bool>(
+    kernel: &K,
+    bvh: &WideBvh,
+    box_ray: &K::BoxRay,
+    (t_max, limit): (f32, f32),
+    after_leaf: bool,
+    current: &mut ChildRef,
+    sp: &mut usize,
+    stack: &mut S,
+    entry: &mut [f32; WIDTH],
+) -> bool {
+    if after_leaf {
+        let Some(next) = pop(stack, sp, limit) else {
+            return false;
+        };
+        *current = next;
+    }
+    loop {
+        let leaf = descend::<K, S, ORDERED>(kernel, bvh, box_ray, t_max, current, sp, stack, entry);
+        if leaf && *current != ChildRef::EMPTY {
+            return true;
+        }
+        let Some(next) = pop(stack, sp, limit) else {
+            return false;
+        };
+        *current = next;
+    }
 }
 
 /// Closest hit, with its barycentrics; `None` also for a ray that is not valid
@@ -608,23 +654,20 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
     let box_ray = kernel.prepare_box(ray)?;
     let mut entry = [0.0f32; WIDTH];
     let mut current = bvh.root;
-    // Entries below `sp` are waiting; the nearest of a node's children is visited first.
+    // Entries below `sp` are waiting; those beyond the closest hit so far are dropped.
     let mut sp = 0usize;
-    loop {
-        let leaf = descend(
-            kernel,
-            bvh,
-            &box_ray,
-            ray.t_max,
-            &mut current,
-            &mut sp,
-            stack,
-            &mut entry,
-        );
-        if leaf && current != ChildRef::EMPTY {
-            break;
-        }
-        current = pop(stack, &mut sp, ray.t_max)?;
+    if !next_leaf::<K, S, true>(
+        kernel,
+        bvh,
+        &box_ray,
+        (ray.t_max, ray.t_max),
+        false,
+        &mut current,
+        &mut sp,
+        stack,
+        &mut entry,
+    ) {
+        return None;
     }
     let woop = kernel.prepare_tri(ray, &box_ray);
     let lanes = (bvh.blocks.len() * BLOCK) as u32;
@@ -655,59 +698,21 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
                 }
             }
         }
-        loop {
-            let Some(next) = pop(stack, &mut sp, best.t) else {
-                return (best.primitive != u32::MAX).then_some(best);
-            };
-            current = next;
-            let leaf = descend(
-                kernel,
-                bvh,
-                &box_ray,
-                best.t,
-                &mut current,
-                &mut sp,
-                stack,
-                &mut entry,
-            );
-            if leaf && current != ChildRef::EMPTY {
-                break;
-            }
+        let more = next_leaf::<K, S, true>(
+            kernel,
+            bvh,
+            &box_ray,
+            (best.t, best.t),
+            true,
+            &mut current,
+            &mut sp,
+            stack,
+            &mut entry,
+        );
+        if !more {
+            return (best.primitive != u32::MAX).then_some(best);
         }
     }
-}
-
-/// Walks down from `current` through inner nodes in any order (the other children onto the
-/// stack) until `current` is a leaf: true then; false where the ray enters no child.
-#[inline(always)]
-#[allow(clippy::too_many_arguments)]
-fn descend_any<K: Kernel, S: Stack>(
-    kernel: &K,
-    bvh: &WideBvh,
-    box_ray: &K::BoxRay,
-    t_max: f32,
-    current: &mut ChildRef,
-    sp: &mut usize,
-    stack: &mut S,
-    entry: &mut [f32; WIDTH],
-) -> bool {
-    while !current.is_leaf() {
-        let node = &bvh.nodes[current.0 as usize];
-        let mut mask = kernel.node(node, box_ray, t_max, entry);
-        if mask == 0 {
-            return false;
-        }
-        let first = mask.trailing_zeros() as usize;
-        mask &= mask - 1;
-        while mask != 0 {
-            let i = mask.trailing_zeros() as usize;
-            mask &= mask - 1;
-            stack.set(*sp, node.children[i], 0.0);
-            *sp += 1;
-        }
-        *current = ChildRef(node.children[first]);
-    }
-    true
 }
 
 /// Any hit within the ray's window (shadow rays): no ordering, the first hit ends the walk;
@@ -726,25 +731,20 @@ pub(crate) fn any<K: Kernel, S: Stack>(
     let mut current = bvh.root;
     let mut sp = 0usize;
     let t_max = ray.t_max;
-    // Every entry is pushed with distance 0, so `pop` drops none of them.
-    loop {
-        let leaf = descend_any(
-            kernel,
-            bvh,
-            &box_ray,
-            t_max,
-            &mut current,
-            &mut sp,
-            stack,
-            &mut entry,
-        );
-        if leaf && current != ChildRef::EMPTY {
-            break;
-        }
-        let Some(next) = pop(stack, &mut sp, f32::INFINITY) else {
-            return false;
-        };
-        current = next;
+    // Entries wait with distance 0 and are never dropped.
+    let window = (t_max, f32::INFINITY);
+    if !next_leaf::<K, S, false>(
+        kernel,
+        bvh,
+        &box_ray,
+        window,
+        false,
+        &mut current,
+        &mut sp,
+        stack,
+        &mut entry,
+    ) {
+        return false;
     }
     let woop = kernel.prepare_tri(ray, &box_ray);
     loop {
@@ -762,24 +762,19 @@ pub(crate) fn any<K: Kernel, S: Stack>(
                 }
             }
         }
-        loop {
-            let Some(next) = pop(stack, &mut sp, f32::INFINITY) else {
-                return false;
-            };
-            current = next;
-            let leaf = descend_any(
-                kernel,
-                bvh,
-                &box_ray,
-                t_max,
-                &mut current,
-                &mut sp,
-                stack,
-                &mut entry,
-            );
-            if leaf && current != ChildRef::EMPTY {
-                break;
-            }
+        let more = next_leaf::<K, S, false>(
+            kernel,
+            bvh,
+            &box_ray,
+            window,
+            true,
+            &mut current,
+            &mut sp,
+            stack,
+            &mut entry,
+        );
+        if !more {
+            return false;
         }
     }
 }
