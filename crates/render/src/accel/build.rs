@@ -564,7 +564,7 @@ fn swap_misplaced(
     }
     // Positions of misplaced primitives waiting to be swapped: `left[sl..nl]` ascending in
     // [0, mid), `right[sr..nr]` descending in [mid, n); `i` and `j` bound what is scanned.
-    let (mut left, mut right) = ([0u32; SCAN], [0u32; SCAN]);
+    let (mut left, mut right) = ([0usize; SCAN], [0usize; SCAN]);
     let (mut sl, mut nl, mut sr, mut nr) = (0, 0, 0, 0);
     let (mut i, mut j) = (0, n);
     loop {
@@ -572,7 +572,7 @@ fn swap_misplaced(
             let end = (i + SCAN).min(mid);
             (sl, nl) = (0, 0);
             for (k, p) in prims[i..end].iter().enumerate() {
-                left[nl] = (i + k) as u32;
+                left[nl] = i + k;
                 nl += usize::from(goes_right(p));
             }
             i = end;
@@ -581,7 +581,7 @@ fn swap_misplaced(
             let start = j.saturating_sub(SCAN).max(mid);
             (sr, nr) = (0, 0);
             for (k, p) in prims[start..j].iter().rev().enumerate() {
-                right[nr] = (j - 1 - k) as u32;
+                right[nr] = j - 1 - k;
                 nr += usize::from(!goes_right(p));
             }
             j = start;
@@ -592,7 +592,7 @@ fn swap_misplaced(
             return sl == nl && sr == nr && i == mid && j == mid;
         }
         for (&a, &b) in left[sl..sl + pairs].iter().zip(&right[sr..sr + pairs]) {
-            prims.swap(a as usize, b as usize);
+            prims.swap(a, b);
         }
         sl += pairs;
         sr += pairs;
