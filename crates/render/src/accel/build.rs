@@ -1095,6 +1095,11 @@ mod tests {
         sets
     }
 
+    /// A box's lanes as bits (which tell +0 from -0).
+    fn bits(b: &Box4) -> ([u32; 4], [u32; 4]) {
+        (b.lo.map(f32::to_bits), b.hi.map(f32::to_bits))
+    }
+
     fn same_box(a: &Box4, b: &Box4) -> bool {
         (0..3).all(|k| a.lo[k] == b.lo[k] && a.hi[k] == b.hi[k])
     }
@@ -1160,7 +1165,6 @@ mod tests {
         let zeros = [prim(0, [0.0; 3], [0.0; 3]), prim(1, [-0.0; 3], [-0.0; 3])];
         cases.push((unit, zeros.to_vec()));
         cases.push((unit, vec![zeros[1], zeros[0]]));
-        let bits = |b: &Box4| (b.lo.map(f32::to_bits), b.hi.map(f32::to_bits));
         for (binner, set) in cases {
             let (mut fast, mut portable) = (Bins::new(), Bins::new());
             bin_prims(&set, &binner, &mut fast);
@@ -1208,7 +1212,6 @@ mod tests {
         };
         let mut expected = set.to_vec();
         let reference = partition_reference(&mut expected, binner, split(left));
-        let bits = |b: &Box4| (b.lo.map(f32::to_bits), b.hi.map(f32::to_bits));
         let mut result = None;
         for given in [
             left,

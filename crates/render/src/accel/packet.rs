@@ -32,10 +32,9 @@
 //! over both, like `wide::closest`.
 
 use crate::accel::triangle::WoopRay;
-use crate::accel::wide::ray_is_valid;
 use crate::accel::wide::{
-    self, ArrayStack, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel, TriangleBlock,
-    WideBvh, WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
+    self, ray_is_valid, ArrayStack, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel,
+    TriangleBlock, WideBvh, WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
 };
 use crate::ray::Ray;
 

@@ -2,7 +2,9 @@
 //! 8-lane operations, one ray against a block of four triangles in 4-lane operations, and the
 //! traversal of `wide.rs` instantiated inside `#[target_feature(enable = "avx2,fma")]`
 //! functions so that all of it is compiled for AVX2 (chosen at run time; the scalar kernel of
-//! `wide.rs` serves CPUs without it). Likewise for packets of eight rays (`packet.rs`): the
+//! `wide.rs` serves CPUs without it), and the single-ray walks once more with AVX-512F and VL
+//! as well (`closest_evex`, `any_evex`: the same code with 32 vector registers) for CPUs that
+//! have them (`Avx2::evex`). Likewise for packets of eight rays (`packet.rs`): the
 //! packet against one child box (lanes are rays), the interval test of a packet against all
 //! eight children (lanes are children), and the packet traversal instantiated for AVX2.
 //!
