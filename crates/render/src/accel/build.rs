@@ -20,8 +20,8 @@
 use rayon::prelude::*;
 
 use crate::accel::isa::Isa;
-use crate::accel::simd;
 use crate::accel::wide::{ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH};
+use crate::accel::{pages, simd};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
 
@@ -900,7 +900,7 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         || (Box4::EMPTY, Box4::EMPTY),
         |a, b| (a.0.union(b.0), a.1.union(b.1)),
     );
-    let mut nodes = Vec::with_capacity(node_capacity(prims.len()));
+    let mut nodes = pages::vec_with_capacity(node_capacity(prims.len()));
     let root = if prims.is_empty() {
         ChildRef::EMPTY
     } else {
@@ -933,7 +933,32 @@ fn pack(
     root: ChildRef,
     bounds: Aabb,
 ) -> WideBvh {
-    let mut blocks: Vec<TriangleBlock> = Vec::with_capacity(prims.len() / 3 + 1);
+    // The shapes of a leaf are read in tree order, at random in `shapes`: a cache miss each
+    // on big meshes. So the leaves are listed first and each one's shapes are prefetched a
+    // few leaves ahead of their conversion.
+    const AHEAD: usize = 8;
+    let leaves: Vec<(u32, u8)> = nodes
+        .iter()
+        .enumerate()
+        .flat_map(|(n, node)| {
+            node.children
+                .iter()
+                .enumerate()
+                .filter_map(move |(slot, &c)| {
+                    let c = ChildRef(c);
+                    (c.is_leaf() && c != ChildRef::EMPTY).then_some((n as u32, slot as u8))
+                })
+        })
+        .collect();
+    // Room for exactly the blocks the leaves need, advised for huge pages before it is written.
+    let block_count: usize = leaves
+        .iter()
+        .map(|&(n, slot)| ChildRef(nodes[n as usize].children[slot as usize]))
+        .chain([root])
+        .filter(|c| c.is_leaf() && *c != ChildRef::EMPTY && !c.is_shapes())
+        .map(|c| c.range().1.div_ceil(BLOCK))
+        .sum();
+    let mut blocks: Vec<TriangleBlock> = pages::vec_with_capacity(block_count);
     let mut lane_source: Vec<u32> = Vec::with_capacity(prims.len() * 4 / 3 + 4);
     let mut others: Vec<Shape> = Vec::new();
     let mut other_source: Vec<u32> = Vec::new();
@@ -973,23 +998,6 @@ fn pack(
             ChildRef::triangles(first, count.div_ceil(BLOCK) as u32)
         }
     };
-    // The shapes of a leaf are read in tree order, at random in `shapes`: a cache miss each
-    // on big meshes. So the leaves are listed first and each one's shapes are prefetched a
-    // few leaves ahead of their conversion.
-    const AHEAD: usize = 8;
-    let leaves: Vec<(u32, u8)> = nodes
-        .iter()
-        .enumerate()
-        .flat_map(|(n, node)| {
-            node.children
-                .iter()
-                .enumerate()
-                .filter_map(move |(slot, &c)| {
-                    let c = ChildRef(c);
-                    (c.is_leaf() && c != ChildRef::EMPTY).then_some((n as u32, slot as u8))
-                })
-        })
-        .collect();
     let leaf_of = |nodes: &[WideNode], (n, slot): (u32, u8)| {
         ChildRef(nodes[n as usize].children[slot as usize])
     };
@@ -1004,6 +1012,7 @@ fn pack(
         nodes[leaf.0 as usize].children[leaf.1 as usize] = converted.0;
     }
     let root = convert(root);
+    debug_assert_eq!(blocks.len(), block_count);
     lane_source.extend(other_source);
     WideBvh {
         nodes,

@@ -28,7 +28,7 @@
 //! packet; the packet traversal would answer them identically (tested).
 //!
 //! **Scalar fallback.** `ScalarPacketKernel` here does the same tests one ray at a time; the
-//! AVX2 kernel lives in `simd.rs` (the one module with `unsafe`). The traversal below is generic
+//! AVX2 kernel lives in `simd.rs` (where its `unsafe` lives). The traversal below is generic
 //! over both, like `wide::closest`.
 
 use crate::accel::triangle::WoopRay;

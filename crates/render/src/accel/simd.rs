@@ -8,7 +8,8 @@
 //! packet against one child box (lanes are rays), the interval test of a packet against all
 //! eight children (lanes are children), and the packet traversal instantiated for AVX2.
 //!
-//! This is the one module of glint-render allowed `unsafe` (DESIGN.md, Tooling): calling
+//! This is one of the two modules of glint-render allowed `unsafe` (DESIGN.md, Tooling; the
+//! other is `pages.rs`, one `madvise`): calling
 //! `target_feature` functions after run-time detection, and reading the uninitialised
 //! traversal stacks below their top. The benchmarks that justified it: `glint bench table`
 //! (`cargo run --release -p glint -- bench table`) and the `accel` criterion bench
