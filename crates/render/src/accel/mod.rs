@@ -5,7 +5,7 @@
 //! huge pages for the trees' arrays) or a scalar fallback, chosen once at
 //! build time (`isa.rs`) and applied in one place (`dispatch.rs`). The modules depend one way:
 //! `isa`, `triangle` <- `wide` (node layout, single-ray traversal) <- `packet` <- `simd` <-
-//! `dispatch`; `build` writes the layout of `wide`.
+//! `dispatch`; `build` writes the layout of `wide`, in arrays from `pages`.
 //! The binary BVH of `crate::bvh` stays as the reference the tests compare against (and as
 //! the top level over instances). `packet.rs` traces eight coherent rays together (camera rays
 //! of a pixel block) with results identical to tracing them one by one. `workload.rs` holds the
