@@ -470,19 +470,19 @@ fn render_with<I: Integrator>(
     )?;
     let bounds = settings.bounds();
     let features = settings.features.then(|| Features {
-        albedo: values.iter().map(|v| v.albedo).collect(),
-        normal: values.iter().map(|v| v.normal).collect(),
-        depth: values.iter().map(|v| v.depth).collect(),
+        albedo: values.gather(|v| v.albedo),
+        normal: values.gather(|v| v.normal),
+        depth: values.gather(|v| v.depth),
     });
     // Kept only for a sample range, the one case where a farm adds pixels up.
     let sums = settings.sample_range.is_some().then(|| SampleSums {
-        radiance: values.iter().map(|v| v.sum).collect(),
-        counts: values.iter().map(|v| v.count).collect(),
+        radiance: values.gather(|v| v.sum),
+        counts: values.gather(|v| v.count),
     });
     let film = Film {
         width: bounds.width(),
         height: bounds.height(),
-        pixels: values.iter().map(|v| v.beauty).collect(),
+        pixels: values.gather(|v| v.beauty),
         origin: (bounds.x0, bounds.y0),
         full_size: (width, height),
         features,
@@ -491,18 +491,49 @@ fn render_with<I: Integrator>(
     Ok((film, stats))
 }
 
+/// The pixels of `bounds` as `render_tiles` computed them: one row-major buffer per tile, the
+/// tiles row by row.
+struct TilePixels<P> {
+    bounds: PixelBounds,
+    tiles_x: u32,
+    tiles: Vec<Vec<P>>,
+}
+
+impl<P: Default + Sync> TilePixels<P> {
+    /// `f` of every pixel, row-major from the top-left of `bounds`. A parallel gather on the
+    /// current pool: done serially, stitching a 1024x1024 frame took about a sixth of the
+    /// time 16 threads took to render it.
+    fn gather<T: Send>(&self, f: impl Fn(&P) -> T + Sync + Send) -> Vec<T> {
+        let width = self.bounds.width() as usize;
+        let count = width * self.bounds.height() as usize;
+        (0..count)
+            .into_par_iter()
+            .map(|i| {
+                let (x, y) = ((i % width) as u32, (i / width) as u32);
+                let (tile_x, tile_y) = (x / TILE_SIZE, y / TILE_SIZE);
+                let tile_width = TILE_SIZE.min(self.bounds.width() - tile_x * TILE_SIZE);
+                let within = ((y % TILE_SIZE) * tile_width + x % TILE_SIZE) as usize;
+                // Every tile is whole once `render_tiles` returns; a default is never read.
+                self.tiles[(tile_y * self.tiles_x + tile_x) as usize]
+                    .get(within)
+                    .map_or_else(|| f(&P::default()), &f)
+            })
+            .collect()
+    }
+}
+
 /// The tile scheduler: `pixel(x, y, counters)` computes one pixel (x, y from the top-left of
 /// the whole image `width` wide), tiles of `bounds` run on the current rayon pool, each pixel
-/// is computed by exactly one task, and the results are stitched in tile order, so neither
-/// thread count nor scheduling can change the image. Returns the pixels of `bounds`,
-/// row-major from its top-left.
+/// is computed by exactly one task and kept in its tile's buffer, so neither thread count nor
+/// scheduling can change the image. Returns the pixels of `bounds` by tile
+/// ([`TilePixels::gather`] lays them out row-major).
 fn render_tiles<P: Copy + Default + Send>(
     bounds: PixelBounds,
     width: u32,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
     beauty: impl Fn(&P) -> Color + Sync,
     pixel: impl Fn(u32, u32, &mut TileCounters) -> P + Sync,
-) -> Result<(Vec<P>, RenderStats), RenderError> {
+) -> Result<(TilePixels<P>, RenderStats), RenderError> {
     let tiles_x = bounds.width().div_ceil(TILE_SIZE);
     let tiles_y = bounds.height().div_ceil(TILE_SIZE);
     let tile_count = (tiles_x * tiles_y) as usize;
@@ -553,30 +584,30 @@ fn render_tiles<P: Copy + Default + Send>(
     if cancelled.load(Ordering::Relaxed) {
         return Err(RenderError::Cancelled);
     }
-    let (bw, bh) = (bounds.width(), bounds.height());
-    let mut pixels = vec![P::default(); bw as usize * bh as usize];
     let mut stats = RenderStats::default();
     let mut first_nonfinite: Option<u64> = None;
-    for (tile, (values, counters)) in tiles.into_iter().enumerate() {
-        let area = tile_bounds(tile);
-        let mut it = values.into_iter();
-        for y in area.y0..area.y1 {
-            for x in area.x0..area.x1 {
-                pixels[((y - bounds.y0) * bw + (x - bounds.x0)) as usize] =
-                    it.next().unwrap_or_default();
-            }
-        }
-        stats.rays += counters.rays;
-        stats.nonfinite_samples += counters.nonfinite_samples;
-        first_nonfinite = match (first_nonfinite, counters.first_nonfinite) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        };
-    }
-    let _ = bh;
+    let pixels = tiles
+        .into_iter()
+        .map(|(values, counters)| {
+            stats.rays += counters.rays;
+            stats.nonfinite_samples += counters.nonfinite_samples;
+            first_nonfinite = match (first_nonfinite, counters.first_nonfinite) {
+                (Some(a), Some(b)) => Some(a.min(b)),
+                (a, b) => a.or(b),
+            };
+            values
+        })
+        .collect();
     stats.first_nonfinite_pixel =
         first_nonfinite.map(|p| ((p % width as u64) as u32, (p / width as u64) as u32));
-    Ok((pixels, stats))
+    Ok((
+        TilePixels {
+            bounds,
+            tiles_x,
+            tiles: pixels,
+        },
+        stats,
+    ))
 }
 
 /// What the bottom-level BVHs cost the camera rays (`measure_traversal`).
@@ -635,4 +666,48 @@ pub fn measure_traversal(scene: &Scene, settings: &RenderSettings) -> TraversalS
             nodes: a.nodes + b.nodes,
             blocks: a.blocks + b.blocks,
         })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Tiles computed on several threads and gathered give every pixel of the bounds once, in
+    /// row-major order from the bounds' top-left, for bounds that are no multiple of the tile
+    /// size and do not start at the origin.
+    #[test]
+    fn gathered_tiles_are_the_bounds_row_by_row() {
+        let bounds = PixelBounds {
+            x0: 3,
+            x1: 3 + 2 * TILE_SIZE + 5,
+            y0: 7,
+            y1: 7 + TILE_SIZE + 9,
+        };
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(3)
+            .build()
+            .unwrap();
+        let (tiles, stats) = pool
+            .install(|| {
+                render_tiles(
+                    bounds,
+                    64,
+                    &|_: &Progress| true,
+                    |_: &(u32, u32)| Color::ZERO,
+                    |x, y, counters| {
+                        counters.rays += 1;
+                        (x, y)
+                    },
+                )
+            })
+            .unwrap();
+        let expected: Vec<(u32, u32)> = (bounds.y0..bounds.y1)
+            .flat_map(|y| (bounds.x0..bounds.x1).map(move |x| (x, y)))
+            .collect();
+        assert_eq!(pool.install(|| tiles.gather(|&p| p)), expected);
+        assert_eq!(stats.rays, expected.len() as u64);
+        // Mapped fields come out in the same order.
+        let xs = pool.install(|| tiles.gather(|&(x, _)| x));
+        assert_eq!(xs, expected.iter().map(|&(x, _)| x).collect::<Vec<_>>());
+    }
 }
