@@ -415,12 +415,15 @@ pub fn run(
 
     let write_start = Instant::now();
     let options = glint_io::WriteOptions { png: job.png };
-    glint_io::write_image_with_metadata(
-        &job.output,
-        &film,
-        &options,
-        &metadata(stats.rays, render_seconds),
-    )
+    // In the pool: the 8-bit conversion and the EXR's compression run in parallel, on `-n`.
+    pool.install(|| {
+        glint_io::write_image_with_metadata(
+            &job.output,
+            &film,
+            &options,
+            &metadata(stats.rays, render_seconds),
+        )
+    })
     .map_err(Failure::Write)?;
     if let Some(checkpoint) = &job.checkpoint {
         // The image is complete: the checkpoint is stale now.

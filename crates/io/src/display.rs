@@ -4,6 +4,7 @@
 //! EXR output never goes through this: it keeps the film's linear values as they are.
 
 use glint_render::{Color, Film, IntegratorKind};
+use rayon::prelude::*;
 
 /// How `write_image_with` turns linear values into a PNG's 8-bit values.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -168,13 +169,18 @@ impl Transfer {
 
 impl DisplayTransform {
     /// The 8-bit RGB values of linear `pixels`, three per pixel: `apply`, then the nearest
-    /// level.
+    /// level. In parallel on the current rayon pool (about 90 ms of `powf` for a 1024x1024
+    /// sRGB frame on one thread).
     pub fn to_rgb8(&self, pixels: &[Color]) -> Vec<u8> {
-        pixels
-            .iter()
-            .flat_map(|&c| self.apply(c).to_array())
-            .map(rounded_level)
-            .collect()
+        let mut rgb = vec![0; pixels.len() * 3];
+        rgb.par_chunks_mut(3)
+            .zip(pixels)
+            .for_each(|(levels, &color)| {
+                for (level, v) in levels.iter_mut().zip(self.apply(color).to_array()) {
+                    *level = rounded_level(v);
+                }
+            });
+        rgb
     }
 
     /// Exposure, curve and transfer function applied to one linear colour: code values in

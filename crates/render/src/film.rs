@@ -1,5 +1,7 @@
 //! The rendered image: linear RGB f32, row 0 at the top, with optional feature layers.
 
+use rayon::prelude::*;
+
 use crate::math::{Color, Vec3};
 
 /// What `render` returns: the pixels of the rendered rectangle (the whole image, or the crop
@@ -74,18 +76,21 @@ impl Film {
 
     /// 8-bit RGB as the course writes it (FORMAT.md 1.3): clamp to [0,1], then floor(c·255),
     /// no gamma. NaN becomes 0.
+    /// In parallel on the current rayon pool: the image write is otherwise serial.
     pub fn to_rgb8_course(&self) -> Vec<u8> {
-        self.pixels
-            .iter()
-            .flat_map(|c| c.to_array())
-            .map(|v| {
-                if v.is_nan() {
-                    0
-                } else {
-                    (v.clamp(0.0, 1.0) * 255.0).floor() as u8
+        let mut rgb = vec![0; self.pixels.len() * 3];
+        rgb.par_chunks_mut(3)
+            .zip(&self.pixels)
+            .for_each(|(levels, color)| {
+                for (level, v) in levels.iter_mut().zip(color.to_array()) {
+                    *level = if v.is_nan() {
+                        0
+                    } else {
+                        (v.clamp(0.0, 1.0) * 255.0).floor() as u8
+                    };
                 }
-            })
-            .collect()
+            });
+        rgb
     }
 
     /// Interleaved RGB f32 (for EXR and arrays).
