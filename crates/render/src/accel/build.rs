@@ -33,6 +33,10 @@ const _: () = assert!(BINS.is_power_of_two());
 /// Subtrees with more primitives than this are built as parallel tasks.
 const PARALLEL_THRESHOLD: usize = 4096;
 
+/// Primitives a task bins when a split's range is binned in parallel (`find_split`): ranges
+/// of at least two chunks are.
+const BINNING_CHUNK: usize = 16384;
+
 /// How the builder splits a range of primitives in two (`-s`, FORMAT.md 1.4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SplitMethod {
@@ -302,6 +306,16 @@ impl Bins {
             counts: [[0; BINS]; 3],
         }
     }
+
+    /// Adds `other`'s first `bins` bins to these.
+    fn merge(&mut self, other: &Bins, bins: usize) {
+        for axis in 0..3 {
+            for bin in 0..bins {
+                self.bounds[axis][bin] = self.bounds[axis][bin].union(other.bounds[axis][bin]);
+                self.counts[axis][bin] += other.counts[axis][bin];
+            }
+        }
+    }
 }
 
 /// Puts each primitive of `prims` into its centroid's bin on every axis (`Binner::bin`),
@@ -352,11 +366,31 @@ fn find_split(
     if binner.scale[..3].iter().all(|&s| s == 0.0) {
         return None;
     }
-    for axis in 0..3 {
-        scratch.bounds[axis][..bins].fill(Box4::EMPTY);
-        scratch.counts[axis][..bins].fill(0);
+    let range = &prims[record.start..record.end];
+    if range.len() >= 2 * BINNING_CHUNK && rayon::current_num_threads() > 1 {
+        // The top of the tree, where every split bins the whole range before any subtree
+        // can run apart: chunks binned in parallel, then merged bin by bin. The merged
+        // counts are the same integers; the boxes the same up to which of +0 and -0 they
+        // keep, which their areas (all a split reads) do not see.
+        *scratch = range
+            .par_chunks(BINNING_CHUNK)
+            .map(|chunk| {
+                let mut part = Bins::new();
+                bin_prims(chunk, &binner, &mut part);
+                part
+            })
+            .reduce_with(|mut a, b| {
+                a.merge(&b, bins);
+                a
+            })
+            .unwrap_or_else(Bins::new);
+    } else {
+        for axis in 0..3 {
+            scratch.bounds[axis][..bins].fill(Box4::EMPTY);
+            scratch.counts[axis][..bins].fill(0);
+        }
+        bin_prims(range, &binner, scratch);
     }
-    bin_prims(&prims[record.start..record.end], &binner, scratch);
     let Bins { bounds, counts } = scratch;
     let mut best: Option<Split> = None;
     for axis in 0..3 {
