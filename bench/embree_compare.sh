@@ -26,6 +26,8 @@
 # Needs g++ and Debian's Embree 3 headers and library (`apt-get install libembree-dev g++`),
 # python3 with numpy. embree_native is built into target/embree_native when missing; meshes are
 # converted to target/bench-rays/NAME.bin and ray files written there once and reused.
+# GLINT=PATH and EMBREE=PATH take binaries built elsewhere (a machine without cargo or g++, such
+# as the lent 16-core one): then nothing is built, and RAYS=DIR moves the ray files.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SHARED=${SHARED:-../shared}
@@ -39,9 +41,11 @@ while [ $# -gt 0 ]; do
     *) echo "unknown argument $1" >&2; exit 2 ;;
   esac
 done
-nice cargo build --release -q -p glint
-GLINT=target/release/glint
-EMBREE=target/embree_native
+if [ -z "${GLINT:-}" ]; then
+  nice cargo build --release -q -p glint
+  GLINT=target/release/glint
+fi
+EMBREE=${EMBREE:-target/embree_native}
 if [ ! -x "$EMBREE" ]; then
   if [ ! -f /usr/include/embree3/rtcore.h ] || ! command -v g++ >/dev/null; then
     echo "embree_native needs g++ and Embree 3: apt-get install libembree-dev g++" >&2
@@ -50,7 +54,7 @@ if [ ! -x "$EMBREE" ]; then
   echo "building $EMBREE from $SHARED/bench/embree_native.cpp" >&2
   g++ -O3 -march=native -o "$EMBREE" "$SHARED/bench/embree_native.cpp" -lembree3
 fi
-RAYS=target/bench-rays
+RAYS=${RAYS:-target/bench-rays}
 mkdir -p "$RAYS"
 MESHES=(
   "$SHARED/models/stanford-bunny.obj"
