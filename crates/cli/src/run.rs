@@ -415,7 +415,8 @@ pub fn run(
 
     let write_start = Instant::now();
     let options = glint_io::WriteOptions { png: job.png };
-    // In the pool: the 8-bit conversion and the EXR's compression run in parallel, on `-n`.
+    // In the pool: the PNG's 8-bit conversion runs on `-n` threads, and `-n 1` keeps the
+    // EXR's compression on one.
     pool.install(|| {
         glint_io::write_image_with_metadata(
             &job.output,

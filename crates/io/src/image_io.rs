@@ -618,9 +618,17 @@ fn encode_exr(
             .other
             .insert(text(key)?, AttributeValue::Text(text(value)?));
     }
-    ExrImage::new(attributes, layer)
-        .write()
-        .to_buffered(writer)?;
+    let image = ExrImage::new(attributes, layer);
+    let options = image.write();
+    // The exr crate compresses on a pool of its own, as wide as the machine: on a pool of one
+    // thread (`-n 1`) it compresses on this one instead.
+    #[cfg(not(target_arch = "wasm32"))]
+    let options = if rayon::current_num_threads() > 1 {
+        options
+    } else {
+        options.non_parallel()
+    };
+    options.to_buffered(writer)?;
     Ok(())
 }
 
