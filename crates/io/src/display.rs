@@ -4,6 +4,7 @@
 //! EXR output never goes through this: it keeps the film's linear values as they are.
 
 use glint_render::{Color, Film, IntegratorKind};
+use rayon::prelude::*;
 
 /// How `write_image_with` turns linear values into a PNG's 8-bit values.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -169,11 +170,13 @@ impl Transfer {
 impl DisplayTransform {
     /// The 8-bit RGB values of linear `pixels`, three per pixel: `apply`, then the nearest
     /// level. In parallel on the current rayon pool (about 90 ms of `powf` for a 1024x1024
-    /// sRGB frame on one thread), one pixel after another in the browser's module.
+    /// sRGB frame on one thread).
     pub fn to_rgb8(&self, pixels: &[Color]) -> Vec<u8> {
-        levels(pixels, |color| {
-            self.apply(color).to_array().map(rounded_level)
-        })
+        let mut rgb = vec![0; pixels.len() * 3];
+        rgb.par_chunks_mut(3).zip(pixels).for_each(|(out, &color)| {
+            out.copy_from_slice(&self.apply(color).to_array().map(rounded_level));
+        });
+        rgb
     }
 
     /// Exposure, curve and transfer function applied to one linear colour: code values in
@@ -185,23 +188,6 @@ impl DisplayTransform {
             .apply(exposed)
             .map(|v| self.transfer.encode(v.clamp(0.0, 1.0)))
     }
-}
-
-/// `level` of every pixel, three values each, in parallel on the current rayon pool.
-#[cfg(not(target_arch = "wasm32"))]
-fn levels(pixels: &[Color], level: impl Fn(Color) -> [u8; 3] + Sync + Send) -> Vec<u8> {
-    use rayon::prelude::*;
-    let mut rgb = vec![0; pixels.len() * 3];
-    rgb.par_chunks_mut(3)
-        .zip(pixels)
-        .for_each(|(out, &color)| out.copy_from_slice(&level(color)));
-    rgb
-}
-
-/// The browser's module has no threads (and glint-io no rayon there): one pixel after another.
-#[cfg(target_arch = "wasm32")]
-fn levels(pixels: &[Color], level: impl Fn(Color) -> [u8; 3]) -> Vec<u8> {
-    pixels.iter().flat_map(|&color| level(color)).collect()
 }
 
 /// The nearest 8-bit level of a code value in [0, 1].

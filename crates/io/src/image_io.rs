@@ -621,8 +621,7 @@ fn encode_exr(
     let image = ExrImage::new(attributes, layer);
     let options = image.write();
     // The exr crate compresses on a pool of its own, as wide as the machine: on a pool of one
-    // thread (`-n 1`) it compresses on this one instead.
-    #[cfg(not(target_arch = "wasm32"))]
+    // thread (`-n 1`, and the browser's module) it compresses on this one instead.
     let options = if rayon::current_num_threads() > 1 {
         options
     } else {
