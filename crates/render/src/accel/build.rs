@@ -1048,7 +1048,9 @@ fn pack(
     let root = convert(root);
     debug_assert_eq!(blocks.len(), block_count);
     lane_source.extend(other_source);
+    let magnitude = plane_magnitude(&nodes);
     WideBvh {
+        magnitude,
         nodes,
         root,
         bounds,
@@ -1057,6 +1059,25 @@ fn pack(
         source: lane_source,
         isa: Isa::detect(),
     }
+}
+
+/// `WideBvh::magnitude`: the largest |plane| of the children's boxes (empty slots left out), ∞
+/// where one is infinite or NaN.
+pub(crate) fn plane_magnitude(nodes: &[WideNode]) -> f32 {
+    let mut largest = 0.0f32;
+    for node in nodes {
+        for slot in (0..WIDTH).filter(|&slot| node.children[slot] != ChildRef::EMPTY.0) {
+            for row in &node.bounds {
+                let m = row[slot].abs();
+                largest = if m.is_nan() {
+                    f32::INFINITY
+                } else {
+                    largest.max(m)
+                };
+            }
+        }
+    }
+    largest
 }
 
 #[cfg(test)]

@@ -172,6 +172,11 @@ pub struct WideBvh {
     /// from in the geometry as given; `u32::MAX` for an unused lane.
     pub(crate) source: Vec<u32>,
     pub(crate) isa: Isa,
+    /// The largest magnitude of any plane of a child box in `nodes` (∞ if one is infinite or
+    /// NaN; 0 without nodes): what bounds the rounding of the AVX2 walk's slab distances
+    /// (`simd.rs`, `SlabMargin`; read only where that walk exists).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    pub(crate) magnitude: f32,
 }
 
 /// The closest hit inside one bottom-level structure.
@@ -660,6 +665,18 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
     stack: &mut S,
 ) -> Option<LocalHit> {
     let box_ray = kernel.prepare_box(ray)?;
+    closest_prepared(kernel, bvh, ray, box_ray, stack)
+}
+
+/// `closest` for a valid ray whose box-test constants the caller made (`Kernel::prepare_box`).
+#[inline(always)]
+pub(crate) fn closest_prepared<K: Kernel, S: Stack>(
+    kernel: &K,
+    bvh: &WideBvh,
+    ray: &Ray,
+    box_ray: K::BoxRay,
+    stack: &mut S,
+) -> Option<LocalHit> {
     let mut entry = [0.0f32; WIDTH];
     let mut current = bvh.root;
     // Entries below `sp` are waiting; those beyond the closest hit so far are dropped.
@@ -735,6 +752,18 @@ pub(crate) fn any<K: Kernel, S: Stack>(
     let Some(box_ray) = kernel.prepare_box(ray) else {
         return false;
     };
+    any_prepared(kernel, bvh, ray, box_ray, stack)
+}
+
+/// `any` for a valid ray whose box-test constants the caller made (`Kernel::prepare_box`).
+#[inline(always)]
+pub(crate) fn any_prepared<K: Kernel, S: Stack>(
+    kernel: &K,
+    bvh: &WideBvh,
+    ray: &Ray,
+    box_ray: K::BoxRay,
+    stack: &mut S,
+) -> bool {
     let mut entry = [0.0f32; WIDTH];
     let mut current = bvh.root;
     let mut sp = 0usize;
