@@ -490,7 +490,10 @@ mod x86 {
 
         #[inline(always)]
         fn prepare_box(&self, ray: &Ray) -> Option<BoxRay> {
-            // SAFETY: only called inside `closest`/`any` above, on a CPU with AVX2.
+            // The walks above are handed their `BoxRay` by `walk_closest`/`walk_any`, which know
+            // the tree's magnitude; a walk started through `wide::closest` or `wide::any` would
+            // come here, and with an unknown (infinite) magnitude take the checked test.
+            // SAFETY: only reached inside the `target_feature` functions above, with AVX2.
             unsafe { prepare_box::<MARGIN>(ray, f32::INFINITY) }
         }
 
