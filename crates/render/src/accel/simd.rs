@@ -430,7 +430,9 @@ mod x86 {
         no_nan: bool,
         /// `inv_dir · FOLDED_FAR_SCALE`, for the far slabs of the short path.
         inv_far: [__m256; 3],
-        /// The direction and its reciprocals in lanes 0-2 (lane 3: 1), for `prepare_tri`.
+        /// The origin (lane 3: 0), the direction and its reciprocals (lane 3: 1) in lanes 0-2,
+        /// for `prepare_tri`.
+        o: __m128,
         d: __m128,
         inv: __m128,
         /// The margin test's constants, for the rays it serves (`SlabMargin`).
@@ -498,9 +500,9 @@ mod x86 {
         }
 
         #[inline(always)]
-        fn prepare_tri(&self, ray: &Ray, box_ray: &BoxRay) -> TriRay {
+        fn prepare_tri(&self, _ray: &Ray, box_ray: &BoxRay) -> TriRay {
             // SAFETY: as above.
-            unsafe { prepare_tri(ray, box_ray) }
+            unsafe { prepare_tri(box_ray) }
         }
 
         #[inline(always)]
@@ -575,54 +577,87 @@ mod x86 {
     // the features, their intrinsics are compiled for AVX2 there, with the ray's constants
     // in registers for the whole walk. Hence `unsafe`: they must only be reached from there.
 
-    /// Per-ray constants of the watertight test (`WoopRay`'s) broadcast to four lanes, with
-    /// the sheared frame's axes as row offsets; `woop` rebuilds the scalar form for blocks
-    /// with a zero edge function.
+    /// Per-ray constants of the watertight test (`WoopRay`'s) in the sheared frame's order,
+    /// with its axes as row offsets; `woop` rebuilds the scalar form for blocks with a zero
+    /// edge function. Kept in memory and broadcast from there by each block test (one load
+    /// each, as a register spilled would take): made this way, the set-up is three lane
+    /// permutations and two stores, where broadcasting the six values once took some sixty
+    /// instructions a ray, spills included (bench/README, issue 14, tenth pass).
+    #[repr(C, align(16))]
     struct TriRay {
-        /// origin[kx], origin[ky], origin[kz].
-        origin: [__m128; 3],
-        /// sx, sy, sz.
-        shear: [__m128; 3],
+        // `lanes` reads `origin` and `shear` by their offsets: keep them first, in this order.
+        /// origin[kx], origin[ky], origin[kz]; lane 3 unused.
+        origin: [f32; 4],
+        /// sx, sy, sz; lane 3 unused.
+        shear: [f32; 4],
         /// kx, ky, kz as byte offsets of a corner's rows in a `TriangleBlock` (16 per axis).
         rows: [usize; 3],
     }
 
     impl TriRay {
-        /// The lanes of a `WoopRay` at hand (a packet's ray taken alone).
+        /// The constants of a `WoopRay` at hand (a packet's ray taken alone).
         #[inline(always)]
         fn new(woop: WoopRay) -> TriRay {
-            // SAFETY: SSE is part of x86-64.
-            unsafe {
-                TriRay {
-                    origin: [woop.kx, woop.ky, woop.kz].map(|k| _mm_set1_ps(woop.origin[k])),
-                    shear: [woop.sx, woop.sy, woop.sz].map(|s| _mm_set1_ps(s)),
-                    rows: [woop.kx, woop.ky, woop.kz].map(|k| k * 4 * BLOCK),
-                }
+            let o = woop.origin;
+            TriRay {
+                origin: [o[woop.kx], o[woop.ky], o[woop.kz], 0.0],
+                shear: [woop.sx, woop.sy, woop.sz, 0.0],
+                rows: [woop.kx, woop.ky, woop.kz].map(|k| k * 4 * BLOCK),
             }
         }
 
-        /// The scalar form, for blocks with a zero edge function: every field is in the lanes
-        /// (kx, ky, kz are a permutation of the axes, so the origin is whole), rather than
-        /// stored beside them for the few rays that need it.
+        /// origin[kx], origin[ky], origin[kz], sx, sy and sz, each in four lanes, loaded from
+        /// memory where they are used: as an `asm!` block that is not `pure`, the loads are
+        /// neither hoisted out of the walk's loops nor merged, so the compiler cannot broadcast
+        /// the values once and then spill the results, as it did.
+        ///
+        /// # Safety
+        /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
+        #[inline(always)]
+        unsafe fn lanes(&self) -> [__m128; 6] {
+            let (ox, oy, oz, sx, sy, sz): (__m128, __m128, __m128, __m128, __m128, __m128);
+            // SAFETY: reads 12 bytes at each of `origin` and `shear` (the asm's only memory
+            // access; `shear` is 16 bytes after `origin` in this `repr(C)` struct) and writes
+            // only its outputs; the caller runs with AVX.
+            unsafe {
+                std::arch::asm!(
+                    "vbroadcastss {ox}, dword ptr [{p}]",
+                    "vbroadcastss {oy}, dword ptr [{p} + 4]",
+                    "vbroadcastss {oz}, dword ptr [{p} + 8]",
+                    "vbroadcastss {sx}, dword ptr [{p} + 16]",
+                    "vbroadcastss {sy}, dword ptr [{p} + 20]",
+                    "vbroadcastss {sz}, dword ptr [{p} + 24]",
+                    p = in(reg) self.origin.as_ptr(),
+                    ox = lateout(xmm_reg) ox,
+                    oy = lateout(xmm_reg) oy,
+                    oz = lateout(xmm_reg) oz,
+                    sx = lateout(xmm_reg) sx,
+                    sy = lateout(xmm_reg) sy,
+                    sz = lateout(xmm_reg) sz,
+                    options(readonly, nostack, preserves_flags),
+                );
+            }
+            [ox, oy, oz, sx, sy, sz]
+        }
+
+        /// The scalar form, for blocks with a zero edge function: every field is here (kx,
+        /// ky, kz are a permutation of the axes, so the origin is whole).
         #[inline(always)]
         fn woop(&self) -> WoopRay {
-            // SAFETY: SSE is part of x86-64.
-            unsafe {
-                let [kx, ky, kz] = self.rows.map(|r| r / (4 * BLOCK));
-                let mut origin = [0.0; 3];
-                for (&k, lanes) in [kx, ky, kz].iter().zip(&self.origin) {
-                    origin[k] = _mm_cvtss_f32(*lanes);
-                }
-                let [sx, sy, sz] = self.shear.map(|lanes| _mm_cvtss_f32(lanes));
-                WoopRay {
-                    origin,
-                    kx,
-                    ky,
-                    kz,
-                    sx,
-                    sy,
-                    sz,
-                }
+            let [kx, ky, kz] = self.rows.map(|r| r / (4 * BLOCK));
+            let mut origin = [0.0; 3];
+            for (&k, &value) in [kx, ky, kz].iter().zip(&self.origin) {
+                origin[k] = value;
+            }
+            let [sx, sy, sz, _] = self.shear;
+            WoopRay {
+                origin,
+                kx,
+                ky,
+                kz,
+                sx,
+                sy,
+                sz,
             }
         }
     }
@@ -705,6 +740,7 @@ mod x86 {
                 t_min: _mm256_set1_ps(t_min + 0.0),
                 no_nan,
                 inv_far: [wide!(inv_far, 0), wide!(inv_far, 1), wide!(inv_far, 2)],
+                o,
                 d,
                 inv,
                 margin,
@@ -712,30 +748,100 @@ mod x86 {
         }
     }
 
-    /// `WoopRay::new` for a ray `prepare_box` passed, with its direction and reciprocals: the
-    /// axes from the same comparisons, then the lanes picked by index in registers:
-    /// sz = 1/d[kz] (`prepare_box`'s division), sx = d[kx]·sz, sy = d[ky]·sz.
+    /// The sheared frame of `WoopRay::axes` by its major axis kz and the sign of d[kz]: entry
+    /// 2·kz + (d[kz] < 0) holds the lanes [kx, ky, kz, 3] (a lane permutation) and the byte
+    /// offsets of kx, ky and kz's rows in a corner of a `TriangleBlock`. kx and ky follow kz
+    /// cyclically, swapped where d[kz] is negative.
+    #[repr(C, align(16))]
+    struct Frame {
+        lanes: [i32; 4],
+        rows: [usize; 3],
+    }
+
+    const FRAMES: [Frame; 6] = {
+        let mut table = [const {
+            Frame {
+                lanes: [0; 4],
+                rows: [0; 3],
+            }
+        }; 6];
+        let mut i = 0;
+        while i < 6 {
+            let kz = i / 2;
+            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if i % 2 == 1 {
+                (kx, ky) = (ky, kx);
+            }
+            table[i] = Frame {
+                lanes: [kx as i32, ky as i32, kz as i32, 3],
+                rows: [kx * 4 * BLOCK, ky * 4 * BLOCK, kz * 4 * BLOCK],
+            };
+            i += 1;
+        }
+        table
+    };
+
+    /// The entry of `FRAMES` by the comparisons `prepare_tri` makes: bits 0 and 1, |d0| ≥ |d1|
+    /// and |d1| ≥ |d2|; bit 2, |d0| ≥ |d2|; bits 3 to 5, d0, d1, d2 < 0. kz as
+    /// `WoopRay::axes` picks it: 0 where |d0| is at least both others, else 1 where |d1| ≥ |d2|,
+    /// else 2.
+    const FRAME_OF: [u8; 64] = {
+        let mut table = [0; 64];
+        let mut key = 0;
+        while key < 64 {
+            let x_major = key & 1 != 0 && key >> 2 & 1 != 0;
+            let y_over_z = key & 2 != 0;
+            let kz = if x_major {
+                0
+            } else if y_over_z {
+                1
+            } else {
+                2
+            };
+            table[key] = (2 * kz + (key >> 3 >> kz & 1)) as u8;
+            key += 1;
+        }
+        table
+    };
+
+    /// `WoopRay::new` for a ray `prepare_box` passed, with its origin, direction and
+    /// reciprocals: the major axis from `WoopRay::axes`' comparisons (made on four lanes at
+    /// once), the frame from `FRAMES`, the lanes permuted into its order once, then
+    /// sz = 1/d[kz] (`prepare_box`'s division), sx = d[kx]·sz, sy = d[ky]·sz, each broadcast
+    /// from its lane.
     ///
     /// # Safety
     /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
     #[inline(always)]
-    unsafe fn prepare_tri(ray: &Ray, box_ray: &BoxRay) -> TriRay {
-        // SAFETY: the caller runs with AVX2.
+    unsafe fn prepare_tri(box_ray: &BoxRay) -> TriRay {
+        // SAFETY: the caller runs with AVX2; `FRAMES` entries are 16-byte aligned.
         unsafe {
-            let (d, inv) = (box_ray.d, box_ray.inv);
-            let o = _mm_setr_ps(ray.origin.x, ray.origin.y, ray.origin.z, 0.0);
-            let below_zero = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps())) as u32;
-            let a = ray.direction.to_array().map(f32::abs);
-            let [kx, ky, kz] = WoopRay::axes(a, below_zero);
-            let pick = |v: __m128, k: usize| _mm_permutevar_ps(v, _mm_set1_epi32(k as i32));
-            let sz = pick(inv, kz);
-            let sx = _mm_mul_ps(pick(d, kx), sz);
-            let sy = _mm_mul_ps(pick(d, ky), sz);
-            TriRay {
-                origin: [pick(o, kx), pick(o, ky), pick(o, kz)],
-                shear: [sx, sy, sz],
-                rows: [kx, ky, kz].map(|k| k * 4 * BLOCK),
-            }
+            let (o, d, inv) = (box_ray.o, box_ray.d, box_ray.inv);
+            // |d| (lane 3: 1), against its lanes rotated by one and by two:
+            // [a0 ≥ a1, a1 ≥ a2, ..] and [a0 ≥ a2, ..].
+            let a = _mm_and_ps(d, _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff)));
+            let ge_next = _mm_movemask_ps(_mm_cmpge_ps(a, _mm_permute_ps::<0b11_00_10_01>(a)));
+            let ge_after = _mm_movemask_ps(_mm_cmpge_ps(a, _mm_permute_ps::<0b11_01_00_10>(a)));
+            let below_zero = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps()));
+            let key = (ge_next & 0b11) | (ge_after & 1) << 2 | (below_zero & 0b111) << 3;
+            let frame = &FRAMES[FRAME_OF[key as usize] as usize];
+            let lanes = _mm_load_si128(frame.lanes.as_ptr().cast());
+            let (o, d, inv) = (
+                _mm_permutevar_ps(o, lanes),
+                _mm_permutevar_ps(d, lanes),
+                _mm_permutevar_ps(inv, lanes),
+            );
+            // [d[kx]·sz, d[ky]·sz, ..] with sz itself in lane 2.
+            let sz = _mm_permute_ps::<0b10_10_10_10>(inv);
+            let shear = _mm_blend_ps::<0b0100>(_mm_mul_ps(d, sz), sz);
+            let mut tri = TriRay {
+                origin: [0.0; 4],
+                shear: [0.0; 4],
+                rows: frame.rows,
+            };
+            _mm_store_ps(tri.origin.as_mut_ptr(), o);
+            _mm_store_ps(tri.shear.as_mut_ptr(), shear);
+            tri
         }
     }
 
@@ -911,8 +1017,7 @@ mod x86 {
                 };
             }
             let [kx, ky, kz] = ray.rows;
-            let [ox, oy, oz] = ray.origin;
-            let [sx, sy, sz] = ray.shear;
+            let [ox, oy, oz, sx, sy, sz] = ray.lanes();
             // `WoopRay::shear`: a = v − o, then x = a[kx] − sx·a[kz], y = a[ky] − sy·a[kz].
             macro_rules! shear {
                 ($corner:expr) => {{
@@ -1586,7 +1691,8 @@ mod x86 {
         pub inv_far: [f32; 3],
         pub no_nan: bool,
         pub woop: WoopRay,
-        pub lanes: [[f32; 4]; 6],
+        /// `TriRay`'s origin[kx], origin[ky], origin[kz], sx, sy, sz.
+        pub frame: [f32; 6],
     }
 
     /// # Safety
@@ -1595,13 +1701,8 @@ mod x86 {
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn prepared(ray: &Ray) -> Option<Prepared> {
         let b = prepare_box::<false>(ray, 0.0)?;
-        let t = prepare_tri(ray, &b);
+        let t = prepare_tri(&b);
         let first = |v: __m256| _mm256_cvtss_f32(v);
-        let lanes = |v: __m128| {
-            let mut out = [0.0f32; 4];
-            _mm_storeu_ps(out.as_mut_ptr(), v);
-            out
-        };
         Some(Prepared {
             planes: crate::accel::wide::BoxPlanes {
                 origin: b.origin.map(first),
@@ -1613,13 +1714,13 @@ mod x86 {
             inv_far: b.inv_far.map(first),
             no_nan: b.no_nan,
             woop: t.woop(),
-            lanes: [
-                lanes(t.origin[0]),
-                lanes(t.origin[1]),
-                lanes(t.origin[2]),
-                lanes(t.shear[0]),
-                lanes(t.shear[1]),
-                lanes(t.shear[2]),
+            frame: [
+                t.origin[0],
+                t.origin[1],
+                t.origin[2],
+                t.shear[0],
+                t.shear[1],
+                t.shear[2],
             ],
         })
     }
@@ -1778,9 +1879,11 @@ mod x86 {
                     w.sy,
                     w.sz,
                 ];
-                for (lanes, e) in got.lanes.iter().zip(expected) {
-                    assert_eq!(lanes.map(f32::to_bits), [e.to_bits(); 4], "{ray:?}");
-                }
+                assert_eq!(
+                    got.frame.map(f32::to_bits),
+                    expected.map(f32::to_bits),
+                    "{ray:?}"
+                );
             }
             // Both outcomes of each test were met.
             assert!(
