@@ -5,6 +5,7 @@ use std::ops::{Add, AddAssign, Div, Index, Mul, MulAssign, Neg, Sub, SubAssign};
 
 /// A 3-vector of f32: a point, a direction or a linear RGB colour.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C)]
 pub struct Vec3 {
     pub x: f32,
     pub y: f32,

@@ -105,18 +105,7 @@ impl<'a> PacketRays<'a> {
                 valid |= 1 << l;
             }
         }
-        let mut p = PacketRays {
-            origin: [Lanes::INFINITY; 3],
-            inv_dir: [Lanes::INFINITY; 3],
-            t_min: Lanes::INFINITY,
-            t_max: Lanes::INFINITY,
-            axes: [[0; PACKET]; 3],
-            shear: [Lanes::INFINITY; 3],
-            shared_axes: None,
-            rays,
-            valid,
-            interval: None,
-        };
+        let mut p = PacketRays::empty(rays, valid);
         if valid == 0 {
             return p;
         }
@@ -182,6 +171,24 @@ impl<'a> PacketRays<'a> {
         }
         p.interval = interval(&p.origin, &p.inv_dir, &p.t_min);
         p
+    }
+
+    /// Every field at its start value (+∞ lanes, zero axes, no shared axes, no interval):
+    /// what `new` gives where no lane is valid.
+    #[inline(always)]
+    pub fn empty(rays: &'a [Ray; PACKET], valid: u32) -> PacketRays<'a> {
+        PacketRays {
+            origin: [Lanes::INFINITY; 3],
+            inv_dir: [Lanes::INFINITY; 3],
+            t_min: Lanes::INFINITY,
+            t_max: Lanes::INFINITY,
+            axes: [[0; PACKET]; 3],
+            shear: [Lanes::INFINITY; 3],
+            shared_axes: None,
+            rays,
+            valid,
+            interval: None,
+        }
     }
 
     /// Ray `l`'s slab-test constants, as `BoxPlanes::new` makes them.
@@ -263,6 +270,12 @@ fn interval(origin: &[Lanes; 3], inv_dir: &[Lanes; 3], t_min: &Lanes) -> Option<
 
 /// The tests of a packet traversal (scalar here, AVX2 in `simd.rs`).
 pub(crate) trait PacketKernel {
+    /// The packet's constants (`PacketRays::new`, which the AVX2 kernel computes on eight
+    /// lanes at once).
+    #[inline(always)]
+    fn rays<'a>(&self, rays: &'a [Ray; PACKET], lanes: u8) -> PacketRays<'a> {
+        PacketRays::new(rays, lanes)
+    }
     /// A superset of the children of `node` that some ray in `lanes` enters within its
     /// `t_max` (all children when the packet has no interval bounds).
     fn candidates(&self, node: &WideNode, p: &PacketRays, lanes: u32, t_max: &Lanes) -> u32;
@@ -520,7 +533,7 @@ pub(crate) fn intersect<K: PacketKernel, S: PacketStack>(
     lanes: u8,
     stack: &mut S,
 ) -> [Option<LocalHit>; PACKET] {
-    let p = PacketRays::new(rays, lanes);
+    let p = kernel.rays(rays, lanes);
     if p.interval.is_none() {
         // Not coherent (direction signs differ): ray by ray, which costs less than testing
         // each child of each node exactly for the packet (as Embree's hybrid traversal does).
@@ -560,7 +573,7 @@ pub(crate) fn occluded<K: PacketKernel, S: PacketStack>(
     lanes: u8,
     stack: &mut S,
 ) -> u8 {
-    let p = PacketRays::new(rays, lanes);
+    let p = kernel.rays(rays, lanes);
     if p.interval.is_none() {
         // Not coherent: ray by ray, as in `intersect`.
         return (0..PACKET)
