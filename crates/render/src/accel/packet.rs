@@ -609,7 +609,7 @@ pub(crate) fn closest<K: PacketKernel, S: PacketStack>(
             let node = &bvh.nodes[current.0 as usize];
             let mut candidates = kernel.candidates(node, p, active, &best_t);
             // Entered children sorted by key, farthest first: (key, slot, rays).
-            let mut sorted = [(0.0f32, 0u8, 0u32); WIDTH];
+            let mut sorted = [(0.0f32, 0u32, 0u32); WIDTH];
             let mut n = 0;
             while candidates != 0 {
                 let i = candidates.trailing_zeros() as usize;
@@ -618,7 +618,7 @@ pub(crate) fn closest<K: PacketKernel, S: PacketStack>(
                 if entered == 0 {
                     continue;
                 }
-                let item = (kernel.min_lane(&entries[i]), i as u8, entered);
+                let item = (kernel.min_lane(&entries[i]), i as u32, entered);
                 let mut k = n;
                 while k > 0 && sorted[k - 1].0 < item.0 {
                     sorted[k] = sorted[k - 1];

@@ -1683,12 +1683,17 @@ mod x86 {
             lo | hi << 32
         };
         let axes = [bytes(kx), bytes(ky), bytes(kz)];
-        p.axes = axes.map(u64::to_le_bytes);
+        p.axes = [
+            axes[0].to_le_bytes(),
+            axes[1].to_le_bytes(),
+            axes[2].to_le_bytes(),
+        ];
         if axes
             .iter()
             .all(|&v| v == (v & 0xff) * 0x0101_0101_0101_0101)
         {
-            p.shared_axes = Some(axes.map(|v| (v & 0xff) as usize));
+            let first = |v: u64| (v & 0xff) as usize;
+            p.shared_axes = Some([first(axes[0]), first(axes[1]), first(axes[2])]);
         }
         p.interval = packet_interval([ox, oy, oz], inv, t_min);
         p
@@ -1697,6 +1702,7 @@ mod x86 {
     /// `packet::interval` on lanes: the same fields, bit for bit.
     #[target_feature(enable = "avx2,fma")]
     #[inline]
+    #[allow(clippy::needless_range_loop)] // Axis-indexed loops over several arrays at once.
     fn packet_interval(origin: [__m256; 3], inv: [__m256; 3], t_min: __m256) -> Option<Interval> {
         // Minima and maxima over the lanes as the scalar folds find them: the first lane
         // holding the extreme value (of +0 and −0, which compare equal, the earlier).
@@ -1713,7 +1719,16 @@ mod x86 {
         }
         let lo = |v: __m256| first_equal(v, spread!(_mm256_min_ps, v));
         let hi = |v: __m256| first_equal(v, spread!(_mm256_max_ps, v));
-        let mut positive = [false; 3];
+        // Array `map`s and `from_fn`s here were calls, not inlined: plain loops instead.
+        let mut iv = Interval {
+            near: [0; 3],
+            far: [0; 3],
+            origin_near: [0.0; 3],
+            origin_far: [0.0; 3],
+            inv_lo: [0.0; 3],
+            inv_hi: [0.0; 3],
+            t_min_lo: 0.0,
+        };
         for a in 0..3 {
             let (l, h) = (lo(inv[a]), hi(inv[a]));
             if !(l.is_finite() && h.is_finite()) {
@@ -1722,18 +1737,21 @@ mod x86 {
             if l.is_sign_negative() != h.is_sign_negative() || l == 0.0 || h == 0.0 {
                 return None;
             }
-            positive[a] = l > 0.0;
+            (iv.inv_lo[a], iv.inv_hi[a]) = (l, h);
         }
-        let (o_lo, o_hi) = (origin.map(lo), origin.map(hi));
-        Some(Interval {
-            near: std::array::from_fn(|a| if positive[a] { a } else { a + 3 }),
-            far: std::array::from_fn(|a| if positive[a] { a + 3 } else { a }),
-            origin_near: std::array::from_fn(|a| if positive[a] { o_hi[a] } else { o_lo[a] }),
-            origin_far: std::array::from_fn(|a| if positive[a] { o_lo[a] } else { o_hi[a] }),
-            inv_lo: inv.map(lo),
-            inv_hi: inv.map(hi),
-            t_min_lo: lo(t_min),
-        })
+        for a in 0..3 {
+            // (plane − o)·inv falls as o grows when inv > 0 and rises when inv < 0.
+            let (o_lo, o_hi) = (lo(origin[a]), hi(origin[a]));
+            if iv.inv_lo[a] > 0.0 {
+                (iv.near[a], iv.far[a]) = (a, a + 3);
+                (iv.origin_near[a], iv.origin_far[a]) = (o_hi, o_lo);
+            } else {
+                (iv.near[a], iv.far[a]) = (a + 3, a);
+                (iv.origin_near[a], iv.origin_far[a]) = (o_lo, o_hi);
+            }
+        }
+        iv.t_min_lo = lo(t_min);
+        Some(iv)
     }
 
     #[target_feature(enable = "avx2,fma")]
