@@ -583,8 +583,9 @@ mod x86 {
     /// with its axes as row offsets; `woop` rebuilds the scalar form for blocks with a zero
     /// edge function. Kept in memory and broadcast from there by each block test (one load
     /// each, as a register spilled would take): made this way, the set-up is three lane
-    /// permutations and two stores, where broadcasting the six values once took some sixty
-    /// instructions a ray, spills included (bench/README, issue 14, tenth pass).
+    /// permutations and two stores, where picking each value into a register of its own and
+    /// spilling them all took some 75 instructions a ray (bunny bounce rays: 895 instructions
+    /// a ray before, 858 after; bench/README, issue 14, tenth pass).
     #[repr(C, align(16))]
     struct TriRay {
         // `lanes` reads `origin` and `shear` by their offsets: keep them first, in this order.
