@@ -9,6 +9,7 @@ pub const SPAWN_EPSILON: f32 = 1e-3;
 /// A ray `origin + t * direction` valid for t in `[t_min, t_max]`. The direction is not
 /// necessarily unit length (the lecture's camera rays are not, and instanced rays keep the
 /// world t by not re-normalising), so t is a parameter, not a distance.
+///
 /// `repr(C)`: eight consecutive f32, which the AVX2 packet kernel loads as one row per ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]

@@ -6,9 +6,10 @@
 //! as well (`closest_evex`, `any_evex`: the same code with 32 vector registers) for CPUs that
 //! have them (`Avx2::evex`). The AVX2 walks test a node's boxes with fused multiply-adds and
 //! per-axis margins (`SlabMargin`) where a ray allows it: with 16 registers the checked test's
-//! constants did not fit, and were reloaded at every node. Likewise for packets of eight rays (`packet.rs`): the
-//! packet against one child box (lanes are rays), the interval test of a packet against all
-//! eight children (lanes are children), and the packet traversal instantiated for AVX2.
+//! constants did not fit, and were reloaded at every node. Likewise for packets of eight rays
+//! (`packet.rs`): the packet's constants made on eight lanes (`packet_rays`), the packet
+//! against one child box (lanes are rays), the interval test of a packet against all eight
+//! children (lanes are children), and the packet traversal instantiated for AVX2.
 //!
 //! This is one of the two modules of glint-render allowed `unsafe` (DESIGN.md, Tooling; the
 //! other is `pages.rs`, one `madvise`): calling
@@ -148,8 +149,8 @@ pub(crate) fn margin_node(
 
 /// What the AVX2 kernel's per-ray set-up makes of `ray`, in the scalar forms: `None` for a
 /// ray it rejects, else the box test's planes (with t_min as the kernel holds it), its far
-/// reciprocals and short-path flag, the watertight test's `WoopRay`, and the triangle test's
-/// broadcast lanes (origin[kx], origin[ky], origin[kz], sx, sy, sz). For the test that
+/// reciprocals and short-path flag, the watertight test's `WoopRay`, and the values the
+/// triangle test broadcasts (origin[kx], origin[ky], origin[kz], sx, sy, sz). For the test that
 /// compares them with `BoxPlanes::new` and `WoopRay::new`.
 #[cfg(test)]
 pub(crate) fn prepared(avx2: Avx2, ray: &Ray) -> Option<x86::Prepared> {
@@ -576,8 +577,9 @@ mod x86 {
     // `Kernel` methods stayed an out-of-line call in the traversal loop (the profile showed
     // `node_test` and `block_test` as functions of their own, with the per-ray constants
     // reloaded from memory at every call). Forced inline into `closest`/`any`, which carry
-    // the features, their intrinsics are compiled for AVX2 there, with the ray's constants
-    // in registers for the whole walk. Hence `unsafe`: they must only be reached from there.
+    // the features, their intrinsics are compiled for AVX2 there, with the box test's
+    // constants in registers for the whole walk (the triangle test's are loaded where they are
+    // used, `TriRay`). Hence `unsafe`: they must only be reached from there.
 
     /// Per-ray constants of the watertight test (`WoopRay`'s) in the sheared frame's order,
     /// with its axes as row offsets; `woop` rebuilds the scalar form for blocks with a zero
@@ -596,6 +598,11 @@ mod x86 {
         /// kx, ky, kz as byte offsets of a corner's rows in a `TriangleBlock` (16 per axis).
         rows: [usize; 3],
     }
+
+    // `TriRay::lanes` reads `origin` and `shear` at these offsets.
+    const _: () = assert!(
+        std::mem::offset_of!(TriRay, origin) == 0 && std::mem::offset_of!(TriRay, shear) == 16
+    );
 
     impl TriRay {
         /// The constants of a `WoopRay` at hand (a packet's ray taken alone).
@@ -619,9 +626,9 @@ mod x86 {
         #[inline(always)]
         unsafe fn lanes(&self) -> [__m128; 6] {
             let (ox, oy, oz, sx, sy, sz): (__m128, __m128, __m128, __m128, __m128, __m128);
-            // SAFETY: reads 12 bytes at each of `origin` and `shear` (the asm's only memory
-            // access; `shear` is 16 bytes after `origin` in this `repr(C)` struct) and writes
-            // only its outputs; the caller runs with AVX.
+            // SAFETY: reads 12 bytes at each of `origin` and `shear` (offsets 0 and 16 of this
+            // `repr(C)` struct, its only memory access) and writes only its outputs; the
+            // caller runs with AVX.
             unsafe {
                 std::arch::asm!(
                     "vbroadcastss {ox}, dword ptr [{p}]",
@@ -630,7 +637,7 @@ mod x86 {
                     "vbroadcastss {sx}, dword ptr [{p} + 16]",
                     "vbroadcastss {sy}, dword ptr [{p} + 20]",
                     "vbroadcastss {sz}, dword ptr [{p} + 24]",
-                    p = in(reg) self.origin.as_ptr(),
+                    p = in(reg) self as *const TriRay,
                     ox = lateout(xmm_reg) ox,
                     oy = lateout(xmm_reg) oy,
                     oz = lateout(xmm_reg) oz,
@@ -810,8 +817,8 @@ mod x86 {
     /// `WoopRay::new` for a ray `prepare_box` passed, with its origin, direction and
     /// reciprocals: the major axis from `WoopRay::axes`' comparisons (made on four lanes at
     /// once), the frame from `FRAMES`, the lanes permuted into its order once, then
-    /// sz = 1/d[kz] (`prepare_box`'s division), sx = d[kx]·sz, sy = d[ky]·sz, each broadcast
-    /// from its lane.
+    /// sz = 1/d[kz] (`prepare_box`'s division), sx = d[kx]·sz, sy = d[ky]·sz, stored for the
+    /// block tests to broadcast (`TriRay::lanes`).
     ///
     /// # Safety
     /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
@@ -1973,8 +1980,6 @@ mod x86 {
         )
     }
 
-    /// The per-ray constants `prepare_box` and `prepare_tri` make, against the scalar
-    /// constructors, bit for bit.
     /// `packet_rays`, for the test that compares it with `PacketRays::new`.
     ///
     /// # Safety
@@ -1985,6 +1990,9 @@ mod x86 {
         packet_rays(rays, lanes)
     }
 
+    /// The per-ray constants `prepare_box` and `prepare_tri` make, against the scalar
+    /// constructors, bit for bit; the packet set-up against `PacketRays::new`; the margin box
+    /// tests against the scalar kernel's.
     #[cfg(test)]
     mod tests {
         use crate::accel::isa::Avx2;
