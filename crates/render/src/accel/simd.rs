@@ -364,16 +364,24 @@ mod x86 {
         }
     }
 
-    /// A traversal stack that is not cleared for every ray (it is 3 KB).
+    /// A traversal stack that is not cleared for every ray (4 KB), its positions taken modulo
+    /// its length, a power of two, so that no access is bounds-checked: the walks use
+    /// positions below `STACK_SIZE` (at most 7 entries a level, and the build caps the depth),
+    /// which the mask leaves as they are. The checks it replaces were a compare and a branch
+    /// at every push and at every step of the sorted insertion (bench/README, issue 14,
+    /// eleventh pass).
     struct UninitStack {
-        entries: [MaybeUninit<(u32, f32)>; STACK_SIZE],
+        entries: [MaybeUninit<(u32, f32)>; UNINIT_STACK],
     }
+
+    /// `UninitStack`'s length: `STACK_SIZE` rounded up to a power of two.
+    const UNINIT_STACK: usize = STACK_SIZE.next_power_of_two();
 
     impl UninitStack {
         #[inline(always)]
         fn new() -> Self {
             UninitStack {
-                entries: [const { MaybeUninit::uninit() }; STACK_SIZE],
+                entries: [const { MaybeUninit::uninit() }; UNINIT_STACK],
             }
         }
     }
@@ -381,12 +389,15 @@ mod x86 {
     impl Stack for UninitStack {
         #[inline(always)]
         fn set(&mut self, i: usize, child: u32, entry: f32) {
-            self.entries[i] = MaybeUninit::new((child, entry));
+            debug_assert!(i < STACK_SIZE);
+            self.entries[i & (UNINIT_STACK - 1)] = MaybeUninit::new((child, entry));
         }
         #[inline(always)]
         fn get(&self, i: usize) -> (u32, f32) {
-            // SAFETY: the walks (`wide::closest`, `wide::any`) read only entries they wrote.
-            unsafe { self.entries[i].assume_init() }
+            debug_assert!(i < STACK_SIZE);
+            // SAFETY: the walks (`wide::closest`, `wide::any`) read only positions they wrote,
+            // and position i is always the same entry (i mod UNINIT_STACK).
+            unsafe { self.entries[i & (UNINIT_STACK - 1)].assume_init() }
         }
     }
 
@@ -538,23 +549,20 @@ mod x86 {
 
         #[inline(always)]
         fn prefetch(&self, bvh: &WideBvh, child: ChildRef) {
+            // The addresses are not bounds-checked (a prefetch never faults, wherever it
+            // points): two instructions fewer for each child pushed.
             let (lines, bytes): (*const i8, usize) = if !child.is_leaf() {
-                match bvh.nodes.get(child.0 as usize) {
-                    Some(node) => ((node as *const WideNode).cast(), 256),
-                    None => return,
-                }
+                let node = bvh.nodes.as_ptr().wrapping_add(child.0 as usize);
+                (node.cast(), 256)
             } else if child != ChildRef::EMPTY && !child.is_shapes() {
-                match bvh.blocks.get(child.range().0) {
-                    Some(block) => ((block as *const TriangleBlock).cast(), 144),
-                    None => return,
-                }
+                let block = bvh.blocks.as_ptr().wrapping_add(child.range().0);
+                (block.cast(), 144)
             } else {
                 return;
             };
             let mut offset = 0;
             while offset < bytes {
-                // SAFETY: a prefetch never faults; the addresses lie inside `nodes` or
-                // `blocks` (the last line may reach past the element, still harmless).
+                // SAFETY: a prefetch never faults and reads nothing the program sees.
                 unsafe { _mm_prefetch::<_MM_HINT_T0>(lines.wrapping_add(offset)) };
                 offset += 64;
             }
