@@ -880,7 +880,7 @@ impl Builder {
                     if r.is_leaf() {
                         r
                     } else {
-                        ChildRef::node(r.0 + offset)
+                        ChildRef::node(r.index() as u32 + offset)
                     }
                 };
                 for mut node in sub.nodes {

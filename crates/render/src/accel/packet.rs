@@ -307,6 +307,11 @@ pub(crate) trait PacketKernel {
     ) -> u32;
     /// The rays of `lanes` that meet any triangle of the block within their window.
     fn block_any(&self, block: &TriangleBlock, p: &PacketRays, lanes: u32) -> u32;
+    /// The inner node `child` refers to (as `Kernel::node_at`).
+    #[inline(always)]
+    fn node_at<'a>(&self, bvh: &'a WideBvh, child: ChildRef) -> &'a WideNode {
+        &bvh.nodes[child.index()]
+    }
     /// The kernel's single-ray closest hit (`wide::closest`).
     fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit>;
     /// The kernel's single-ray any hit (`wide::any`).
@@ -606,7 +611,7 @@ pub(crate) fn closest<K: PacketKernel, S: PacketStack>(
     }
     loop {
         if !current.is_leaf() {
-            let node = &bvh.nodes[current.0 as usize];
+            let node = kernel.node_at(bvh, current);
             let mut candidates = kernel.candidates(node, p, active, &best_t);
             // Entered children sorted by key, farthest first: (key, slot, rays).
             let mut sorted = [(0.0f32, 0u32, 0u32); WIDTH];
@@ -718,7 +723,7 @@ pub(crate) fn any<K: PacketKernel, S: PacketStack>(
     }
     loop {
         if !current.is_leaf() {
-            let node = &bvh.nodes[current.0 as usize];
+            let node = kernel.node_at(bvh, current);
             let mut candidates = kernel.candidates(node, p, active, &p.t_max);
             let mut next: Option<(u32, u32)> = None;
             while candidates != 0 {

@@ -401,6 +401,39 @@ mod x86 {
         }
     }
 
+    /// `Kernel::node_at` (and `PacketKernel::node_at`) for the AVX2 walks: `child.0 · 8` is
+    /// the node's byte offset (`ChildRef::index`), one scaled index in the address instead of
+    /// a shift and an add on the walk's critical path (the next node's address waits on the
+    /// child reference's load). One check covers both the index and the five zero bits below
+    /// it: rotated right by five, any of those bits set lands in bits 59-63, beyond every
+    /// length.
+    #[inline(always)]
+    fn node_at(bvh: &WideBvh, child: ChildRef) -> &WideNode {
+        let offset = child.0 as usize;
+        if (offset as u64).rotate_right(5) >= bvh.nodes.len() as u64 {
+            node_out_of_range(child);
+        }
+        // SAFETY: offset is 32 times an index below `nodes.len()` (checked above), so
+        // offset · 8 is the byte offset of that node, in bounds and aligned.
+        unsafe {
+            &*bvh
+                .nodes
+                .as_ptr()
+                .cast::<u8>()
+                .add(offset * 8)
+                .cast::<WideNode>()
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn node_out_of_range(child: ChildRef) -> ! {
+        panic!(
+            "BVH child reference {:#x} is not a node of the tree",
+            child.0
+        )
+    }
+
     /// The byte offsets in `WideNode::bounds` of the near and far rows of x, y and z.
     struct SlabRows {
         near: [usize; 3],
@@ -552,7 +585,11 @@ mod x86 {
             // The addresses are not bounds-checked (a prefetch never faults, wherever it
             // points): two instructions fewer for each child pushed.
             let (lines, bytes): (*const i8, usize) = if !child.is_leaf() {
-                let node = bvh.nodes.as_ptr().wrapping_add(child.0 as usize);
+                let node = bvh
+                    .nodes
+                    .as_ptr()
+                    .cast::<u8>()
+                    .wrapping_add(child.0 as usize * 8);
                 (node.cast(), 256)
             } else if child != ChildRef::EMPTY && !child.is_shapes() {
                 let block = bvh.blocks.as_ptr().wrapping_add(child.range().0);
@@ -566,6 +603,11 @@ mod x86 {
                 unsafe { _mm_prefetch::<_MM_HINT_T0>(lines.wrapping_add(offset)) };
                 offset += 64;
             }
+        }
+
+        #[inline(always)]
+        fn node_at<'a>(&self, bvh: &'a WideBvh, child: ChildRef) -> &'a WideNode {
+            node_at(bvh, child)
         }
 
         #[inline(always)]
@@ -1320,6 +1362,10 @@ mod x86 {
             hits
         }
 
+        #[inline(always)]
+        fn node_at<'a>(&self, bvh: &'a WideBvh, child: ChildRef) -> &'a WideNode {
+            node_at(bvh, child)
+        }
         #[inline(always)]
         fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
             // SAFETY: only reached from the packet walks' `target_feature(enable =
@@ -2278,6 +2324,68 @@ mod x86 {
                 extra * 1000 < scalar_entered,
                 "{extra} boxes entered in excess, {scalar_entered} by both"
             );
+        }
+
+        /// The AVX2 walks address a node by its reference times 8 (`node_at`): a reference
+        /// that is not 32 times a node index of the tree (a stray low bit, or past the end)
+        /// stops the walk with a message instead of reading elsewhere; well-formed ones reach
+        /// the node `ChildRef::index` names.
+        #[test]
+        fn nodes_are_reached_by_their_references_and_nothing_else() {
+            use crate::accel::wide::ChildRef;
+            use crate::geometry::Shape;
+            let Some(avx2) = avx2_or_skip() else {
+                return;
+            };
+            let mut rng = crate::testing::rng(11);
+            let shapes: Vec<Shape> = (0..500)
+                .map(|_| {
+                    let c = crate::testing::random_unit(&mut rng) * 4.0;
+                    Shape::Triangle {
+                        vertices: [
+                            c,
+                            c + Vec3::new(0.3, 0.0, 0.0),
+                            c + Vec3::new(0.0, 0.3, 0.1),
+                        ],
+                    }
+                })
+                .collect();
+            let mut bvh = crate::accel::build::build(&shapes);
+            assert!(bvh.nodes.len() > 8, "{}", bvh.nodes.len());
+            for (i, _) in bvh.nodes.iter().enumerate() {
+                let child = ChildRef::node(i as u32);
+                assert_eq!(child.index(), i);
+                assert!(std::ptr::eq(super::node_at(&bvh, child), &bvh.nodes[i]));
+            }
+            // At the first triangle's centroid, from afar.
+            let Shape::Triangle {
+                vertices: [a, b, c],
+            } = shapes[0]
+            else {
+                unreachable!()
+            };
+            let direction = Vec3::new(0.01, 0.02, 1.0);
+            let ray = Ray {
+                origin: (a + b + c) * (1.0 / 3.0) - direction * 20.0,
+                direction,
+                t_min: 0.0,
+                t_max: f32::INFINITY,
+            };
+            assert!(super::super::closest(avx2, &bvh, &ray).is_some());
+            let last = ChildRef::node(bvh.nodes.len() as u32 - 1).0;
+            for bad in [last + 1, last + 16, last + 32, u32::MAX >> 1] {
+                bvh.root = ChildRef(bad);
+                let walk = std::panic::catch_unwind(|| super::super::closest(avx2, &bvh, &ray));
+                let message = walk.expect_err("a corrupt reference must stop the walk");
+                let text = message
+                    .downcast_ref::<String>()
+                    .cloned()
+                    .unwrap_or_default();
+                assert!(
+                    text.contains("is not a node of the tree"),
+                    "{bad:#x}: {text}"
+                );
+            }
         }
 
         /// The `Avx2` proof covers AVX2 and FMA; AVX-512 only where `Avx2::evex` says so, and

@@ -6,7 +6,7 @@
 //! references. After Embree's `AABBNode` (`kernels/bvh/bvh_node_aabb.h`). Unused slots hold an
 //! empty box (min +∞, max −∞), which no ray enters.
 //!
-//! **Child references** are `u32`: an inner node's index, or a leaf (top bit set) holding a
+//! **Child references** are `u32`: an inner node's index times 32, or a leaf (top bit set) holding a
 //! range of up to 8 triangle blocks or up to 8 other shapes. See `ChildRef`.
 //!
 //! **Triangles** live in `TriangleBlock`s of four, vertices structure-of-arrays (144 bytes), so
@@ -117,9 +117,10 @@ impl TriangleBlock {
     }
 }
 
-/// A child reference: bit 31 clear, an inner node index; set, a leaf, with bit 30 telling
-/// triangle blocks (0) from shapes (1), bits 27-29 the count minus one (1 to 8 blocks or
-/// shapes) and bits 0-26 the first block or shape.
+/// A child reference: bit 31 clear, an inner node, its index times 32 (`index`: times 8 it is
+/// the node's byte offset, which the AVX2 walk adds to its row pointers in one address);
+/// set, a leaf, with bit 30 telling triangle blocks (0) from shapes (1), bits 27-29 the count
+/// minus one (1 to 8 blocks or shapes) and bits 0-26 the first block or shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ChildRef(pub u32);
 
@@ -129,9 +130,18 @@ impl ChildRef {
     const SHAPES: u32 = 1 << 30;
     pub const MAX_START: u32 = (1 << 27) - 1;
 
+    /// Inner nodes a tree may hold: 2²⁶ (16 GiB of nodes).
+    pub const MAX_NODES: u32 = Self::LEAF >> Self::NODE_SHIFT;
+    const NODE_SHIFT: u32 = 5;
+
     pub fn node(index: u32) -> ChildRef {
-        debug_assert!(index < Self::LEAF);
-        ChildRef(index)
+        assert!(index < Self::MAX_NODES, "more than 2^26 BVH nodes");
+        ChildRef(index << Self::NODE_SHIFT)
+    }
+    /// The index of an inner node.
+    #[inline(always)]
+    pub fn index(self) -> usize {
+        (self.0 >> Self::NODE_SHIFT) as usize
     }
     pub fn triangles(first_block: u32, blocks: u32) -> ChildRef {
         debug_assert!((1..=8).contains(&blocks) && first_block <= Self::MAX_START);
@@ -341,6 +351,11 @@ pub(crate) trait Kernel {
     /// first triangle block may be fetched into the cache meanwhile.
     #[inline(always)]
     fn prefetch(&self, _bvh: &WideBvh, _child: ChildRef) {}
+    /// The inner node `child` refers to.
+    #[inline(always)]
+    fn node_at<'a>(&self, bvh: &'a WideBvh, child: ChildRef) -> &'a WideNode {
+        &bvh.nodes[child.index()]
+    }
 }
 
 /// A block's hit: its lane, t and barycentrics.
@@ -532,7 +547,7 @@ fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
     entry: &mut [f32; WIDTH],
 ) -> bool {
     while !current.is_leaf() {
-        let node = &bvh.nodes[current.0 as usize];
+        let node = kernel.node_at(bvh, *current);
         let mut mask = kernel.node(node, box_ray, t_max, entry);
         if mask == 0 {
             return false;
@@ -857,7 +872,7 @@ impl WideBvh {
             }
             stats.nodes += 1;
             stats.sah_cost += ratio(area);
-            let node = &self.nodes[child.0 as usize];
+            let node = &self.nodes[child.index()];
             for slot in 0..WIDTH {
                 let area = node.child_bounds(slot).half_area();
                 stack.push((ChildRef(node.children[slot]), area, above + 1));
