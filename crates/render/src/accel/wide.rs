@@ -6,8 +6,8 @@
 //! references. After Embree's `AABBNode` (`kernels/bvh/bvh_node_aabb.h`). Unused slots hold an
 //! empty box (min +∞, max −∞), which no ray enters.
 //!
-//! **Child references** are `u32`: an inner node's index times 32, or a leaf (top bit set) holding a
-//! range of up to 8 triangle blocks or up to 8 other shapes. See `ChildRef`.
+//! **Child references** are `u32`: an inner node's index times 32, or a leaf (top bit set)
+//! holding a range of up to 8 triangle blocks or up to 8 other shapes. See `ChildRef`.
 //!
 //! **Triangles** live in `TriangleBlock`s of four, vertices structure-of-arrays (144 bytes), so
 //! one SIMD pass tests a whole block with the watertight test of `triangle.rs`. A leaf's blocks
@@ -118,7 +118,7 @@ impl TriangleBlock {
 }
 
 /// A child reference: bit 31 clear, an inner node, its index times 32 (`index`: times 8 it is
-/// the node's byte offset, which the AVX2 walk adds to its row pointers in one address);
+/// the node's byte offset, which the AVX2 walks add to the nodes' base in one scaled address);
 /// set, a leaf, with bit 30 telling triangle blocks (0) from shapes (1), bits 27-29 the count
 /// minus one (1 to 8 blocks or shapes) and bits 0-26 the first block or shape.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
