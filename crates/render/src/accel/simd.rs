@@ -2352,7 +2352,7 @@ mod x86 {
                 .collect();
             let mut bvh = crate::accel::build::build(&shapes);
             assert!(bvh.nodes.len() > 8, "{}", bvh.nodes.len());
-            for (i, _) in bvh.nodes.iter().enumerate() {
+            for i in 0..bvh.nodes.len() {
                 let child = ChildRef::node(i as u32);
                 assert_eq!(child.index(), i);
                 assert!(std::ptr::eq(super::node_at(&bvh, child), &bvh.nodes[i]));

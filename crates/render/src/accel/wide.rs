@@ -131,7 +131,7 @@ impl ChildRef {
     pub const MAX_START: u32 = (1 << 27) - 1;
 
     /// Inner nodes a tree may hold: 2²⁶ (16 GiB of nodes).
-    pub const MAX_NODES: u32 = Self::LEAF >> Self::NODE_SHIFT;
+    const MAX_NODES: u32 = Self::LEAF >> Self::NODE_SHIFT;
     const NODE_SHIFT: u32 = 5;
 
     pub fn node(index: u32) -> ChildRef {
