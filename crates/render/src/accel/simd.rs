@@ -150,13 +150,15 @@ pub(crate) fn margin_node(
 /// What the AVX2 kernel's per-ray set-up makes of `ray`, in the scalar forms: `None` for a
 /// ray it rejects, else the box test's planes (with t_min as the kernel holds it), its far
 /// reciprocals and short-path flag, the watertight test's `WoopRay`, and the values the
-/// triangle test broadcasts (origin[kx], origin[ky], origin[kz], sx, sy, sz). For the test that
-/// compares them with `BoxPlanes::new` and `WoopRay::new`.
+/// triangle test broadcasts (origin[kx], origin[ky], origin[kz], sx, sy, sz). With a
+/// `magnitude`, the set-up of the AVX2 walks (`MARGIN`) in a tree of that magnitude, which
+/// also makes the margin test's constants for the rays it serves; without, the AVX-512 walks'.
+/// For the test that compares them with `BoxPlanes::new` and `WoopRay::new`.
 #[cfg(test)]
-pub(crate) fn prepared(avx2: Avx2, ray: &Ray) -> Option<x86::Prepared> {
+pub(crate) fn prepared(avx2: Avx2, ray: &Ray, magnitude: Option<f32>) -> Option<x86::Prepared> {
     let _ = avx2;
     // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
-    unsafe { x86::prepared(ray) }
+    unsafe { x86::prepared(ray, magnitude) }
 }
 
 /// `Binner::bin` on the three axes at once for a primitive with box rows `lo`, `hi` (lane 3
@@ -734,7 +736,9 @@ mod x86 {
     /// more per ray. Volatile reads are never merged.
     ///
     /// With `MARGIN`, also the margin test's constants (`SlabMargin`) for a ray it serves,
-    /// `magnitude` bounding the tree's planes (`WideBvh::magnitude`).
+    /// `magnitude` bounding the tree's planes (`WideBvh::magnitude`). Those rays are told
+    /// apart by one test of two products first (see `served`), before any of the checks the
+    /// other rays take: nearly every ray is one of them.
     ///
     /// # Safety
     /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
@@ -755,14 +759,6 @@ mod x86 {
             let d = _mm_setr_ps(dx, dy, dz, 1.0);
             let abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
             let abs = |v: __m128| _mm_and_ps(v, abs_mask);
-            let infinity = _mm_set1_ps(f32::INFINITY);
-            let finite = |v: __m128| _mm_cmplt_ps(abs(v), infinity);
-            // `ray_is_valid`: a finite origin and direction (NaN compares false), and
-            // t_min <= t_max.
-            #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            if _mm_movemask_ps(_mm_and_ps(finite(o), finite(d))) != 0b1111 || !(t_min <= t_max) {
-                return None;
-            }
             // `BoxPlanes::new`: 1/d per axis (the same IEEE division), the slab rows chosen
             // by the sign bits.
             let inv = _mm_div_ps(_mm_set1_ps(1.0), d);
@@ -773,38 +769,65 @@ mod x86 {
                     _mm256_broadcastss_ps(_mm_permute_ps::<{ $lane * 0b01_01_01_01 }>($v))
                 };
             }
-            let no_nan = _mm_movemask_ps(finite(inv)) == 0b1111 && t_min >= 0.0;
-            let mut margin = None;
-            if MARGIN && no_nan {
-                // Per axis K = (B + |o|) · |1/d| and m = 2⁻¹⁷ · K (lane 3 is padding).
+            // A macro, not a closure: a closure's body would be compiled without AVX2.
+            macro_rules! box_ray {
+                ($no_nan:expr, $margin:expr) => {
+                    BoxRay {
+                        origin: [wide!(o, 0), wide!(o, 1), wide!(o, 2)],
+                        inv_dir: [wide!(inv, 0), wide!(inv, 1), wide!(inv, 2)],
+                        rows: &SLAB_ROWS[sign],
+                        // `+ 0.0` turns -0 into +0 (equal as floats), whose bits are the least
+                        // non-negative integer, as the integer reductions need.
+                        t_min: _mm256_set1_ps(t_min + 0.0),
+                        no_nan: $no_nan,
+                        inv_far: [wide!(inv_far, 0), wide!(inv_far, 1), wide!(inv_far, 2)],
+                        o,
+                        d,
+                        inv,
+                        margin: $margin,
+                    }
+                };
+            }
+            if MARGIN {
+                // Per axis K = (B + |o|) · |1/d| (lane 3 is padding). The rays the margin test
+                // serves are exactly those with every K below f32::MAX / 4 (false for NaN,
+                // so the origin is finite and every 1/d too), every |d| · |1/d| below 2 (false
+                // for d = ±0, whose 1/d is infinite, for an infinite or NaN d, and for a d so
+                // small that 1/d overflows; about 1 otherwise: the direction is finite and each
+                // 1/d as well), and 0 ≤ t_min ≤ t_max: valid rays (`ray_is_valid`) with
+                // `BoxRay::no_nan`, as `SlabMargin` asks. No other ray is served, so the
+                // checks below, for the others, need not make the margins.
                 let k = _mm_mul_ps(_mm_add_ps(_mm_set1_ps(magnitude), abs(o)), abs(inv));
-                if _mm_movemask_ps(_mm_cmplt_ps(k, _mm_set1_ps(f32::MAX / 4.0))) == 0b1111 {
+                let unit = _mm_mul_ps(abs(d), abs(inv));
+                let served = _mm_and_ps(
+                    _mm_cmplt_ps(k, _mm_set1_ps(f32::MAX / 4.0)),
+                    _mm_cmplt_ps(unit, _mm_set1_ps(2.0)),
+                );
+                if _mm_movemask_ps(served) == 0b1111 && t_min >= 0.0 && t_min <= t_max {
+                    // m = 2⁻¹⁷ · K per axis, at least the least normal float.
                     let m = _mm_max_ps(
                         _mm_mul_ps(k, _mm_set1_ps(1.0 / 131_072.0)),
                         _mm_set1_ps(f32::MIN_POSITIVE),
                     );
                     let c = _mm_xor_ps(_mm_mul_ps(o, inv), _mm_set1_ps(-0.0));
                     let (near, far) = (_mm_sub_ps(c, m), _mm_add_ps(c, m));
-                    margin = Some(SlabMargin {
+                    let margin = SlabMargin {
                         near: [wide!(near, 0), wide!(near, 1), wide!(near, 2)],
                         far: [wide!(far, 0), wide!(far, 1), wide!(far, 2)],
-                    });
+                    };
+                    return Some(box_ray!(true, Some(margin)));
                 }
             }
-            Some(BoxRay {
-                origin: [wide!(o, 0), wide!(o, 1), wide!(o, 2)],
-                inv_dir: [wide!(inv, 0), wide!(inv, 1), wide!(inv, 2)],
-                rows: &SLAB_ROWS[sign],
-                // `+ 0.0` turns -0 into +0 (equal as floats), whose bits are the least
-                // non-negative integer, as the integer reductions need.
-                t_min: _mm256_set1_ps(t_min + 0.0),
-                no_nan,
-                inv_far: [wide!(inv_far, 0), wide!(inv_far, 1), wide!(inv_far, 2)],
-                o,
-                d,
-                inv,
-                margin,
-            })
+            let infinity = _mm_set1_ps(f32::INFINITY);
+            let finite = |v: __m128| _mm_cmplt_ps(abs(v), infinity);
+            // `ray_is_valid`: a finite origin and direction (NaN compares false), and
+            // t_min <= t_max.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
+            if _mm_movemask_ps(_mm_and_ps(finite(o), finite(d))) != 0b1111 || !(t_min <= t_max) {
+                return None;
+            }
+            let no_nan = _mm_movemask_ps(finite(inv)) == 0b1111 && t_min >= 0.0;
+            Some(box_ray!(no_nan, None))
         }
     }
 
@@ -1967,14 +1990,19 @@ mod x86 {
         pub woop: WoopRay,
         /// `TriRay`'s origin[kx], origin[ky], origin[kz], sx, sy, sz.
         pub frame: [f32; 6],
+        /// The margin test's near and far constants (`SlabMargin`), for a ray it serves.
+        pub margin: Option<[[f32; 3]; 2]>,
     }
 
     /// # Safety
     /// The CPU must have AVX2 and FMA.
     #[cfg(test)]
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn prepared(ray: &Ray) -> Option<Prepared> {
-        let b = prepare_box::<false>(ray, 0.0)?;
+    pub(super) unsafe fn prepared(ray: &Ray, magnitude: Option<f32>) -> Option<Prepared> {
+        let b = match magnitude {
+            Some(magnitude) => prepare_box::<true>(ray, magnitude)?,
+            None => prepare_box::<false>(ray, 0.0)?,
+        };
         let t = prepare_tri(&b);
         let first = |v: __m256| _mm256_cvtss_f32(v);
         Some(Prepared {
@@ -1996,6 +2024,7 @@ mod x86 {
                 t.shear[1],
                 t.shear[2],
             ],
+            margin: b.margin.map(|m| [m.near.map(first), m.far.map(first)]),
         })
     }
 
@@ -2080,7 +2109,7 @@ mod x86 {
                     for &c in &values[..9] {
                         let o = Vec3::new(values[(i + 3) % values.len()], c, a);
                         for d in [Vec3::new(a, b, c), Vec3::new(c, a, b), Vec3::new(b, c, a)] {
-                            for (t_min, t_max) in [(0.0, f32::INFINITY), (-0.0, 1.0), (1.0, 0.5)] {
+                            for (t_min, t_max) in [(0.0, f32::INFINITY), (-0.0, 1.0), (1.0, 0.5), (-1.0, 2.0)] {
                                 rays.push(Ray {
                                     origin: o,
                                     direction: d,
@@ -2128,8 +2157,15 @@ mod x86 {
             };
             let bits3 = |v: [f32; 3]| v.map(f32::to_bits);
             let (mut valid, mut short) = (0, 0);
-            for ray in rays() {
-                let got = prepared(avx2, &ray);
+            let (mut served, mut unserved) = (0, 0);
+            // The AVX-512 walks' set-up, then the AVX2 walks' in trees of these magnitudes
+            // (the last two leave some or all rays to the checked test).
+            let magnitudes = [None, Some(0.0), Some(10.0), Some(1.0e37), Some(f32::INFINITY)];
+            for (ray, magnitude) in rays()
+                .into_iter()
+                .flat_map(|ray| magnitudes.map(|m| (ray, m)))
+            {
+                let got = prepared(avx2, &ray, magnitude);
                 assert_eq!(got.is_some(), ray_is_valid(&ray), "{ray:?}");
                 let Some(got) = got else { continue };
                 valid += 1;
@@ -2147,6 +2183,26 @@ mod x86 {
                 let no_nan = p.inv_dir.iter().all(|c| c.is_finite()) && p.t_min >= 0.0;
                 assert_eq!(got.no_nan, no_nan, "{ray:?}");
                 short += usize::from(no_nan);
+                // `SlabMargin`: per axis K = (B + |o|) · |1/d| (and B itself for the padding
+                // lane), served where every K < f32::MAX / 4; m = max(2⁻¹⁷ · K, least normal);
+                // near −(o · 1/d) − m, far −(o · 1/d) + m.
+                let margin = magnitude.filter(|_| no_nan).and_then(|b| {
+                    let k = [0, 1, 2].map(|a| (b + p.origin[a].abs()) * p.inv_dir[a].abs());
+                    (k.iter().all(|&k| k < f32::MAX / 4.0) && b < f32::MAX / 4.0).then(|| {
+                        let m = k.map(|k| (k * (1.0 / 131_072.0)).max(f32::MIN_POSITIVE));
+                        let c = [0, 1, 2].map(|a| -(p.origin[a] * p.inv_dir[a]));
+                        [[0, 1, 2].map(|a| c[a] - m[a]), [0, 1, 2].map(|a| c[a] + m[a])]
+                    })
+                });
+                assert_eq!(
+                    got.margin.map(|m| m.map(bits3)),
+                    margin.map(|m| m.map(bits3)),
+                    "{ray:?} in a tree of magnitude {magnitude:?}"
+                );
+                if magnitude.is_some() {
+                    served += usize::from(margin.is_some());
+                    unserved += usize::from(margin.is_none());
+                }
                 let w = WoopRay::new(ray.origin, ray.direction);
                 let g = got.woop;
                 assert_eq!((g.kx, g.ky, g.kz), (w.kx, w.ky, w.kz), "{ray:?}");
@@ -2175,6 +2231,7 @@ mod x86 {
                 valid > 40_000 && short > 40_000 && short < valid,
                 "{valid} {short}"
             );
+            assert!(served > 40_000 && unserved > 40_000, "{served} {unserved}");
         }
 
         /// The AVX2 packet set-up against `PacketRays::new`: every field the same (compared
