@@ -831,45 +831,27 @@ mod x86 {
         }
     }
 
-    /// The sheared frame of `WoopRay::axes` by its major axis kz and the sign of d[kz]: entry
-    /// 2·kz + (d[kz] < 0) holds the lanes [kx, ky, kz, 3] (a lane permutation) and the byte
-    /// offsets of kx, ky and kz's rows in a corner of a `TriangleBlock`. kx and ky follow kz
-    /// cyclically, swapped where d[kz] is negative.
-    #[repr(C, align(16))]
+    /// The sheared frame of `WoopRay::axes`: the lanes [kx, ky, kz, 3] (a lane permutation) and
+    /// the byte offsets of kx, ky and kz's rows in a corner of a `TriangleBlock`. kx and ky
+    /// follow kz cyclically, swapped where d[kz] is negative.
+    #[repr(C, align(64))]
     struct Frame {
         lanes: [i32; 4],
         rows: [usize; 3],
     }
 
-    const FRAMES: [Frame; 6] = {
+    /// The frame by the comparisons `prepare_tri` makes, one load away (4 KB; an index into
+    /// a table of the six frames would put a second load on the path to the first block
+    /// test; 64-byte entries, so that the index is the key shifted): bits 0 and 1, |d0| ≥ |d1| and |d1| ≥ |d2|; bit 2, |d0| ≥ |d2|; bits 3 to 5, d0,
+    /// d1, d2 < 0. kz as `WoopRay::axes` picks it: 0 where |d0| is at least both others, else
+    /// 1 where |d1| ≥ |d2|, else 2.
+    const FRAMES: [Frame; 64] = {
         let mut table = [const {
             Frame {
                 lanes: [0; 4],
                 rows: [0; 3],
             }
-        }; 6];
-        let mut i = 0;
-        while i < 6 {
-            let kz = i / 2;
-            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
-            if i % 2 == 1 {
-                (kx, ky) = (ky, kx);
-            }
-            table[i] = Frame {
-                lanes: [kx as i32, ky as i32, kz as i32, 3],
-                rows: [kx * 4 * BLOCK, ky * 4 * BLOCK, kz * 4 * BLOCK],
-            };
-            i += 1;
-        }
-        table
-    };
-
-    /// The entry of `FRAMES` by the comparisons `prepare_tri` makes: bits 0 and 1, |d0| ≥ |d1|
-    /// and |d1| ≥ |d2|; bit 2, |d0| ≥ |d2|; bits 3 to 5, d0, d1, d2 < 0. kz as
-    /// `WoopRay::axes` picks it: 0 where |d0| is at least both others, else 1 where |d1| ≥ |d2|,
-    /// else 2.
-    const FRAME_OF: [u8; 64] = {
-        let mut table = [0; 64];
+        }; 64];
         let mut key = 0;
         while key < 64 {
             let x_major = key & 1 != 0 && key >> 2 & 1 != 0;
@@ -881,7 +863,14 @@ mod x86 {
             } else {
                 2
             };
-            table[key] = (2 * kz + (key >> 3 >> kz & 1)) as u8;
+            let (mut kx, mut ky) = ((kz + 1) % 3, (kz + 2) % 3);
+            if key >> 3 >> kz & 1 != 0 {
+                (kx, ky) = (ky, kx);
+            }
+            table[key] = Frame {
+                lanes: [kx as i32, ky as i32, kz as i32, 3],
+                rows: [kx * 4 * BLOCK, ky * 4 * BLOCK, kz * 4 * BLOCK],
+            };
             key += 1;
         }
         table
@@ -897,7 +886,7 @@ mod x86 {
     /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
     #[inline(always)]
     unsafe fn prepare_tri(box_ray: &BoxRay) -> TriRay {
-        // SAFETY: the caller runs with AVX2; `FRAMES` entries are 16-byte aligned.
+        // SAFETY: the caller runs with AVX2; `FRAMES` entries are 64-byte aligned.
         unsafe {
             let (o, d, inv) = (box_ray.o, box_ray.d, box_ray.inv);
             // |d| (lane 3: 1), against its lanes rotated by one and by two:
@@ -907,7 +896,7 @@ mod x86 {
             let ge_after = _mm_movemask_ps(_mm_cmpge_ps(a, _mm_permute_ps::<0b11_01_00_10>(a)));
             let below_zero = _mm_movemask_ps(_mm_cmplt_ps(d, _mm_setzero_ps()));
             let key = (ge_next & 0b11) | (ge_after & 1) << 2 | (below_zero & 0b111) << 3;
-            let frame = &FRAMES[FRAME_OF[key as usize] as usize];
+            let frame = &FRAMES[key as usize];
             let lanes = _mm_load_si128(frame.lanes.as_ptr().cast());
             let (o, d, inv) = (
                 _mm_permutevar_ps(o, lanes),
