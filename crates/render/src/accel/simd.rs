@@ -2098,7 +2098,9 @@ mod x86 {
                     for &c in &values[..9] {
                         let o = Vec3::new(values[(i + 3) % values.len()], c, a);
                         for d in [Vec3::new(a, b, c), Vec3::new(c, a, b), Vec3::new(b, c, a)] {
-                            for (t_min, t_max) in [(0.0, f32::INFINITY), (-0.0, 1.0), (1.0, 0.5), (-1.0, 2.0)] {
+                            for (t_min, t_max) in
+                                [(0.0, f32::INFINITY), (-0.0, 1.0), (1.0, 0.5), (-1.0, 2.0)]
+                            {
                                 rays.push(Ray {
                                     origin: o,
                                     direction: d,
@@ -2149,7 +2151,13 @@ mod x86 {
             let (mut served, mut unserved) = (0, 0);
             // The AVX-512 walks' set-up, then the AVX2 walks' in trees of these magnitudes
             // (the last two leave some or all rays to the checked test).
-            let magnitudes = [None, Some(0.0), Some(10.0), Some(1.0e37), Some(f32::INFINITY)];
+            let magnitudes = [
+                None,
+                Some(0.0),
+                Some(10.0),
+                Some(1.0e37),
+                Some(f32::INFINITY),
+            ];
             for (ray, magnitude) in rays()
                 .into_iter()
                 .flat_map(|ray| magnitudes.map(|m| (ray, m)))
@@ -2180,7 +2188,10 @@ mod x86 {
                     (k.iter().all(|&k| k < f32::MAX / 4.0) && b < f32::MAX / 4.0).then(|| {
                         let m = k.map(|k| (k * (1.0 / 131_072.0)).max(f32::MIN_POSITIVE));
                         let c = [0, 1, 2].map(|a| -(p.origin[a] * p.inv_dir[a]));
-                        [[0, 1, 2].map(|a| c[a] - m[a]), [0, 1, 2].map(|a| c[a] + m[a])]
+                        [
+                            [0, 1, 2].map(|a| c[a] - m[a]),
+                            [0, 1, 2].map(|a| c[a] + m[a]),
+                        ]
                     })
                 });
                 assert_eq!(
