@@ -769,7 +769,8 @@ mod x86 {
                     _mm256_broadcastss_ps(_mm_permute_ps::<{ $lane * 0b01_01_01_01 }>($v))
                 };
             }
-            // A macro, not a closure: a closure's body would be compiled without AVX2.
+            // A macro, not a closure: a closure is a function of its own, compiled without
+            // AVX2 where the compiler does not inline it (this one is large and used twice).
             macro_rules! box_ray {
                 ($no_nan:expr, $margin:expr) => {
                     BoxRay {
