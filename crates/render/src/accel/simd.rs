@@ -841,11 +841,11 @@ mod x86 {
         rows: [usize; 3],
     }
 
-    /// The frame by the comparisons `prepare_tri` makes, one load away (4 KB; an index into
-    /// a table of the six frames would put a second load on the path to the first block
-    /// test; 64-byte entries, so that the index is the key shifted): bits 0 and 1, |d0| ≥ |d1| and |d1| ≥ |d2|; bit 2, |d0| ≥ |d2|; bits 3 to 5, d0,
-    /// d1, d2 < 0. kz as `WoopRay::axes` picks it: 0 where |d0| is at least both others, else
-    /// 1 where |d1| ≥ |d2|, else 2.
+    /// The frame by the key of the comparisons `prepare_tri` makes: bits 0 and 1, |d0| ≥ |d1|
+    /// and |d1| ≥ |d2|; bit 2, |d0| ≥ |d2|; bits 3 to 5, d0, d1, d2 < 0. kz as `WoopRay::axes`
+    /// picks it: 0 where |d0| is at least both others, else 1 where |d1| ≥ |d2|, else 2. One
+    /// load away (4 KB; an index into a table of the six frames would put a second load on the
+    /// path to the first block test), in 64-byte entries so that the index is the key shifted.
     const FRAMES: [Frame; 64] = {
         let mut table = [const {
             Frame {
