@@ -150,12 +150,11 @@ pub(crate) fn margin_node(
 /// What the AVX2 kernel's per-ray set-up makes of `ray`, in the scalar forms: `None` for a
 /// ray it rejects, else the box test's planes (with t_min as the kernel holds it), its far
 /// reciprocals and short-path flag, the watertight test's `WoopRay`, and the values the
-/// triangle test broadcasts (origin[kx], origin[ky], origin[kz], sx, sy, sz). With a
-/// `magnitude`, the set-up of the AVX2 walks (`MARGIN`) in a tree of that magnitude, which
-/// also makes the margin test's constants for the rays it serves; without, the AVX-512 walks'.
+/// triangle test broadcasts (origin[kx], origin[ky], origin[kz], sx, sy, sz), and the margin
+/// test's constants for a ray it serves in a tree of that `magnitude` (an infinite one: none).
 /// For the test that compares them with `BoxPlanes::new` and `WoopRay::new`.
 #[cfg(test)]
-pub(crate) fn prepared(avx2: Avx2, ray: &Ray, magnitude: Option<f32>) -> Option<x86::Prepared> {
+pub(crate) fn prepared(avx2: Avx2, ray: &Ray, magnitude: f32) -> Option<x86::Prepared> {
     let _ = avx2;
     // SAFETY: `avx2` proves the CPU has AVX2 and FMA.
     unsafe { x86::prepared(ray, magnitude) }
@@ -299,7 +298,7 @@ mod x86 {
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn closest(bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
         // SAFETY: this function runs with AVX2 and FMA.
-        unsafe { walk_closest::<true>(bvh, ray) }
+        unsafe { walk_closest(bvh, ray) }
     }
 
     /// # Safety
@@ -307,20 +306,21 @@ mod x86 {
     #[target_feature(enable = "avx2,fma")]
     pub(super) unsafe fn any(bvh: &WideBvh, ray: &Ray) -> bool {
         // SAFETY: as above.
-        unsafe { walk_any::<true>(bvh, ray) }
+        unsafe { walk_any(bvh, ray) }
     }
 
     // The same two walks compiled with AVX-512F and AVX-512VL as well: the same intrinsics,
     // but EVEX-encoded with 32 vector registers, so that the per-ray constants of the box and
-    // triangle tests stay in registers (bench/README, issue 14, sixth pass). Only the names
-    // ending in `_evex` may carry these features (`only_evex_kernels_need_avx512`).
+    // triangle tests stay in registers (bench/README, issue 14, sixth pass; the margin box
+    // test since the thirteenth, 4-11 % faster there on a Xeon). Only the names ending in
+    // `_evex` may carry these features (`only_evex_kernels_need_avx512`).
 
     /// # Safety
     /// The CPU must have AVX2, FMA, AVX-512F and AVX-512VL.
     #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
     pub(super) unsafe fn closest_evex(bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
         // SAFETY: this function runs with AVX2, FMA and more.
-        unsafe { walk_closest::<false>(bvh, ray) }
+        unsafe { walk_closest(bvh, ray) }
     }
 
     /// # Safety
@@ -328,22 +328,20 @@ mod x86 {
     #[target_feature(enable = "avx2,fma,avx512f,avx512vl")]
     pub(super) unsafe fn any_evex(bvh: &WideBvh, ray: &Ray) -> bool {
         // SAFETY: as above.
-        unsafe { walk_any::<false>(bvh, ray) }
+        unsafe { walk_any(bvh, ray) }
     }
 
-    // The single-ray walks. With `MARGIN` (the AVX2 walks, 16 vector registers), rays that
-    // `SlabMargin` serves take its box test, the others the checked one; without (the
-    // AVX-512 walks, whose 32 registers hold the checked test's constants), every ray takes
-    // the checked test (bench/README, issue 14, ninth pass).
+    // The single-ray walks: rays that `SlabMargin` serves take its box test, the others the
+    // checked one (bench/README, issue 14, ninth pass), each in a walk of its own.
 
     /// # Safety
     /// Only inside the `target_feature` functions of this module.
     #[inline(always)]
-    unsafe fn walk_closest<const MARGIN: bool>(bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
+    unsafe fn walk_closest(bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
         // SAFETY: the caller runs with AVX2 and FMA.
-        let b = unsafe { prepare_box::<MARGIN>(ray, bvh.magnitude) }?;
+        let b = unsafe { prepare_box(ray, bvh.magnitude) }?;
         let stack = &mut UninitStack::new();
-        if MARGIN && b.margin.is_some() {
+        if b.margin.is_some() {
             wide::closest_prepared(&Avx2Kernel::<true>, bvh, ray, b, stack)
         } else {
             wide::closest_prepared(&Avx2Kernel::<false>, bvh, ray, b, stack)
@@ -353,13 +351,13 @@ mod x86 {
     /// # Safety
     /// As `walk_closest`.
     #[inline(always)]
-    unsafe fn walk_any<const MARGIN: bool>(bvh: &WideBvh, ray: &Ray) -> bool {
+    unsafe fn walk_any(bvh: &WideBvh, ray: &Ray) -> bool {
         // SAFETY: the caller runs with AVX2 and FMA.
-        let Some(b) = (unsafe { prepare_box::<MARGIN>(ray, bvh.magnitude) }) else {
+        let Some(b) = (unsafe { prepare_box(ray, bvh.magnitude) }) else {
             return false;
         };
         let stack = &mut UninitStack::new();
-        if MARGIN && b.margin.is_some() {
+        if b.margin.is_some() {
             wide::any_prepared(&Avx2Kernel::<true>, bvh, ray, b, stack)
         } else {
             wide::any_prepared(&Avx2Kernel::<false>, bvh, ray, b, stack)
@@ -545,7 +543,7 @@ mod x86 {
             // the tree's magnitude; a walk started through `wide::closest` or `wide::any` would
             // come here, and with an unknown (infinite) magnitude take the checked test.
             // SAFETY: only reached inside the `target_feature` functions above, with AVX2.
-            unsafe { prepare_box::<MARGIN>(ray, f32::INFINITY) }
+            unsafe { prepare_box(ray, f32::INFINITY) }
         }
 
         #[inline(always)]
@@ -735,15 +733,15 @@ mod x86 {
     /// two of them, cannot be forwarded from the store buffer: a stall of a dozen cycles or
     /// more per ray. Volatile reads are never merged.
     ///
-    /// With `MARGIN`, also the margin test's constants (`SlabMargin`) for a ray it serves,
-    /// `magnitude` bounding the tree's planes (`WideBvh::magnitude`). Those rays are told
-    /// apart by one test of two products first (see `served`), before any of the checks the
-    /// other rays take: nearly every ray is one of them.
+    /// Also the margin test's constants (`SlabMargin`) for a ray it serves, `magnitude`
+    /// bounding the tree's planes (`WideBvh::magnitude`; infinite: it serves no ray). Those
+    /// rays are told apart by one test of two products first (see `served`), before any of the
+    /// checks the other rays take: nearly every ray is one of them.
     ///
     /// # Safety
     /// Only inside the `target_feature(enable = "avx2,fma")` functions above.
     #[inline(always)]
-    unsafe fn prepare_box<const MARGIN: bool>(ray: &Ray, magnitude: f32) -> Option<BoxRay> {
+    unsafe fn prepare_box(ray: &Ray, magnitude: f32) -> Option<BoxRay> {
         // SAFETY: the caller runs with AVX2; each volatile read is of an f32 field of `ray`.
         unsafe {
             let f = |x: &f32| std::ptr::read_volatile(x);
@@ -789,35 +787,33 @@ mod x86 {
                     }
                 };
             }
-            if MARGIN {
-                // Per axis K = (B + |o|) · |1/d| (lane 3 is padding). The rays the margin test
-                // serves are exactly those with every K below f32::MAX / 4 (false for NaN,
-                // so the origin is finite and every 1/d too), every |d| · |1/d| below 2 (false
-                // for d = ±0, whose 1/d is infinite, for an infinite or NaN d, and for a d so
-                // small that 1/d overflows; about 1 otherwise: the direction is finite and each
-                // 1/d as well), and 0 ≤ t_min ≤ t_max: valid rays (`ray_is_valid`) with
-                // `BoxRay::no_nan`, as `SlabMargin` asks. No other ray is served, so the
-                // checks below, for the others, need not make the margins.
-                let k = _mm_mul_ps(_mm_add_ps(_mm_set1_ps(magnitude), abs(o)), abs(inv));
-                let unit = _mm_mul_ps(abs(d), abs(inv));
-                let served = _mm_and_ps(
-                    _mm_cmplt_ps(k, _mm_set1_ps(f32::MAX / 4.0)),
-                    _mm_cmplt_ps(unit, _mm_set1_ps(2.0)),
+            // Per axis K = (B + |o|) · |1/d| (lane 3 is padding). The rays the margin test
+            // serves are exactly those with every K below f32::MAX / 4 (false for NaN,
+            // so the origin is finite and every 1/d too), every |d| · |1/d| below 2 (false
+            // for d = ±0, whose 1/d is infinite, for an infinite or NaN d, and for a d so
+            // small that 1/d overflows; about 1 otherwise: the direction is finite and each
+            // 1/d as well), and 0 ≤ t_min ≤ t_max: valid rays (`ray_is_valid`) with
+            // `BoxRay::no_nan`, as `SlabMargin` asks. No other ray is served, so the
+            // checks below, for the others, need not make the margins.
+            let k = _mm_mul_ps(_mm_add_ps(_mm_set1_ps(magnitude), abs(o)), abs(inv));
+            let unit = _mm_mul_ps(abs(d), abs(inv));
+            let served = _mm_and_ps(
+                _mm_cmplt_ps(k, _mm_set1_ps(f32::MAX / 4.0)),
+                _mm_cmplt_ps(unit, _mm_set1_ps(2.0)),
+            );
+            if _mm_movemask_ps(served) == 0b1111 && t_min >= 0.0 && t_min <= t_max {
+                // m = 2⁻¹⁷ · K per axis, at least the least normal float.
+                let m = _mm_max_ps(
+                    _mm_mul_ps(k, _mm_set1_ps(1.0 / 131_072.0)),
+                    _mm_set1_ps(f32::MIN_POSITIVE),
                 );
-                if _mm_movemask_ps(served) == 0b1111 && t_min >= 0.0 && t_min <= t_max {
-                    // m = 2⁻¹⁷ · K per axis, at least the least normal float.
-                    let m = _mm_max_ps(
-                        _mm_mul_ps(k, _mm_set1_ps(1.0 / 131_072.0)),
-                        _mm_set1_ps(f32::MIN_POSITIVE),
-                    );
-                    let c = _mm_xor_ps(_mm_mul_ps(o, inv), _mm_set1_ps(-0.0));
-                    let (near, far) = (_mm_sub_ps(c, m), _mm_add_ps(c, m));
-                    let margin = SlabMargin {
-                        near: [wide!(near, 0), wide!(near, 1), wide!(near, 2)],
-                        far: [wide!(far, 0), wide!(far, 1), wide!(far, 2)],
-                    };
-                    return Some(box_ray!(true, Some(margin)));
-                }
+                let c = _mm_xor_ps(_mm_mul_ps(o, inv), _mm_set1_ps(-0.0));
+                let (near, far) = (_mm_sub_ps(c, m), _mm_add_ps(c, m));
+                let margin = SlabMargin {
+                    near: [wide!(near, 0), wide!(near, 1), wide!(near, 2)],
+                    far: [wide!(far, 0), wide!(far, 1), wide!(far, 2)],
+                };
+                return Some(box_ray!(true, Some(margin)));
             }
             let infinity = _mm_set1_ps(f32::INFINITY);
             let finite = |v: __m128| _mm_cmplt_ps(abs(v), infinity);
@@ -1383,13 +1379,13 @@ mod x86 {
         fn single_closest(&self, bvh: &WideBvh, ray: &Ray) -> Option<LocalHit> {
             // SAFETY: only reached from the packet walks' `target_feature(enable =
             // "avx2,fma")` functions.
-            unsafe { walk_closest::<true>(bvh, ray) }
+            unsafe { walk_closest(bvh, ray) }
         }
 
         #[inline(always)]
         fn single_any(&self, bvh: &WideBvh, ray: &Ray) -> bool {
             // SAFETY: as above.
-            unsafe { walk_any::<true>(bvh, ray) }
+            unsafe { walk_any(bvh, ray) }
         }
 
         #[inline(always)]
@@ -1988,11 +1984,8 @@ mod x86 {
     /// The CPU must have AVX2 and FMA.
     #[cfg(test)]
     #[target_feature(enable = "avx2,fma")]
-    pub(super) unsafe fn prepared(ray: &Ray, magnitude: Option<f32>) -> Option<Prepared> {
-        let b = match magnitude {
-            Some(magnitude) => prepare_box::<true>(ray, magnitude)?,
-            None => prepare_box::<false>(ray, 0.0)?,
-        };
+    pub(super) unsafe fn prepared(ray: &Ray, magnitude: f32) -> Option<Prepared> {
+        let b = prepare_box(ray, magnitude)?;
         let t = prepare_tri(&b);
         let first = |v: __m256| _mm256_cvtss_f32(v);
         Some(Prepared {
@@ -2032,7 +2025,7 @@ mod x86 {
         magnitude: f32,
         t_max: f32,
     ) -> Option<(u32, [f32; WIDTH])> {
-        let b = prepare_box::<true>(ray, magnitude)?;
+        let b = prepare_box(ray, magnitude)?;
         let m = b.margin?;
         let mut entry = [0.0; WIDTH];
         let mask = node_test_margin(node, &b, &m, t_max, &mut entry);
@@ -2150,15 +2143,9 @@ mod x86 {
             let bits3 = |v: [f32; 3]| v.map(f32::to_bits);
             let (mut valid, mut short) = (0, 0);
             let (mut served, mut unserved) = (0, 0);
-            // The AVX-512 walks' set-up, then the AVX2 walks' in trees of these magnitudes
-            // (the last two leave some or all rays to the checked test).
-            let magnitudes = [
-                None,
-                Some(0.0),
-                Some(10.0),
-                Some(1.0e37),
-                Some(f32::INFINITY),
-            ];
+            // The walks' set-up in trees of these magnitudes (the last two leave some or all
+            // rays to the checked test).
+            let magnitudes = [0.0, 10.0, 1.0e37, f32::INFINITY];
             for (ray, magnitude) in rays()
                 .into_iter()
                 .flat_map(|ray| magnitudes.map(|m| (ray, m)))
@@ -2184,7 +2171,7 @@ mod x86 {
                 // `SlabMargin`: per axis K = (B + |o|) · |1/d| (and B itself for the padding
                 // lane), served where every K < f32::MAX / 4; m = max(2⁻¹⁷ · K, least normal);
                 // near −(o · 1/d) − m, far −(o · 1/d) + m.
-                let margin = magnitude.filter(|_| no_nan).and_then(|b| {
+                let margin = Some(magnitude).filter(|_| no_nan).and_then(|b| {
                     let k = [0, 1, 2].map(|a| (b + p.origin[a].abs()) * p.inv_dir[a].abs());
                     (k.iter().all(|&k| k < f32::MAX / 4.0) && b < f32::MAX / 4.0).then(|| {
                         let m = k.map(|k| (k * (1.0 / 131_072.0)).max(f32::MIN_POSITIVE));
@@ -2200,10 +2187,8 @@ mod x86 {
                     margin.map(|m| m.map(bits3)),
                     "{ray:?} in a tree of magnitude {magnitude:?}"
                 );
-                if magnitude.is_some() {
-                    served += usize::from(margin.is_some());
-                    unserved += usize::from(margin.is_none());
-                }
+                served += usize::from(margin.is_some());
+                unserved += usize::from(margin.is_none());
                 let w = WoopRay::new(ray.origin, ray.direction);
                 let g = got.woop;
                 assert_eq!((g.kx, g.ky, g.kz), (w.kx, w.ky, w.kz), "{ray:?}");
