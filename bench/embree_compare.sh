@@ -28,6 +28,10 @@
 # converted to target/bench-rays/NAME.bin and ray files written there once and reused.
 # GLINT=PATH and EMBREE=PATH take binaries built elsewhere (a machine without cargo or g++, such
 # as the lent 16-core one): then nothing is built, and RAYS=DIR moves the ray files.
+# GLINT=A,B,... runs several glints side by side: in each round every glint's single rays run
+# (in alternating order from round to round) next to the same Embree run; the main table is A's
+# (with A's packets), and a second table gives every glint's single rays, their ratio to Embree's
+# single rays and to A's.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SHARED=${SHARED:-../shared}
@@ -45,6 +49,7 @@ if [ -z "${GLINT:-}" ]; then
   nice cargo build --release -q -p glint
   GLINT=target/release/glint
 fi
+FIRST_GLINT=${GLINT%%,*}
 EMBREE=${EMBREE:-target/embree_native}
 if [ ! -x "$EMBREE" ]; then
   if [ ! -f /usr/include/embree3/rtcore.h ] || ! command -v g++ >/dev/null; then
@@ -65,7 +70,7 @@ for mesh in "${MESHES[@]}"; do
   name=$(basename "${mesh%.*}")
   if [ -n "$ONLY" ] && [[ "$name" != *"$ONLY"* ]]; then continue; fi
   if [ ! -f "$RAYS/$name.random.rays" ]; then
-    "$GLINT" bench make-rays --mesh "$mesh" --out-dir "$RAYS" >&2
+    "$FIRST_GLINT" bench make-rays --mesh "$mesh" --out-dir "$RAYS" >&2
   fi
   if [ ! -f "$RAYS/$name.bin" ]; then
     python3 "$SHARED/bench/mesh_to_bin.py" "$mesh" "$RAYS/$name.bin" >&2
@@ -76,7 +81,9 @@ python3 -c 'import embreex' 2>/dev/null && HAVE_EMBREEX=1
 
 python3 - "$GLINT" "$EMBREE" "$RAYS" "$ROUNDS" "$REPEAT" "$ONLY" "$SETS" "$SHARED" "$HAVE_EMBREEX" "${MESHES[@]}" <<'PY'
 import json, os, statistics, subprocess, sys
-glint, embree, rays, rounds, repeat, only, sets, shared, have_embreex = sys.argv[1:10]
+glints, embree, rays, rounds, repeat, only, sets, shared, have_embreex = sys.argv[1:10]
+glints = glints.split(',')
+glint = glints[0]
 meshes = sys.argv[10:]
 rounds, repeat = max(1, int(rounds)), max(1, int(repeat))
 sets = sets.split(',')
@@ -98,8 +105,17 @@ for mesh in meshes:
         tfile = os.path.join(rays, f'{name}.{kind}.glint.t')
         common = ['--mesh', mesh, '--rays', rayfile, '--threads', '1', '--repeat', str(repeat)]
         f = {k: [] for k in ('single', 'pkt42', 'pkt81', 'e_single', 'e_stream', 'e_pkt8')}
+        each = {g: [] for g in glints}
         for r in range(rounds):
-            gj = run([glint, 'bench', 'rays'] + common + (['--write-t', tfile] if r == 0 else []))
+            for g in (glints if r % 2 == 0 else glints[::-1]):
+                j = run([g, 'bench', 'rays'] + common +
+                        (['--write-t', tfile] if r == 0 and g == glint else []))
+                each[g].append(j['mrays_per_s'])
+                if g == glint:
+                    gj = j
+                elif r == 0 and j['hits'] != gj['hits']:
+                    print(f'note: {name} {kind}: {g} {j["hits"]} hits, {glint} {gj["hits"]}',
+                          file=sys.stderr)
             f['single'].append(gj['mrays_per_s']); gb.append(gj['build_s'])
             if kind == 'primary':
                 f['pkt42'].append(run([glint, 'bench', 'rays'] + common + ['--packets'])['mrays_per_s'])
@@ -114,7 +130,7 @@ for mesh in meshes:
             agree = run(['python3', check, '--mesh', mesh, '--rays', rayfile, '--repeat', '1',
                          '--compare', tfile]).get('agree')
         m = {k: (med(v) if v else None) for k, v in f.items()}
-        rows.append((name, kind, gj['rays'], m, agree))
+        rows.append((name, kind, gj['rays'], m, agree, {g: med(v) for g, v in each.items()}))
         print(f'{name:16} {kind:8} glint {m["single"]:6.2f}  embree single {m["e_single"]:6.2f} '
               f'stream {m["e_stream"]:6.2f} packet8 {m["e_pkt8"]:6.2f}', file=sys.stderr)
 
@@ -131,7 +147,7 @@ print('G/E1: G single / E single; G/Ebest: G single / best of E single, stream, 
 print(f'{"mesh":16} {"rays":8} {"count":>8} {"G single":>8} {"G 4x2":>7} {"G 8x1":>7} {"E single":>8} '
       f'{"E stream":>8} {"E pkt8":>7} | {"G/E1":>5} {"G/Ebest":>7} {"pk/E8":>6} {"81/E8":>6} {"agree":>9}')
 ratios = {'G/E1': [], 'G/Ebest': [], 'pk/E8': [], '81/E8': []}
-for name, kind, n, m, agree in rows:
+for name, kind, n, m, agree, _ in rows:
     best = max(m['e_single'], m['e_stream'], m['e_pkt8'])
     r1, rb = m['single'] / m['e_single'], m['single'] / best
     rp = m['pkt42'] / m['e_pkt8'] if m['pkt42'] else None
@@ -155,4 +171,14 @@ for k, v in ratios.items():
         print(f'lowest {k} {min(v):.2f}', end='; ')
 print(f'highest build ratio {max(build_ratios):.2f}' if build_ratios else '')
 print('targets: G/E1 >= 1.0 on every set, pk/E8 >= 1.0 on primary rays, build ratio <= 1.0')
+if len(glints) > 1:
+    print()
+    print('Single rays of each glint, side by side (medians, Mrays/s; /E1: to Embree single, '
+          f'/A: to the first glint): ' + ', '.join(f'{chr(65 + i)} = {g}' for i, g in enumerate(glints)))
+    print(f'{"mesh":16} {"rays":8} ' + ' '.join(f'{chr(65 + i):>6} {"/E1":>5} {"/A":>5}'
+                                                for i in range(len(glints))))
+    for name, kind, n, m, agree, each in rows:
+        a = each[glint]
+        print(f'{name:16} {kind:8} ' + ' '.join(
+            f'{each[g]:6.2f} {each[g] / m["e_single"]:5.2f} {each[g] / a:5.3f}' for g in glints))
 PY
