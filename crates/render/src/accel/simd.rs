@@ -2171,16 +2171,16 @@ mod x86 {
                 // `SlabMargin`: per axis K = (B + |o|) · |1/d| (and B itself for the padding
                 // lane), served where every K < f32::MAX / 4; m = max(2⁻¹⁷ · K, least normal);
                 // near −(o · 1/d) − m, far −(o · 1/d) + m.
-                let margin = Some(magnitude).filter(|_| no_nan).and_then(|b| {
-                    let k = [0, 1, 2].map(|a| (b + p.origin[a].abs()) * p.inv_dir[a].abs());
-                    (k.iter().all(|&k| k < f32::MAX / 4.0) && b < f32::MAX / 4.0).then(|| {
-                        let m = k.map(|k| (k * (1.0 / 131_072.0)).max(f32::MIN_POSITIVE));
-                        let c = [0, 1, 2].map(|a| -(p.origin[a] * p.inv_dir[a]));
-                        [
-                            [0, 1, 2].map(|a| c[a] - m[a]),
-                            [0, 1, 2].map(|a| c[a] + m[a]),
-                        ]
-                    })
+                let b = magnitude;
+                let k = [0, 1, 2].map(|a| (b + p.origin[a].abs()) * p.inv_dir[a].abs());
+                let serves = no_nan && k.iter().all(|&k| k < f32::MAX / 4.0) && b < f32::MAX / 4.0;
+                let margin = serves.then(|| {
+                    let m = k.map(|k| (k * (1.0 / 131_072.0)).max(f32::MIN_POSITIVE));
+                    let c = [0, 1, 2].map(|a| -(p.origin[a] * p.inv_dir[a]));
+                    [
+                        [0, 1, 2].map(|a| c[a] - m[a]),
+                        [0, 1, 2].map(|a| c[a] + m[a]),
+                    ]
                 });
                 assert_eq!(
                     got.margin.map(|m| m.map(bits3)),
