@@ -946,7 +946,8 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         let builder = Builder { config, method };
         builder.subtree(&mut prims, 0, record, 0, &mut nodes, &mut bins)
     };
-    pack(
+    let t0 = std::time::Instant::now();
+    let r = pack(
         shapes,
         &prims,
         nodes,
@@ -956,10 +957,21 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         } else {
             bounds.aabb()
         },
-    )
+    );
+    eprintln!("PACK {:.3}", t0.elapsed().as_secs_f64() * 1e3);
+    r
 }
 
 /// Turns leaves over primitive ranges into leaves over triangle blocks and shape runs.
+///
+/// The blocks follow the leaves in node order (each node's slots in order, the root last when
+/// it is a leaf), a leaf's triangles in the order given, four to a block. A first pass over
+/// the leaves, serial but light, gives each leaf its first block (or shape) and lists the
+/// blocks to make; the blocks, which read every triangle's vertices at random in `shapes` (a
+/// cache miss each on big meshes: most of the time), are then made in parallel on the
+/// current pool. Serial, this took a fifth of a 1M-triangle build and, at 16 threads, the
+/// largest serial part of the instanced dragon's (bench/README, issue 14, fourteenth pass).
+/// The result does not depend on the thread count.
 fn pack(
     shapes: &[Shape],
     prims: &[PrimRef],
@@ -967,10 +979,14 @@ fn pack(
     root: ChildRef,
     bounds: Aabb,
 ) -> WideBvh {
-    // The shapes of a leaf are read in tree order, at random in `shapes`: a cache miss each
-    // on big meshes. So the leaves are listed first and each one's shapes are prefetched a
-    // few leaves ahead of their conversion.
-    const AHEAD: usize = 8;
+    /// A leaf's primitives in the order given (so the lowest lane of a tie is also the
+    /// lowest index).
+    fn sorted(prims: &[PrimRef], start: usize, count: usize) -> [PrimRef; 8] {
+        let mut sorted = [prims[start]; 8];
+        sorted[..count].copy_from_slice(&prims[start..start + count]);
+        sorted[..count].sort_unstable_by_key(PrimRef::index);
+        sorted
+    }
     let leaves: Vec<(u32, u8)> = nodes
         .iter()
         .enumerate()
@@ -984,16 +1000,9 @@ fn pack(
                 })
         })
         .collect();
-    // Room for exactly the blocks the leaves need, advised for huge pages before it is written.
-    let block_count: usize = leaves
-        .iter()
-        .map(|&(n, slot)| ChildRef(nodes[n as usize].children[slot as usize]))
-        .chain([root])
-        .filter(|c| c.is_leaf() && *c != ChildRef::EMPTY && !c.is_shapes())
-        .map(|c| c.range().1.div_ceil(BLOCK))
-        .sum();
-    let mut blocks: Vec<TriangleBlock> = pages::vec_with_capacity(block_count);
-    let mut lane_source: Vec<u32> = Vec::with_capacity(prims.len() * 4 / 3 + 4);
+    // The blocks to make, in order: (the leaf's first primitive, its count, which block of
+    // the leaf).
+    let mut jobs: Vec<(u32, u8, u8)> = Vec::with_capacity(prims.len() / 3 + 1);
     let mut others: Vec<Shape> = Vec::new();
     let mut other_source: Vec<u32> = Vec::new();
     let mut convert = |r: ChildRef| -> ChildRef {
@@ -1001,52 +1010,53 @@ fn pack(
             return r;
         }
         let (start, count) = r.range();
-        // Lanes in the order given, so the lowest lane of a tie is also the lowest index.
-        let mut sorted = [prims[start]; 8];
-        sorted[..count].copy_from_slice(&prims[start..start + count]);
-        let range = &mut sorted[..count];
-        range.sort_unstable_by_key(PrimRef::index);
-        let range = &*range;
         if r.is_shapes() {
             let first = others.len() as u32;
-            for p in range {
+            for p in &sorted(prims, start, count)[..count] {
                 others.push(shapes[p.index()]);
                 other_source.push(p.index() as u32);
             }
             ChildRef::shapes(first, count as u32)
         } else {
-            let first = blocks.len() as u32;
-            for chunk in range.chunks(BLOCK) {
-                let mut block = TriangleBlock::EMPTY;
-                for (lane, p) in chunk.iter().enumerate() {
-                    if let Shape::Triangle { vertices } = &shapes[p.index()] {
-                        block.set(lane, vertices);
-                    }
-                    lane_source.push(p.index() as u32);
-                }
-                for _ in chunk.len()..BLOCK {
-                    lane_source.push(u32::MAX);
-                }
-                blocks.push(block);
-            }
-            ChildRef::triangles(first, count.div_ceil(BLOCK) as u32)
+            let first = jobs.len() as u32;
+            let blocks = count.div_ceil(BLOCK);
+            jobs.extend((0..blocks).map(|b| (start as u32, count as u8, b as u8)));
+            ChildRef::triangles(first, blocks as u32)
         }
     };
-    let leaf_of = |nodes: &[WideNode], (n, slot): (u32, u8)| {
-        ChildRef(nodes[n as usize].children[slot as usize])
-    };
-    for (i, &leaf) in leaves.iter().enumerate() {
-        if let Some(&ahead) = leaves.get(i + AHEAD) {
-            let (start, count) = leaf_of(&nodes, ahead).range();
-            for p in &prims[start..start + count] {
-                simd::prefetch(&shapes[p.index()]);
-            }
-        }
-        let converted = convert(leaf_of(&nodes, leaf));
-        nodes[leaf.0 as usize].children[leaf.1 as usize] = converted.0;
+    for (n, slot) in leaves {
+        let child = &mut nodes[n as usize].children[slot as usize];
+        *child = convert(ChildRef(*child)).0;
     }
     let root = convert(root);
-    debug_assert_eq!(blocks.len(), block_count);
+    // The blocks, each from its leaf's triangles; the shapes of the block a few jobs ahead
+    // are fetched meanwhile, so that a task's misses overlap.
+    const AHEAD: usize = 8;
+    let mut blocks: Vec<TriangleBlock> = pages::vec_with_capacity(jobs.len());
+    let mut lanes: Vec<[u32; BLOCK]> = Vec::with_capacity(jobs.len());
+    jobs.par_iter()
+        .enumerate()
+        .with_min_len(1024)
+        .map(|(i, &(start, count, block))| {
+            if let Some(&(s, c, _)) = jobs.get(i + AHEAD) {
+                for p in &prims[s as usize..s as usize + c as usize] {
+                    simd::prefetch(&shapes[p.index()]);
+                }
+            }
+            let (count, first) = (count as usize, block as usize * BLOCK);
+            let leaf = sorted(prims, start as usize, count);
+            let mut out = TriangleBlock::EMPTY;
+            let mut source = [u32::MAX; BLOCK];
+            for (lane, p) in leaf[first..count.min(first + BLOCK)].iter().enumerate() {
+                if let Shape::Triangle { vertices } = &shapes[p.index()] {
+                    out.set(lane, vertices);
+                }
+                source[lane] = p.index() as u32;
+            }
+            (out, source)
+        })
+        .unzip_into_vecs(&mut blocks, &mut lanes);
+    let mut lane_source = lanes.into_flattened();
     lane_source.extend(other_source);
     let magnitude = plane_magnitude(&nodes);
     WideBvh {
@@ -1157,6 +1167,113 @@ mod tests {
             sets.push(signed_zeros);
         }
         sets
+    }
+
+    /// `pack`'s layout, against its definition: walking the nodes in order (each node's slots
+    /// in order, then the root), the triangle leaves' blocks come one after another from
+    /// block 0, and the shape leaves' shapes likewise; a leaf holds its triangles in the
+    /// order given, four to a block, the lanes past the last one empty (NaN vertices, source
+    /// `u32::MAX`); each lane's vertices and source are its triangle's, and every shape is
+    /// in exactly one leaf. Run on two threads too, where the blocks are made in parallel.
+    #[test]
+    fn pack_lays_out_the_leaves_in_node_order() {
+        let mut r = Rng(0x2545_f491_4f6c_dd1d);
+        let triangles: Vec<Shape> = (0..20_000)
+            .map(|_| {
+                let a = Vec3::new(r.f32() * 50.0, r.f32() * 50.0, r.f32() * 50.0);
+                let mut corner = || a + Vec3::new(r.f32(), r.f32(), r.f32());
+                Shape::Triangle {
+                    vertices: [corner(), corner(), corner()],
+                }
+            })
+            .collect();
+        // Triangles alone (leaves of up to two blocks), and with spheres among them.
+        let mut mixed = triangles.clone();
+        for k in 0..300 {
+            let center = Vec3::new(r.f32() * 50.0, r.f32() * 50.0, r.f32() * 50.0);
+            mixed.insert(
+                k * 61,
+                Shape::Sphere {
+                    center,
+                    radius: 0.5,
+                },
+            );
+        }
+        let mut two_block_leaves = 0;
+        for shapes in [triangles, mixed] {
+            check_pack(&shapes, &mut two_block_leaves);
+        }
+        assert!(
+            two_block_leaves > 100,
+            "{two_block_leaves} leaves of two blocks"
+        );
+    }
+
+    fn check_pack(shapes: &[Shape], two_block_leaves: &mut usize) {
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("thread pool")
+                .install(|| build_with(shapes, SplitMethod::Sah))
+        };
+        for bvh in [on(1), on(2)] {
+            let mut leaves: Vec<ChildRef> = bvh
+                .nodes
+                .iter()
+                .flat_map(|node| node.children.map(ChildRef))
+                .filter(|c| c.is_leaf() && *c != ChildRef::EMPTY)
+                .collect();
+            leaves.push(bvh.root);
+            let (mut next_block, mut next_shape) = (0, 0);
+            let mut seen = vec![0u32; shapes.len()];
+            let lanes = bvh.blocks.len() * BLOCK;
+            for leaf in leaves.into_iter().filter(|c| c.is_leaf()) {
+                let (first, count) = leaf.range();
+                let mut indices = Vec::new();
+                if leaf.is_shapes() {
+                    assert_eq!(first, next_shape);
+                    next_shape += count;
+                    for s in first..first + count {
+                        let index = bvh.source[lanes + s] as usize;
+                        assert_eq!(bvh.shapes[s], shapes[index]);
+                        indices.push(index);
+                    }
+                } else {
+                    assert_eq!(first, next_block);
+                    next_block += count;
+                    *two_block_leaves += (count == 2) as usize;
+                    for lane in first * BLOCK..(first + count) * BLOCK {
+                        let (block, at) = (&bvh.blocks[lane / BLOCK], lane % BLOCK);
+                        match bvh.source[lane] {
+                            u32::MAX => {
+                                assert!(block.triangle(at).iter().flatten().all(|v| v.is_nan()));
+                                // Empty lanes only at the end of a leaf's last block.
+                                assert!(lane / BLOCK == first + count - 1);
+                            }
+                            index => {
+                                let Shape::Triangle { vertices } = shapes[index as usize] else {
+                                    panic!("lane {lane} holds shape {index}, not a triangle");
+                                };
+                                assert_eq!(block.triangle(at), vertices.map(|v| v.to_array()));
+                                assert!(indices.len() == lane - first * BLOCK);
+                                indices.push(index as usize);
+                            }
+                        }
+                    }
+                    assert!(indices.len() > (count - 1) * BLOCK);
+                }
+                assert!(indices.windows(2).all(|w| w[0] < w[1]), "{indices:?}");
+                for i in indices {
+                    seen[i] += 1;
+                }
+            }
+            assert_eq!(
+                (next_block, next_shape),
+                (bvh.blocks.len(), bvh.shapes.len())
+            );
+            assert!(seen.iter().all(|&n| n == 1));
+        }
     }
 
     /// A box's lanes as bits (which tell +0 from -0).
