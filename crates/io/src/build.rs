@@ -16,6 +16,8 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
+use rayon::prelude::*;
+
 use glint_render::{
     Background, Camera, Color, ColorSource, CubeMap, GeometryDesc, Image, Instance, Light,
     Material, MaterialId, Matrix4, SceneParts, Shape, TextureId, Transform, Vec3,
@@ -513,7 +515,8 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             return Ok(None);
         };
         let shapes: Vec<Shape> = triangles
-            .iter()
+            .par_iter()
+            .with_min_len(4096)
             .map(|&vertices| Shape::Triangle { vertices })
             .collect();
         let materials = vec![material; shapes.len()];

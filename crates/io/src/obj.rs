@@ -4,6 +4,8 @@
 //! ignored because the course gives one shader per mesh.
 
 use std::io::BufRead;
+
+use rayon::prelude::*;
 use std::path::Path;
 
 use glint_render::Vec3;
@@ -39,7 +41,10 @@ pub(crate) fn load_triangles(
         )));
     }
     let mesh = read_obj(&bytes).map_err(AssetError::Failed)?;
+    // In parallel like the parse: serial, this was a tenth of the instanced dragon's load.
     Ok((0..mesh.triangles.len())
+        .into_par_iter()
+        .with_min_len(4096)
         .map(|index| mesh.triangle(index))
         .collect())
 }
