@@ -4,9 +4,9 @@
 //! ignored because the course gives one shader per mesh.
 
 use std::io::BufRead;
+use std::path::Path;
 
 use rayon::prelude::*;
-use std::path::Path;
 
 use glint_render::Vec3;
 

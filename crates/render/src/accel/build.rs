@@ -946,8 +946,7 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         let builder = Builder { config, method };
         builder.subtree(&mut prims, 0, record, 0, &mut nodes, &mut bins)
     };
-    let t0 = std::time::Instant::now();
-    let r = pack(
+    pack(
         shapes,
         &prims,
         nodes,
@@ -957,9 +956,7 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         } else {
             bounds.aabb()
         },
-    );
-    eprintln!("PACK {:.3}", t0.elapsed().as_secs_f64() * 1e3);
-    r
+    )
 }
 
 /// Turns leaves over primitive ranges into leaves over triangle blocks and shape runs.
