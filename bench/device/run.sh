@@ -1,0 +1,58 @@
+#!/bin/bash
+# The standard figures of issue 14 on the lent 16-core machine, in one call, from what
+# bench/device/pack.sh put into target/device/: Glint against native Embree
+# (bench/embree_compare.sh, every glint packed side by side), whole-frame scaling at 1 and
+# all threads (bench/scaling.py), the machine's own ceiling (16 single-thread copies at once)
+# and the stage times of two 16-thread frames. Each part has a time limit, so that the call
+# ends within the 600 s a command may run; what ran is in $OUT (machine.txt, embree.txt,
+# scaling.txt, ceiling.txt, stages.txt), and printed.
+#
+# Options by environment: EC (embree_compare.sh's, default "--rounds 3 --repeat 2"), SC
+# (scaling.py's, default "--rounds 3"), CE (the ceiling's, default "--size 0.5 --rounds 2"),
+# and EC_S, SC_S, CE_S, their limits in seconds (330, 150, 60).
+set -u
+cd "$(dirname "$0")/../.."
+D=target/device
+OUT=${OUT:-/tmp/device-out}
+mkdir -p "$OUT"
+T0=$(date +%s)
+el() { echo "== $1 at $(($(date +%s) - T0)) s"; }
+[ -d "$D/bin" ] || { echo "no $D: run bench/device/pack.sh here first, then carry it" >&2; exit 2; }
+for f in "$D"/bin/*.xz "$D"/lib/*.xz "$D"/shared/models/*.xz; do
+  [ -e "$f" ] && xz -d -f -T0 "$f"
+done
+chmod +x "$D"/bin/*
+export LD_LIBRARY_PATH=$PWD/$D/lib
+THREADS=$(nproc)
+{ lscpu; free -g; } > "$OUT/machine.txt" 2>&1
+grep -E "Model name|^CPU\(s\)|Thread" "$OUT/machine.txt"
+echo "AVX-512: $(grep -o 'avx512[a-z]*' "$OUT/machine.txt" | sort -u | tr '\n' ' ')"
+GLINTS=$(find "$D/bin" -type f ! -name embree_native | sort | paste -sd, -)
+FIRST=${GLINTS%%,*}
+export SHARED=$PWD/$D/shared RAYS=/tmp/device-rays EMBREE=$PWD/$D/bin/embree_native
+el setup
+# shellcheck disable=SC2086
+GLINT=$GLINTS timeout "${EC_S:-330}" bash bench/embree_compare.sh ${EC:---rounds 3 --repeat 2} \
+  > "$OUT/embree.txt" 2> "$OUT/embree.err"
+echo "embree_compare: rc $?"
+cat "$OUT/embree.txt"
+tail -3 "$OUT/embree.err"
+el embree
+# shellcheck disable=SC2086
+PYTHONUNBUFFERED=1 timeout "${SC_S:-150}" python3 bench/scaling.py --glint "$GLINTS" \
+  --shared "$SHARED" --threads "1,$THREADS" ${SC:---rounds 3} > "$OUT/scaling.txt" 2>&1
+cat "$OUT/scaling.txt"
+el scaling
+# shellcheck disable=SC2086
+PYTHONUNBUFFERED=1 timeout "${CE_S:-60}" python3 bench/scaling.py --glint "$FIRST" \
+  --shared "$SHARED" --ceiling --threads "1,$THREADS" ${CE:---size 0.5 --rounds 2} \
+  > "$OUT/ceiling.txt" 2>&1
+cat "$OUT/ceiling.txt"
+el ceiling
+C=$SHARED/scenes/course/willemsen
+for s in scenes_A/spheres_1K.xml:9 scenes_B/StanfordDragon_Instanced.json:16; do
+  echo "${s%%:*}, $THREADS threads: $("$FIRST" render "$C/${s%%:*}" -w 1024 -h 1024 -r "${s##*:}" \
+    -n "$THREADS" --stats -o /tmp/device-stages.png 2>&1 | grep -E "^ +(load|hash|build|render|write) " \
+    | tr -s ' ' | paste -sd';' -)"
+done | tee "$OUT/stages.txt"
+el stages
