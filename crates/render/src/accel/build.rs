@@ -966,9 +966,10 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
 /// the leaves, serial but light, gives each leaf its first block (or shape) and lists the
 /// blocks to make; the blocks, which read every triangle's vertices at random in `shapes` (a
 /// cache miss each on big meshes: most of the time), are then made in parallel on the
-/// current pool. Serial, this took a fifth of a 1M-triangle build and, at 16 threads, the
-/// largest serial part of the instanced dragon's (bench/README, issue 14, fourteenth pass).
-/// The result does not depend on the thread count.
+/// current pool. Serial, this took 50-100 ms of igea-sub4's 1-thread build (1.07M
+/// triangles) and 6-9 ms of the instanced dragon's, more than the root node's splits, on one
+/// thread at any pool size (bench/README, issue 14, fourteenth pass). The result does not
+/// depend on the thread count.
 fn pack(
     shapes: &[Shape],
     prims: &[PrimRef],
