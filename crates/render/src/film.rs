@@ -76,18 +76,18 @@ impl Film {
 
     /// 8-bit RGB as the course writes it (FORMAT.md 1.3): clamp to [0,1], then floor(c·255),
     /// no gamma. NaN becomes 0.
-    /// In parallel on the current rayon pool: the image write is otherwise serial.
+    /// In parallel on the current rayon pool, a row at a time: the image write is otherwise
+    /// serial.
     pub fn to_rgb8_course(&self) -> Vec<u8> {
         let mut rgb = vec![0; self.pixels.len() * 3];
-        rgb.par_chunks_mut(3)
-            .zip(&self.pixels)
-            .for_each(|(levels, color)| {
-                for (level, v) in levels.iter_mut().zip(color.to_array()) {
-                    *level = if v.is_nan() {
-                        0
-                    } else {
-                        (v.clamp(0.0, 1.0) * 255.0).floor() as u8
-                    };
+        let row = (self.width as usize).max(1);
+        rgb.par_chunks_mut(3 * row)
+            .zip(self.pixels.par_chunks(row))
+            .for_each(|(levels, colors)| {
+                for (levels, color) in levels.chunks_exact_mut(3).zip(colors) {
+                    for (level, v) in levels.iter_mut().zip(color.to_array()) {
+                        *level = course_level(v);
+                    }
                 }
             });
         rgb
@@ -96,5 +96,83 @@ impl Film {
     /// Interleaved RGB f32 (for EXR and arrays).
     pub fn to_rgb_f32(&self) -> Vec<f32> {
         self.pixels.iter().flat_map(|c| c.to_array()).collect()
+    }
+}
+/// floor(v·255) of `v` clamped to [0, 1]; NaN gives 0. The product lies in [0, 255] (or is
+/// -0.0), where truncation toward zero is the floor: no `floorf` call (x86-64's baseline has no
+/// SSE4.1 `roundss`), the same levels.
+#[inline]
+fn course_level(v: f32) -> u8 {
+    if v.is_nan() {
+        0
+    } else {
+        (v.clamp(0.0, 1.0) * 255.0) as u8
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The level as FORMAT.md 1.3 defines it.
+    fn floor_level(v: f32) -> u8 {
+        if v.is_nan() {
+            0
+        } else {
+            (v.clamp(0.0, 1.0) * 255.0).floor() as u8
+        }
+    }
+
+    #[test]
+    fn course_levels_are_the_floor_of_the_clamped_value() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            f32::MIN_POSITIVE,
+            -f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -f32::NAN,
+            f32::MAX,
+        ];
+        // Every level's threshold k/255 and the floats within 64 ulps of it, either side.
+        for k in 0..=256u32 {
+            let bits = (k as f32 / 255.0).to_bits();
+            values.extend((bits.saturating_sub(64)..=bits + 64).map(f32::from_bits));
+        }
+        // And bit patterns spread over all of them (a fixed LCG).
+        let mut state = 0x2545_f491_u32;
+        values.extend((0..1 << 20).map(|_| {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            f32::from_bits(state)
+        }));
+        for v in values {
+            assert_eq!(
+                course_level(v),
+                floor_level(v),
+                "{v:e} ({:#x})",
+                v.to_bits()
+            );
+        }
+    }
+
+    #[test]
+    fn course_rgb8_is_row_major_whatever_the_width() {
+        for (width, height) in [(1, 1), (1, 5), (7, 3), (64, 2)] {
+            let mut film = Film::new(width, height);
+            for (i, pixel) in film.pixels.iter_mut().enumerate() {
+                *pixel = Vec3::new(i as f32 / 400.0, 1.0 - i as f32 / 400.0, 0.5);
+            }
+            let expected: Vec<u8> = film
+                .pixels
+                .iter()
+                .flat_map(|c| c.to_array().map(floor_level))
+                .collect();
+            assert_eq!(film.to_rgb8_course(), expected, "{width}x{height}");
+        }
     }
 }
