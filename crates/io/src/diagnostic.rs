@@ -2,7 +2,7 @@
 //! the way compilers report. Errors stop the load (`SceneError`); warnings are collected and
 //! handed back with the scene so the application decides how to show them.
 
-use std::cell::OnceCell;
+use std::cell::{Cell, OnceCell};
 use std::collections::HashSet;
 use std::fmt;
 use std::ops::Range;
@@ -176,10 +176,13 @@ impl SceneError {
 
 /// Byte offsets to 1-based line and character column. roxmltree's `text_pos_at` rescans the
 /// document from the start on every call, which is quadratic over scenes with thousands of
-/// shapes; this index answers each query with a binary search.
+/// shapes; this index answers each query with a binary search, or at once when the line is the
+/// previous query's or the next one (the parsers ask in file order).
 pub(crate) struct LineIndex<'text> {
     text: &'text str,
     line_starts: Vec<usize>,
+    /// The line index of the previous query.
+    last_line: Cell<usize>,
 }
 
 impl<'text> LineIndex<'text> {
@@ -191,7 +194,29 @@ impl<'text> LineIndex<'text> {
                 .filter(|&(_, byte)| byte == b'\n')
                 .map(|(offset, _)| offset + 1),
         );
-        LineIndex { text, line_starts }
+        LineIndex {
+            text,
+            line_starts,
+            last_line: Cell::new(0),
+        }
+    }
+
+    /// The index of the line holding `offset` (a char boundary no further than the text's end).
+    fn line_of(&self, offset: usize) -> usize {
+        let starts = &self.line_starts;
+        let holds = |line: usize| {
+            starts[line] <= offset && starts.get(line + 1).is_none_or(|&next| offset < next)
+        };
+        let last = self.last_line.get();
+        let line = if holds(last) {
+            last
+        } else if last + 1 < starts.len() && holds(last + 1) {
+            last + 1
+        } else {
+            starts.partition_point(|&start| start <= offset) - 1
+        };
+        self.last_line.set(line);
+        line
     }
 
     pub fn span_at(&self, offset: usize) -> Span {
@@ -199,7 +224,7 @@ impl<'text> LineIndex<'text> {
         while !self.text.is_char_boundary(offset) {
             offset -= 1;
         }
-        let line_index = self.line_starts.partition_point(|&start| start <= offset) - 1;
+        let line_index = self.line_of(offset);
         let line_start = self.line_starts[line_index];
         let column = self.text[line_start..offset].chars().count() + 1;
         Span {
@@ -361,6 +386,31 @@ mod tests {
         assert_eq!(index.line_text(3), Some("xyz"));
         assert_eq!(index.line_text(4), None);
         assert_eq!(index.span_at(100), Span { line: 3, column: 4 });
+    }
+
+    /// The previous query's line is a hint, never the answer: every offset, asked in file
+    /// order, backwards and in a scattered order, gets the line a search from scratch gives.
+    #[test]
+    fn line_lookups_agree_in_any_order() {
+        let text = "\n\nab\ncé d\r\n\n\nxyz\nlast line without a break";
+        let index = LineIndex::new(text);
+        let expected = |offset: usize| {
+            let line = text[..offset].matches('\n').count();
+            let start = text[..offset].rfind('\n').map_or(0, |at| at + 1);
+            Span {
+                line: line as u32 + 1,
+                column: text[start..offset].chars().count() as u32 + 1,
+            }
+        };
+        let offsets: Vec<usize> = (0..=text.len())
+            .filter(|&offset| text.is_char_boundary(offset))
+            .collect();
+        let forward = offsets.iter().copied();
+        let backward = offsets.iter().rev().copied();
+        let scattered = (0..offsets.len()).map(|i| offsets[(i * 7 + 3) % offsets.len()]);
+        for offset in forward.chain(backward).chain(scattered) {
+            assert_eq!(index.span_at(offset), expected(offset), "offset {offset}");
+        }
     }
 
     #[test]

@@ -6,14 +6,20 @@
 //! about is refused with a located error: unquoted or numeric keys (`{camera: ...}`) and
 //! single-quoted strings (`'red'`).
 
+use std::borrow::Cow;
+
 use jsonc_parser::ast;
 use jsonc_parser::common::Ranged;
 
 use crate::diagnostic::{Diagnostics, SceneError};
 use crate::tree::{Node, Value};
 
-/// Parses `text` and returns the top-level value as a node with an empty key.
-pub(crate) fn parse(text: &str, diagnostics: &Diagnostics) -> Result<Node, SceneError> {
+/// Parses `text` into jsonc-parser's syntax tree of its top-level value; `tree` makes the
+/// located tree of it, borrowing its keys and strings.
+pub(crate) fn parse<'text>(
+    text: &'text str,
+    diagnostics: &Diagnostics,
+) -> Result<ast::Value<'text>, SceneError> {
     check_nesting(text, diagnostics)?;
     let options = jsonc_parser::ParseOptions {
         allow_comments: true,
@@ -28,14 +34,18 @@ pub(crate) fn parse(text: &str, diagnostics: &Diagnostics) -> Result<Node, Scene
                     format!("malformed JSON: {}", error.kind()),
                 )
             })?;
-    let Some(value) = result.value else {
-        return Err(diagnostics.error(
+    result.value.ok_or_else(|| {
+        diagnostics.error(
             diagnostics.span_at(text.len()),
             "malformed JSON: the file holds no value",
-        ));
-    };
+        )
+    })
+}
+
+/// The top-level value as a node with an empty key.
+pub(crate) fn tree<'a>(value: &'a ast::Value<'_>, diagnostics: &Diagnostics) -> Node<'a> {
     let span = diagnostics.span_at(value.start());
-    Ok(Node::new("", span, span, convert(&value, diagnostics)))
+    Node::new("", span, span, convert(value, diagnostics))
 }
 
 /// Far deeper than any scene needs (the course's deepest is 5). jsonc-parser descends
@@ -92,10 +102,10 @@ fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError
     Ok(())
 }
 
-fn convert(value: &ast::Value, diagnostics: &Diagnostics) -> Value {
+fn convert<'a>(value: &'a ast::Value<'_>, diagnostics: &Diagnostics) -> Value<'a> {
     match value {
-        ast::Value::StringLit(string) => Value::Text(string.value.to_string()),
-        ast::Value::NumberLit(number) => Value::Number(number.value.to_owned()),
+        ast::Value::StringLit(string) => Value::Text(Cow::Borrowed(&string.value)),
+        ast::Value::NumberLit(number) => Value::Number(Cow::Borrowed(number.value)),
         ast::Value::BooleanLit(boolean) => Value::Bool(boolean.value),
         ast::Value::NullKeyword(_) => Value::Null,
         ast::Value::Array(array) => Value::List(

@@ -163,9 +163,13 @@ pub fn load_scene_with_assets_limited(
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     let mut diagnostics = Diagnostics::new(path, text);
     let format = detect_format(text, path, &diagnostics)?;
+    let json_syntax;
     let root = match format {
         Format::Xml => xml::parse(text, &diagnostics)?,
-        Format::Json => json::parse(text, &diagnostics)?,
+        Format::Json => {
+            json_syntax = json::parse(text, &diagnostics)?;
+            json::tree(&json_syntax, &diagnostics)
+        }
     };
     let desc = read::read_document(&root, format, &mut diagnostics)?;
     let base_directory = path.parent().unwrap_or(Path::new(""));

@@ -3,6 +3,8 @@
 //! impossible value is an error at its location; unknown entries, unknown types and missing
 //! optional parameters are warnings.
 
+use std::borrow::Cow;
+
 use glint_render::{Projection, Vec3};
 
 use crate::desc::{
@@ -68,10 +70,7 @@ pub(crate) fn read_document(
                 Value::Object(entries) => entries.as_slice(),
                 _ => &[],
             };
-            if entries
-                .iter()
-                .any(|entry| SCENE_KEYS.contains(&entry.key.as_str()))
-            {
+            if entries.iter().any(|entry| SCENE_KEYS.contains(&entry.key)) {
                 return read_scene(root, diagnostics);
             }
             Err(diagnostics.error(
@@ -163,7 +162,7 @@ fn read_scene(node: &Node, diagnostics: &mut Diagnostics) -> Result<SceneDesc, S
             _ => &[],
         };
         if let Some((entry, suggestion)) = entries.iter().find_map(|entry| {
-            let suggestion = did_you_mean(&entry.key, ["camera"]);
+            let suggestion = did_you_mean(entry.key, ["camera"]);
             (!suggestion.is_empty()).then_some((entry, suggestion))
         }) {
             return Err(diagnostics.error(
@@ -719,7 +718,7 @@ fn read_shape(
         ShapeRole::Shape | ShapeRole::Emitter => "shape",
         ShapeRole::Definition => "instance definition",
     };
-    let mut fields = Fields::of(node, with_article(noun), diagnostics)?;
+    let mut fields = Fields::of(node, shape_phrase(None, role), diagnostics)?;
     let name = match fields.take("name", diagnostics) {
         Some(name) => Some(string(name, diagnostics)?.value),
         None => None,
@@ -737,7 +736,7 @@ fn read_shape(
         Some(shader) => Some(shader_reference(shader, diagnostics)?),
         None => None,
     };
-    fields.set_what(with_article(&format!("{} {noun}", type_name.value)));
+    fields.set_what(shape_phrase(Some(&type_name.value), role));
     let kind = match type_name.value.as_str() {
         // FORMAT.md 5: JL26's defaults for missing geometry.
         "sphere" => {
@@ -897,7 +896,7 @@ fn read_transform_object(
         }
     };
     for entry in entries {
-        let operation = match entry.key.as_str() {
+        let operation = match entry.key {
             "name" => continue,
             "translate" => TransformOperation::Translate(vector(entry, diagnostics)?),
             "scale" => TransformOperation::Scale(scale_amount(entry, diagnostics)?),
@@ -923,7 +922,7 @@ fn read_transform_object(
                 }
             }
             _ => {
-                let suggestion = did_you_mean(&entry.key, ["translate", "rotate", "scale"]);
+                let suggestion = did_you_mean(entry.key, ["translate", "rotate", "scale"]);
                 let message = if entry.key == TEXT_KEY {
                     "text is not used in a transform; ignored".to_owned()
                 } else {
@@ -947,8 +946,8 @@ fn read_transform_object(
 /// Scale factors: "sx sy sz", or one number for a uniform scale.
 fn scale_amount(node: &Node, diagnostics: &mut Diagnostics) -> Result<Vec3, SceneError> {
     let single = match &node.value {
-        Value::Number(text) => Some(text.as_str()),
-        Value::Text(text) if text.split_whitespace().count() == 1 => Some(text.as_str()),
+        Value::Number(text) => Some(&**text),
+        Value::Text(text) if text.split_whitespace().count() == 1 => Some(&**text),
         _ => None,
     };
     match single {
@@ -1017,6 +1016,49 @@ fn read_xform_entry(
 }
 
 /// "a sphere shape", "an instance shape".
+/// How a shape is named in messages: "a shape", "a sphere shape", "an instance definition",
+/// without a copy for the course's shape types.
+fn shape_phrase(type_name: Option<&str>, role: ShapeRole) -> Cow<'static, str> {
+    const KNOWN: [(&str, &str, &str); SHAPE_TYPES.len()] = [
+        ("sphere", "a sphere shape", "a sphere instance definition"),
+        (
+            "triangle",
+            "a triangle shape",
+            "a triangle instance definition",
+        ),
+        ("box", "a box shape", "a box instance definition"),
+        ("mesh", "a mesh shape", "a mesh instance definition"),
+        (
+            "instance",
+            "an instance shape",
+            "an instance instance definition",
+        ),
+    ];
+    let definition = role == ShapeRole::Definition;
+    let Some(type_name) = type_name else {
+        return Cow::Borrowed(if definition {
+            "an instance definition"
+        } else {
+            "a shape"
+        });
+    };
+    match KNOWN.iter().find(|(name, _, _)| *name == type_name) {
+        Some(&(_, shape, instance_definition)) => Cow::Borrowed(if definition {
+            instance_definition
+        } else {
+            shape
+        }),
+        None => {
+            let noun = if definition {
+                "instance definition"
+            } else {
+                "shape"
+            };
+            Cow::Owned(with_article(&format!("{type_name} {noun}")))
+        }
+    }
+}
+
 fn with_article(phrase: &str) -> String {
     let starts_with_vowel = phrase
         .chars()
@@ -1026,5 +1068,30 @@ fn with_article(phrase: &str) -> String {
         format!("an {phrase}")
     } else {
         format!("a {phrase}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table of shape phrases says what the general rule would: "a"/"an", the type, the
+    /// noun.
+    #[test]
+    fn shape_phrases_follow_the_general_rule() {
+        for (role, noun) in [
+            (ShapeRole::Shape, "shape"),
+            (ShapeRole::Emitter, "shape"),
+            (ShapeRole::Definition, "instance definition"),
+        ] {
+            assert_eq!(shape_phrase(None, role), with_article(noun));
+            for type_name in SHAPE_TYPES.into_iter().chain(["ellipsoid", "", "Sphere"]) {
+                assert_eq!(
+                    shape_phrase(Some(type_name), role),
+                    with_article(&format!("{type_name} {noun}")),
+                    "{type_name} {noun}"
+                );
+            }
+        }
     }
 }

@@ -12,44 +12,54 @@
 //!   as repeated XML elements (so `"light": {...}` and `"light": [{...}]` read alike, 3.2);
 //!   other arrays (`"center": [1, 2, 3]`) stay a `List`.
 
+use std::borrow::Cow;
+
 use crate::desc::Span;
 
 /// Key under which an XML element's text is kept when the element also has attributes or
 /// children (`<diffuse tex="earth">1 1 1</diffuse>`, `<rotate axis="X">45</rotate>`).
 pub(crate) const TEXT_KEY: &str = "#text";
 
+/// Keys and values borrow from the file's text (`'text`) where they appear in it as they read;
+/// only text with XML entities or JSON escapes is copied. A tree of a 100,000-shape file then
+/// holds one allocation per object rather than several per entry.
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) struct Node {
+pub(crate) struct Node<'text> {
     /// The key with leading underscores removed; empty for list elements.
-    pub key: String,
+    pub key: &'text str,
     /// The key as written, for messages.
-    pub raw_key: String,
+    pub raw_key: &'text str,
     /// Where the key (XML: the element or attribute) starts.
     pub key_span: Span,
     /// Where the value starts.
     pub span: Span,
-    pub value: Value,
+    pub value: Value<'text>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
-pub(crate) enum Value {
+pub(crate) enum Value<'text> {
     /// XML text or attribute value, or a JSON string.
-    Text(String),
+    Text(Cow<'text, str>),
     /// A JSON number literal, still as text.
-    Number(String),
+    Number(Cow<'text, str>),
     Bool(bool),
     Null,
     /// A JSON array that is not a list of objects.
-    List(Vec<Node>),
+    List(Vec<Node<'text>>),
     /// XML element with attributes or children, or a JSON object.
-    Object(Vec<Node>),
+    Object(Vec<Node<'text>>),
 }
 
-impl Node {
-    pub fn new(raw_key: &str, key_span: Span, span: Span, value: Value) -> Node {
+impl<'text> Node<'text> {
+    pub fn new(
+        raw_key: &'text str,
+        key_span: Span,
+        span: Span,
+        value: Value<'text>,
+    ) -> Node<'text> {
         Node {
-            key: raw_key.trim_start_matches('_').to_owned(),
-            raw_key: raw_key.to_owned(),
+            key: raw_key.trim_start_matches('_'),
+            raw_key,
             key_span,
             span,
             value,

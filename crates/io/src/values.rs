@@ -2,7 +2,10 @@
 //! `Fields`, which hands out an object's entries and afterwards reports every entry nobody
 //! asked for (pbrt-v4's `ReportUnused`), with a "did you mean" when a known key is close.
 
+use std::borrow::Cow;
+
 use glint_render::Vec3;
+use smallvec::SmallVec;
 
 use crate::desc::{ColorDesc, Located, Span};
 use crate::diagnostic::{did_you_mean, Diagnostics, SceneError};
@@ -11,22 +14,23 @@ use crate::tree::{Node, Value, TEXT_KEY};
 /// The entries of one object, taken one key at a time.
 pub(crate) struct Fields<'tree> {
     /// How the object is named in messages: "a sphere shape", "the scene".
-    what: String,
+    what: Cow<'static, str>,
     span: Span,
-    entries: &'tree [Node],
-    used: Vec<bool>,
+    entries: &'tree [Node<'tree>],
+    /// Which entries were taken (the course's objects have a handful).
+    used: SmallVec<[bool; 16]>,
     known: Vec<&'static str>,
 }
 
 impl<'tree> Fields<'tree> {
     /// The entries of `node`, which must be an object (an empty XML element counts as one).
     pub fn of(
-        node: &'tree Node,
-        what: impl Into<String>,
+        node: &'tree Node<'tree>,
+        what: impl Into<Cow<'static, str>>,
         diagnostics: &Diagnostics,
     ) -> Result<Fields<'tree>, SceneError> {
         let what = what.into();
-        let entries: &[Node] = match &node.value {
+        let entries: &[Node<'tree>] = match &node.value {
             Value::Object(entries) => entries,
             Value::Text(text) if text.trim().is_empty() => &[],
             _ => {
@@ -42,7 +46,7 @@ impl<'tree> Fields<'tree> {
         Ok(Fields {
             what,
             span: node.span,
-            used: vec![false; entries.len()],
+            used: SmallVec::from_elem(false, entries.len()),
             entries,
             known: Vec::new(),
         })
@@ -57,7 +61,7 @@ impl<'tree> Fields<'tree> {
     }
 
     /// Renames the object once its type is known ("a light" becomes "an area light").
-    pub fn set_what(&mut self, what: impl Into<String>) {
+    pub fn set_what(&mut self, what: impl Into<Cow<'static, str>>) {
         self.what = what.into();
     }
 
@@ -67,11 +71,11 @@ impl<'tree> Fields<'tree> {
         &mut self,
         keys: &[&'static str],
         diagnostics: &mut Diagnostics,
-    ) -> Option<&'tree Node> {
+    ) -> Option<&'tree Node<'tree>> {
         self.known.extend_from_slice(keys);
-        let mut first: Option<&'tree Node> = None;
+        let mut first: Option<&'tree Node<'tree>> = None;
         for (index, entry) in self.entries.iter().enumerate() {
-            if !keys.contains(&entry.key.as_str()) {
+            if !keys.contains(&entry.key) {
                 continue;
             }
             self.used[index] = true;
@@ -93,12 +97,12 @@ impl<'tree> Fields<'tree> {
         &mut self,
         key: &'static str,
         diagnostics: &mut Diagnostics,
-    ) -> Option<&'tree Node> {
+    ) -> Option<&'tree Node<'tree>> {
         self.take_any(&[key], diagnostics)
     }
 
     /// Every entry under `key`, in order (repeated elements, array entries).
-    pub fn take_all(&mut self, key: &'static str) -> Vec<&'tree Node> {
+    pub fn take_all(&mut self, key: &'static str) -> Vec<&'tree Node<'tree>> {
         self.known.push(key);
         let mut found = Vec::new();
         for (index, entry) in self.entries.iter().enumerate() {
@@ -124,7 +128,7 @@ impl<'tree> Fields<'tree> {
             }
             if entry.key == TEXT_KEY {
                 let text = match &entry.value {
-                    Value::Text(text) => text.as_str(),
+                    Value::Text(text) => &**text,
                     _ => "",
                 };
                 diagnostics.warn(
@@ -136,7 +140,7 @@ impl<'tree> Fields<'tree> {
                     ),
                 );
             } else {
-                let suggestion = did_you_mean(&entry.key, self.known.iter().copied());
+                let suggestion = did_you_mean(entry.key, self.known.iter().copied());
                 diagnostics.warn(
                     entry.key_span,
                     format!(
@@ -233,19 +237,27 @@ fn parse_finite(text: &str) -> Option<f64> {
 pub(crate) fn vector(node: &Node, diagnostics: &mut Diagnostics) -> Result<Vec3, SceneError> {
     let (numbers, irregular) = match &node.value {
         Value::Text(text) => {
-            let (numbers, complete) = stream_numbers(text);
-            let plain = text
+            // Plain numbers (nearly every file): each token read once. Their stream reading
+            // is the same numbers.
+            let plain: Option<Vec<f64>> = text
                 .split(|character: char| character.is_whitespace() || character == ',')
                 .filter(|token| !token.is_empty())
-                .all(|token| parse_finite(token).is_some());
-            (
-                if complete || numbers.len() >= 3 {
-                    numbers
-                } else {
-                    Vec::new()
-                },
-                !plain,
-            )
+                .map(parse_finite)
+                .collect();
+            match plain {
+                Some(numbers) => (numbers, false),
+                None => {
+                    let (numbers, complete) = stream_numbers(text);
+                    (
+                        if complete || numbers.len() >= 3 {
+                            numbers
+                        } else {
+                            Vec::new()
+                        },
+                        true,
+                    )
+                }
+            }
         }
         Value::List(items) => {
             let numbers: Option<Vec<f64>> = items
@@ -277,7 +289,7 @@ pub(crate) fn vector(node: &Node, diagnostics: &mut Diagnostics) -> Result<Vec3,
     let vector = Vec3::new(numbers[0] as f32, numbers[1] as f32, numbers[2] as f32);
     if irregular {
         let text = match &node.value {
-            Value::Text(text) => text.as_str(),
+            Value::Text(text) => &**text,
             _ => "",
         };
         diagnostics.warn(

@@ -1,11 +1,16 @@
 //! Course XML (FORMAT.md 2) into the located tree, with roxmltree.
 
+use std::borrow::Cow;
+
 use crate::desc::Span;
 use crate::diagnostic::{Diagnostics, SceneError};
 use crate::tree::{Node, Value, TEXT_KEY};
 
 /// Parses `text` and returns the root element as a node keyed by its tag name.
-pub(crate) fn parse(text: &str, diagnostics: &Diagnostics) -> Result<Node, SceneError> {
+pub(crate) fn parse<'text>(
+    text: &'text str,
+    diagnostics: &Diagnostics,
+) -> Result<Node<'text>, SceneError> {
     check_nesting(text, diagnostics)?;
     let document = roxmltree::Document::parse(text).map_err(|error| {
         let span = match error {
@@ -91,12 +96,12 @@ fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError
     Ok(())
 }
 
-fn convert_element(
-    element: roxmltree::Node,
-    text: &str,
+fn convert_element<'text>(
+    element: roxmltree::Node<'_, 'text>,
+    text: &'text str,
     diagnostics: &Diagnostics,
     depth: usize,
-) -> Result<Node, SceneError> {
+) -> Result<Node<'text>, SceneError> {
     let element_span = diagnostics.span_at(element.range().start);
     if depth > MAX_NESTING {
         return Err(diagnostics.error(
@@ -110,42 +115,47 @@ fn convert_element(
             attribute.name(),
             diagnostics.span_at(attribute.range().start),
             diagnostics.span_at(attribute.range_value().start),
-            Value::Text(attribute.value().to_owned()),
+            Value::Text(borrowed(attribute.value_storage())),
         ));
     }
-    let mut element_text = String::new();
+    // The element's text: its one text child as the file has it, or its text children joined.
+    let mut element_text: Option<Cow<'text, str>> = None;
     let mut text_offset = None;
     for child in element.children() {
         if child.is_element() {
             entries.push(convert_element(child, text, diagnostics, depth + 1)?);
         } else if child.is_text() {
-            let content = child.text().unwrap_or_default();
+            let Some(content) = child.text_storage() else {
+                continue;
+            };
             if text_offset.is_none() && !content.trim().is_empty() {
                 // Point at the first character of the value, not at the whitespace before it.
                 let raw = &text[child.range()];
                 let leading = raw.len() - raw.trim_start().len();
                 text_offset = Some(child.range().start + leading);
             }
-            element_text.push_str(content);
+            element_text = Some(match element_text {
+                None => borrowed(content),
+                Some(before) => Cow::Owned(before.into_owned() + content),
+            });
         }
     }
-    let trimmed = element_text.trim();
+    let trimmed = match element_text {
+        None => Cow::Borrowed(""),
+        Some(Cow::Borrowed(content)) => Cow::Borrowed(content.trim()),
+        Some(Cow::Owned(content)) => Cow::Owned(content.trim().to_owned()),
+    };
     let has_structure = !entries.is_empty();
     let tag = element.tag_name().name();
     if !has_structure {
         let span = text_offset.map_or(element_span, |offset| diagnostics.span_at(offset));
-        return Ok(Node::new(
-            tag,
-            element_span,
-            span,
-            Value::Text(trimmed.to_owned()),
-        ));
+        return Ok(Node::new(tag, element_span, span, Value::Text(trimmed)));
     }
     if let Some(offset) = text_offset {
         let span = diagnostics.span_at(offset);
-        let mut text_node = Node::new(TEXT_KEY, span, span, Value::Text(trimmed.to_owned()));
+        let mut text_node = Node::new(TEXT_KEY, span, span, Value::Text(trimmed));
         // Messages about the text name the element it belongs to.
-        text_node.raw_key = tag.to_owned();
+        text_node.raw_key = tag;
         entries.push(text_node);
     }
     Ok(Node::new(
@@ -154,4 +164,12 @@ fn convert_element(
         element_span,
         Value::Object(entries),
     ))
+}
+
+/// A value as the file has it, or a copy where roxmltree had to rewrite it (entities).
+fn borrowed<'text>(storage: &roxmltree::StringStorage<'text>) -> Cow<'text, str> {
+    match storage {
+        roxmltree::StringStorage::Borrowed(text) => Cow::Borrowed(text),
+        roxmltree::StringStorage::Owned(text) => Cow::Owned(text.to_string()),
+    }
 }

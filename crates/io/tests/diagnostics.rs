@@ -656,3 +656,78 @@ fn deep_nesting_is_an_error() {
         error.message
     );
 }
+
+// ---- text the parsers rewrite ----------------------------------------------------------------
+
+/// Keys and values are borrowed from the file where they read as written; those the parsers
+/// rewrite (XML entities and CDATA, text split by a processing instruction, JSON escapes) are copied. Either
+/// way the scene must be the one its plain twin gives, with the same warnings.
+#[test]
+fn escaped_and_split_text_reads_as_its_plain_twin() {
+    let fixture = Fixture::new();
+    let plain_body = r#"  <shader name="red&blue" type="Lambertian"><diffuse>1 0 0.5</diffuse></shader>
+  <shape name="ball" type="sphere"><shader ref="red&blue"/>
+    <center>0 0 -5</center><radius>1.5</radius></shape>
+  <shape type="sphere"><center>0 2 -5</center><radius>0.25</radius><colour>1</colour></shape>
+"#;
+    let escaped_body = r#"  <shader name="red&amp;blue" type="Lambertian"><diffuse>&#49; 0 0.5</diffuse></shader>
+  <shape name="ball" type="sphere"><shader ref="red&#38;blue"/>
+    <center>0 0 -<?note five?>5</center><radius><![CDATA[1.5]]></radius></shape>
+  <shape type="sphere"><center> 0 2 -5 </center><radius>0.25</radius><colour>1</colour></shape>
+"#;
+    let plain = expect_ok(fixture.load(
+        "plain.xml",
+        &xml_scene(&plain_body.replace("red&blue", "red and blue")),
+    ));
+    let escaped = expect_ok(
+        fixture.load(
+            "escaped.xml",
+            &xml_scene(
+                &escaped_body
+                    .replace("red&amp;blue", "red and blue")
+                    .replace("red&#38;blue", "red and blue"),
+            ),
+        ),
+    );
+    let ampersand = expect_ok(fixture.load("ampersand.xml", &xml_scene(escaped_body)));
+    let json = |body: &str| {
+        format!(
+            r#"{{"scene": {{{CAMERA_JSON},
+  "shader": [{{"_name": "red&blue", "_type": "Lambertian", "diffuse": "1 0 0.5"}}],
+  {body}}}}}"#
+        )
+    };
+    let json_plain = expect_ok(fixture.load(
+        "plain.json",
+        &json(
+            r#""shape": [{"_name": "ball", "_type": "sphere", "shader": {"_ref": "red&blue"},
+                  "center": "0 0 -5", "radius": "1.5"}]"#,
+        ),
+    ));
+    let json_escaped = expect_ok(fixture.load(
+        "escaped.json",
+        &json(r#""\u0073hape": [{"_name": "ball", "\u005ftype": "sph\u0065re", "shader": {"_ref": "red\u0026blue"},
+                  "center": "0 0 \u002d5", "radius": "1.\u0035"}]"#),
+    ));
+    let hash = |loaded: &LoadedScene| glint_io::scene_hash(&loaded.parts);
+    let messages = |loaded: &LoadedScene| {
+        loaded
+            .warnings
+            .iter()
+            .map(|warning| warning.message.clone())
+            .collect::<Vec<_>>()
+    };
+    // The warnings are the unknown `colour` and the second sphere's missing shader: every
+    // other entry was read.
+    assert_eq!(messages(&plain).len(), 2, "{:?}", messages(&plain));
+    assert_eq!(messages(&json_plain), Vec::<String>::new());
+    assert_eq!(hash(&escaped), hash(&plain));
+    assert_eq!(messages(&escaped), messages(&plain));
+    assert_eq!(hash(&ampersand), hash(&plain), "a name with `&` in it");
+    assert_eq!(hash(&json_escaped), hash(&json_plain));
+    assert_eq!(messages(&json_escaped), messages(&json_plain));
+    // The warning about the unknown `colour` entry names it as written, at its place.
+    let unknown = warning(&plain, "colour");
+    assert_eq!(at(unknown), (9, 68));
+    assert_eq!(at(warning(&escaped, "colour")), (9, 70));
+}
