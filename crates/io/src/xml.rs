@@ -44,16 +44,24 @@ const MAX_NESTING: usize = 100;
 /// Counts open and close tags outside comments, CDATA and declarations, and fails where the
 /// nesting gets too deep. Malformed markup is left for roxmltree to report.
 fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError> {
-    let bytes = text.as_bytes();
+    match too_deep(text.as_bytes()) {
+        None => Ok(()),
+        Some(start) => Err(diagnostics.error(
+            diagnostics.span_at(start),
+            format!("elements nested more than {MAX_NESTING} levels deep; not a scene file"),
+        )),
+    }
+}
+
+/// Where the open tag that nests deeper than `MAX_NESTING` starts, if one does.
+fn too_deep(bytes: &[u8]) -> Option<usize> {
     let skip_past = |from: usize, pattern: &[u8]| -> usize {
-        bytes[from..]
-            .windows(pattern.len())
-            .position(|window| window == pattern)
+        memchr::memmem::find(&bytes[from..], pattern)
             .map_or(bytes.len(), |position| from + position + pattern.len())
     };
     let mut depth = 0usize;
     let mut index = 0;
-    while let Some(offset) = bytes[index..].iter().position(|&byte| byte == b'<') {
+    while let Some(offset) = memchr::memchr(b'<', &bytes[index..]) {
         let start = index + offset;
         let rest = &bytes[start..];
         if rest.starts_with(b"<!--") {
@@ -68,32 +76,33 @@ fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError
         } else {
             // An open tag: find its end outside quoted attribute values.
             let mut end = start + 1;
-            let mut quote = None;
-            while end < bytes.len() {
-                match (quote, bytes[end]) {
-                    (None, b'"' | b'\'') => quote = Some(bytes[end]),
-                    (Some(open), byte) if byte == open => quote = None,
-                    (None, b'>') => break,
-                    _ => {}
+            loop {
+                let Some(offset) = memchr::memchr3(b'"', b'\'', b'>', &bytes[end..]) else {
+                    end = bytes.len();
+                    break;
+                };
+                end += offset;
+                if bytes[end] == b'>' {
+                    break;
                 }
-                end += 1;
+                // A quote: on past its closing twin.
+                let Some(offset) = memchr::memchr(bytes[end], &bytes[end + 1..]) else {
+                    end = bytes.len();
+                    break;
+                };
+                end += 1 + offset + 1;
             }
             let self_closing = end < bytes.len() && bytes[end - 1] == b'/';
             if !self_closing {
                 depth += 1;
                 if depth > MAX_NESTING {
-                    return Err(diagnostics.error(
-                        diagnostics.span_at(start),
-                        format!(
-                            "elements nested more than {MAX_NESTING} levels deep; not a scene file"
-                        ),
-                    ));
+                    return Some(start);
                 }
             }
             index = (end + 1).min(bytes.len());
         }
     }
-    Ok(())
+    None
 }
 
 fn convert_element<'text>(
@@ -171,5 +180,107 @@ fn borrowed<'text>(storage: &roxmltree::StringStorage<'text>) -> Cow<'text, str>
     match storage {
         roxmltree::StringStorage::Borrowed(text) => Cow::Borrowed(text),
         roxmltree::StringStorage::Owned(text) => Cow::Owned(text.to_string()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scan as first written, a byte at a time: the definition `too_deep` must keep.
+    fn too_deep_bytewise(bytes: &[u8]) -> Option<usize> {
+        let skip_past = |from: usize, pattern: &[u8]| -> usize {
+            bytes[from..]
+                .windows(pattern.len())
+                .position(|window| window == pattern)
+                .map_or(bytes.len(), |position| from + position + pattern.len())
+        };
+        let mut depth = 0usize;
+        let mut index = 0;
+        while let Some(offset) = bytes[index..].iter().position(|&byte| byte == b'<') {
+            let start = index + offset;
+            let rest = &bytes[start..];
+            if rest.starts_with(b"<!--") {
+                index = skip_past(start, b"-->");
+            } else if rest.starts_with(b"<![CDATA[") {
+                index = skip_past(start, b"]]>");
+            } else if rest.starts_with(b"<?") || rest.starts_with(b"<!") {
+                index = skip_past(start, b">");
+            } else if rest.starts_with(b"</") {
+                depth = depth.saturating_sub(1);
+                index = skip_past(start, b">");
+            } else {
+                let mut end = start + 1;
+                let mut quote = None;
+                while end < bytes.len() {
+                    match (quote, bytes[end]) {
+                        (None, b'"' | b'\'') => quote = Some(bytes[end]),
+                        (Some(open), byte) if byte == open => quote = None,
+                        (None, b'>') => break,
+                        _ => {}
+                    }
+                    end += 1;
+                }
+                let self_closing = end < bytes.len() && bytes[end - 1] == b'/';
+                if !self_closing {
+                    depth += 1;
+                    if depth > MAX_NESTING {
+                        return Some(start);
+                    }
+                }
+                index = (end + 1).min(bytes.len());
+            }
+        }
+        None
+    }
+
+    /// Documents of tags, quotes, comments, CDATA and declarations in random order, nested to
+    /// around the limit: the same answer as the byte-at-a-time scan, truncated anywhere.
+    #[test]
+    fn the_nesting_scan_agrees_with_its_definition() {
+        const PIECES: [&str; 16] = [
+            "<a>",
+            "</a>",
+            "<a/>",
+            "<b x='>'>",
+            "<c y=\">/\">",
+            "<d z='\"'/>",
+            "<!-- <a> -->",
+            "<![CDATA[<a>]]>",
+            "<?pi <a>?>",
+            "<!DOCTYPE x>",
+            "'",
+            "\"",
+            ">",
+            "<",
+            "/",
+            "text ",
+        ];
+        let mut state = 0x9e37_79b9_u32;
+        let mut next = |bound: usize| {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as usize % bound
+        };
+        let mut deep = 0;
+        for _ in 0..400 {
+            // Mostly opening tags, so that some documents pass the limit.
+            let opening = next(4);
+            let mut document = String::new();
+            for _ in 0..next(300) {
+                let piece = if next(4) < opening {
+                    "<a>"
+                } else {
+                    PIECES[next(16)]
+                };
+                document.push_str(piece);
+            }
+            let bytes = document.as_bytes();
+            for cut in [bytes.len(), bytes.len() / 2, bytes.len().saturating_sub(1)] {
+                let expected = too_deep_bytewise(&bytes[..cut]);
+                assert_eq!(too_deep(&bytes[..cut]), expected, "{:?}", &document[..cut]);
+                deep += usize::from(expected.is_some());
+            }
+        }
+        assert!(deep > 50, "only {deep} documents reach the limit");
     }
 }
