@@ -20,9 +20,11 @@ use crate::desc::Span;
 /// children (`<diffuse tex="earth">1 1 1</diffuse>`, `<rotate axis="X">45</rotate>`).
 pub(crate) const TEXT_KEY: &str = "#text";
 
-/// Keys and values borrow from the file's text (`'text`) where they appear in it as they read;
-/// only text with XML entities or JSON escapes is copied. A tree of a 100,000-shape file then
-/// holds one allocation per object rather than several per entry.
+/// Keys and values are borrowed (`'text`): from the file's text for XML, where they appear in
+/// it as they read (text roxmltree rewrote, for entities, CDATA or text split around a
+/// processing instruction, is copied), and from jsonc-parser's syntax tree for JSON, which the
+/// loader keeps while the tree is read. A tree of a 100,000-shape file then holds one
+/// allocation per object rather than several per entry.
 #[derive(Clone, Debug, PartialEq)]
 pub(crate) struct Node<'text> {
     /// The key with leading underscores removed; empty for list elements.
