@@ -336,28 +336,10 @@ mod tests {
                 (v.clamp(0.0, 1.0) * 255.0).round() as u8
             }
         };
-        let mut values = vec![
-            0.0,
-            -0.0,
-            1.0,
-            f32::from_bits(1),
-            f32::MIN_POSITIVE,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            -1.0,
-        ];
-        for k in 0..=255u32 {
-            for threshold in [(k as f32 + 0.5) / 255.0, k as f32 / 255.0] {
-                let bits = threshold.to_bits();
-                values.extend((bits.saturating_sub(64)..=bits + 64).map(f32::from_bits));
-            }
-        }
-        let mut state = 0x2545_f491_u32;
-        values.extend((0..1 << 20).map(|_| {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            f32::from_bits(state)
-        }));
+        // Every half-way point (k + 0.5) / 255 and threshold k / 255.
+        let values = glint_render::testing::float_probes(
+            (0..=255u32).flat_map(|k| [(k as f32 + 0.5) / 255.0, k as f32 / 255.0]),
+        );
         for v in values {
             assert_eq!(rounded_level(v), reference(v), "{v:e} ({:#x})", v.to_bits());
         }

@@ -125,31 +125,8 @@ mod tests {
 
     #[test]
     fn course_levels_are_the_floor_of_the_clamped_value() {
-        let mut values = vec![
-            0.0,
-            -0.0,
-            1.0,
-            -1.0,
-            f32::MIN_POSITIVE,
-            -f32::MIN_POSITIVE,
-            f32::from_bits(1),
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            -f32::NAN,
-            f32::MAX,
-        ];
-        // Every level's threshold k/255 and the floats within 64 ulps of it, either side.
-        for k in 0..=256u32 {
-            let bits = (k as f32 / 255.0).to_bits();
-            values.extend((bits.saturating_sub(64)..=bits + 64).map(f32::from_bits));
-        }
-        // And bit patterns spread over all of them (a fixed LCG).
-        let mut state = 0x2545_f491_u32;
-        values.extend((0..1 << 20).map(|_| {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            f32::from_bits(state)
-        }));
+        // Every level's threshold k/255.
+        let values = crate::testing::float_probes((0..=256u32).map(|k| k as f32 / 255.0));
         for v in values {
             assert_eq!(
                 course_level(v),

@@ -346,3 +346,33 @@ pub fn grid_cube(n: usize) -> Vec<Tri> {
 pub fn shared_models() -> std::path::PathBuf {
     std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/models")
 }
+
+/// Floats to hold a conversion of code values to its definition on: the specials, every
+/// threshold given with the 64 floats either side of it, and 2^20 bit patterns spread over all
+/// floats (a fixed LCG).
+pub fn float_probes(thresholds: impl IntoIterator<Item = f32>) -> Vec<f32> {
+    let mut values = vec![
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        f32::MIN_POSITIVE,
+        -f32::MIN_POSITIVE,
+        f32::from_bits(1),
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        -f32::NAN,
+        f32::MAX,
+    ];
+    for threshold in thresholds {
+        let bits = threshold.to_bits();
+        values.extend((bits.saturating_sub(64)..=bits + 64).map(f32::from_bits));
+    }
+    let mut state = 0x2545_f491_u32;
+    values.extend((0..1 << 20).map(|_| {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        f32::from_bits(state)
+    }));
+    values
+}
