@@ -325,23 +325,30 @@ mod tests {
         );
     }
 
+    /// The level as first written: the nearest by `f32::round`.
+    fn round_level(v: f32) -> u8 {
+        if v.is_nan() {
+            0
+        } else {
+            (v.clamp(0.0, 1.0) * 255.0).round() as u8
+        }
+    }
+
     /// `rounded_level` is the rounding it replaces, `(v.clamp(0, 1) * 255).round()`, on every
     /// half-way point (k + 0.5) / 255 and 64 ulps either side, specials and 2^20 bit patterns.
     #[test]
     fn levels_round_as_f32_round_does() {
-        let reference = |v: f32| {
-            if v.is_nan() {
-                0
-            } else {
-                (v.clamp(0.0, 1.0) * 255.0).round() as u8
-            }
-        };
         // Every half-way point (k + 0.5) / 255 and threshold k / 255.
         let values = glint_render::testing::float_probes(
             (0..=255u32).flat_map(|k| [(k as f32 + 0.5) / 255.0, k as f32 / 255.0]),
         );
         for v in values {
-            assert_eq!(rounded_level(v), reference(v), "{v:e} ({:#x})", v.to_bits());
+            assert_eq!(
+                rounded_level(v),
+                round_level(v),
+                "{v:e} ({:#x})",
+                v.to_bits()
+            );
         }
     }
 
@@ -372,15 +379,7 @@ mod tests {
             };
             let expected: Vec<u8> = pixels
                 .iter()
-                .flat_map(|&c| {
-                    transform.apply(c).to_array().map(|v| {
-                        if v.is_nan() {
-                            0
-                        } else {
-                            (v.clamp(0.0, 1.0) * 255.0).round() as u8
-                        }
-                    })
-                })
+                .flat_map(|&c| transform.apply(c).to_array().map(round_level))
                 .collect();
             for count in [0, 1, 1023, 1024, 1025, pixels.len()] {
                 assert_eq!(

@@ -1015,7 +1015,6 @@ fn read_xform_entry(
     }))
 }
 
-/// "a sphere shape", "an instance shape".
 /// How a shape is named in messages: "a shape", "a sphere shape", "an instance definition",
 /// without a copy for the course's shape types.
 fn shape_phrase(type_name: Option<&str>, role: ShapeRole) -> Cow<'static, str> {
@@ -1059,6 +1058,7 @@ fn shape_phrase(type_name: Option<&str>, role: ShapeRole) -> Cow<'static, str> {
     }
 }
 
+/// The phrase with its article: "a sphere shape", "an instance shape".
 fn with_article(phrase: &str) -> String {
     let starts_with_vowel = phrase
         .chars()

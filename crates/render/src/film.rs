@@ -98,6 +98,7 @@ impl Film {
         self.pixels.iter().flat_map(|c| c.to_array()).collect()
     }
 }
+
 /// floor(v·255) of `v` clamped to [0, 1]; NaN gives 0. The product lies in [0, 255] (or is
 /// -0.0), where truncation toward zero is the floor: no `floorf` call (x86-64's baseline has no
 /// SSE4.1 `roundss`), the same levels.
