@@ -56,20 +56,30 @@ pub(crate) fn count_triangles(bytes: &[u8]) -> u64 {
 }
 
 fn count_triangles_of_lines(bytes: &[u8]) -> u64 {
-    bytes
-        .split(|&byte| byte == b'\n')
-        .filter_map(|line| {
-            let line = line.strip_prefix(b"f")?;
-            if !line.first().is_some_and(u8::is_ascii_whitespace) {
-                return None;
-            }
-            let corners = line
-                .split(u8::is_ascii_whitespace)
-                .filter(|token| !token.is_empty())
-                .count() as u64;
-            Some(corners.saturating_sub(2))
-        })
-        .sum()
+    let mut triangles = 0u64;
+    let mut start = 0;
+    // Line ends by `memchr`; only `f` lines are walked, a byte at a time, counting the starts
+    // of their words (`u8::is_ascii_whitespace` separates them).
+    let ends = memchr::memchr_iter(b'\n', bytes).chain(std::iter::once(bytes.len()));
+    for end in ends {
+        let line = &bytes[start..end];
+        start = end + 1;
+        let Some(rest) = line.strip_prefix(b"f") else {
+            continue;
+        };
+        if !rest.first().is_some_and(u8::is_ascii_whitespace) {
+            continue;
+        }
+        let mut corners = 0u64;
+        let mut in_word = false;
+        for byte in rest {
+            let word = !byte.is_ascii_whitespace();
+            corners += u64::from(word && !in_word);
+            in_word = word;
+        }
+        triangles += corners.saturating_sub(2);
+    }
+    triangles
 }
 
 /// The one OBJ reader: scene meshes (`load_triangles`) and stand-alone meshes
@@ -127,6 +137,47 @@ pub(crate) fn read_with_tobj(reader: &mut impl BufRead) -> Result<Mesh, String> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The count by line ends and word starts is the count by `split`s it replaced (kept
+    /// here as the definition), on random texts of the bytes that matter to it.
+    #[test]
+    fn triangle_count_follows_its_definition() {
+        fn by_splits(bytes: &[u8]) -> u64 {
+            bytes
+                .split(|&byte| byte == b'\n')
+                .filter_map(|line| {
+                    let line = line.strip_prefix(b"f")?;
+                    if !line.first().is_some_and(u8::is_ascii_whitespace) {
+                        return None;
+                    }
+                    let corners = line
+                        .split(u8::is_ascii_whitespace)
+                        .filter(|token| !token.is_empty())
+                        .count() as u64;
+                    Some(corners.saturating_sub(2))
+                })
+                .sum()
+        }
+        let mut state = 0xd1b5_4a32_d192_ed03u64;
+        let mut random = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..20_000 {
+            let length = (random() % 120) as usize;
+            let bytes = b"f f1 \n\t\r\x0b\x0cv#/";
+            let text: Vec<u8> = (0..length)
+                .map(|_| bytes[(random() % bytes.len() as u64) as usize])
+                .collect();
+            assert_eq!(
+                count_triangles_of_lines(&text),
+                by_splits(&text),
+                "{text:?}"
+            );
+        }
+    }
 
     #[test]
     fn polygons_become_fans() {

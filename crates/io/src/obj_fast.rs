@@ -4,15 +4,16 @@
 //!
 //! It gives exactly the triangles tobj gives (`obj::read_obj`'s other path), or declines
 //! (`None`) and leaves the file to tobj: it accepts only what it can read the way tobj does,
-//! with the same tokenising (`str::split_whitespace`), the same number parsing (`f32` and
-//! `isize` `FromStr`), the same fan triangulation `(v0, vk, vk+1)` and the same relative
-//! indices. Anything else declines: a byte that is not ASCII, `vt`, `vn` and `l` records, a
-//! face corner with a `/`, a face of fewer than three corners, a `v` with a fourth value, a
-//! malformed number, an index 0 or one naming a vertex not yet defined at its line (tobj
-//! accepts forward references within an object; this reader does not try), an `usemtl`
-//! without a name, a face on a non-finite vertex. Errors are therefore always tobj's.
-//! `tests::agrees_with_tobj` holds it to that on every OBJ file of the course corpus and
-//! the shared models and on the malformed cases of `obj.rs`.
+//! with the same tokenising (`str::split_whitespace`'s words, found a byte at a time), the
+//! same number parsing (`f32` `FromStr`, and `isize`'s by `parse_index`), the same fan
+//! triangulation `(v0, vk, vk+1)` and the same relative indices. Anything else declines: a
+//! byte that is not ASCII, `vt`, `vn` and `l` records, a face corner with a `/`, a face of
+//! fewer than three corners, a `v` with a fourth value, a malformed number, an index 0 or one
+//! naming a vertex not yet defined at its line (tobj accepts forward references within an
+//! object; this reader does not try), an `usemtl` without a name, a face on a non-finite
+//! vertex. Errors are therefore always tobj's. `tests::agrees_with_tobj` holds it to that on
+//! every OBJ file of the course corpus and the shared models and on the malformed cases of
+//! `obj.rs`.
 
 use glint_render::Vec3;
 
@@ -41,13 +42,19 @@ struct Face {
 
 /// The mesh of an OBJ file's bytes, or `None` when tobj should read it (module docs).
 pub(crate) fn read(bytes: &[u8]) -> Option<Mesh> {
-    if !bytes.is_ascii() || bytes.len() >= u32::MAX as usize {
+    if bytes.len() >= u32::MAX as usize {
         return None;
     }
-    let text = std::str::from_utf8(bytes).ok()?;
-    let chunks = map(&split_at_lines(text), |piece| parse_chunk(piece))
-        .into_iter()
-        .collect::<Option<Vec<Chunk>>>()?;
+    // Each piece checked for ASCII (then every offset in it is a char boundary) in its task.
+    let chunks = map(&line_pieces(bytes), |range| {
+        let piece = &bytes[range.clone()];
+        if !piece.is_ascii() {
+            return None;
+        }
+        parse_chunk(std::str::from_utf8(piece).ok()?)
+    })
+    .into_iter()
+    .collect::<Option<Vec<Chunk>>>()?;
     // The file's vertex index of each chunk's first vertex.
     let mut bases = Vec::with_capacity(chunks.len());
     let mut total = 0usize;
@@ -71,16 +78,6 @@ pub(crate) fn read(bytes: &[u8]) -> Option<Mesh> {
         positions,
         triangles,
     })
-}
-
-/// `text` cut after a `\n` about every `CHUNK_BYTES`, into as many pieces as there are
-/// threads to take them (at least one piece).
-fn split_at_lines(text: &str) -> Vec<&str> {
-    // ASCII (checked by the caller): every byte offset is a char boundary.
-    line_pieces(text.as_bytes())
-        .into_iter()
-        .map(|range| &text[range])
-        .collect()
 }
 
 /// Byte ranges covering `bytes`, each ending after a `\n` but the last, about `CHUNK_BYTES`
@@ -116,10 +113,16 @@ pub(crate) fn sum_over_lines(bytes: &[u8], f: impl Fn(&[u8]) -> u64 + Sync + Sen
 
 fn parse_chunk(text: &str) -> Option<Chunk> {
     let mut chunk = Chunk::default();
-    for line in text.split('\n') {
+    let mut start = 0;
+    // The lines of `text` as `str::split('\n')` gives them (the last one after the last `\n`,
+    // empty when `text` ends with one), found by `memchr`.
+    let ends = memchr::memchr_iter(b'\n', text.as_bytes()).chain(std::iter::once(text.len()));
+    for end in ends {
+        let line = &text[start..end];
+        start = end + 1;
         // tobj reads lines with `BufRead::lines`, which drops a `\r` before the `\n`.
         let line = line.strip_suffix('\r').unwrap_or(line);
-        let mut words = line.split_whitespace();
+        let mut words = Words { line, at: 0 };
         match words.next() {
             None | Some("#") => {}
             Some("v") => {
@@ -135,10 +138,8 @@ fn parse_chunk(text: &str) -> Option<Chunk> {
             Some("f") => {
                 let first = chunk.corners.len();
                 for word in words {
-                    if word.contains('/') {
-                        return None;
-                    }
-                    let index: isize = word.parse().ok()?;
+                    // A corner with a `/` (`1/2/3`, `3//7`) is no number: declined here too.
+                    let index = parse_index(word)?;
                     if index == 0 {
                         return None;
                     }
@@ -166,6 +167,66 @@ fn parse_chunk(text: &str) -> Option<Chunk> {
         }
     }
     Some(chunk)
+}
+
+/// `word.parse::<isize>().ok()`: an optional sign, then one or more ASCII digits, `None` on
+/// anything else and on overflow; without the generic parser's calls per digit.
+fn parse_index(word: &str) -> Option<isize> {
+    let bytes = word.as_bytes();
+    let (negative, digits) = match bytes.first()? {
+        b'-' => (true, &bytes[1..]),
+        b'+' => (false, &bytes[1..]),
+        _ => (false, bytes),
+    };
+    if digits.is_empty() {
+        return None;
+    }
+    let mut value: isize = 0;
+    for &byte in digits {
+        let digit = byte.wrapping_sub(b'0');
+        if digit > 9 {
+            return None;
+        }
+        value = value.checked_mul(10)?;
+        value = if negative {
+            value.checked_sub(isize::from(digit))?
+        } else {
+            value.checked_add(isize::from(digit))?
+        };
+    }
+    Some(value)
+}
+
+/// The words of an ASCII line as `str::split_whitespace` gives them, a byte at a time
+/// instead of a `char` at a time.
+struct Words<'a> {
+    line: &'a str,
+    at: usize,
+}
+
+/// `char::is_whitespace` of an ASCII byte: tab, line feed, vertical tab, form feed, carriage
+/// return and space.
+fn is_whitespace(byte: u8) -> bool {
+    matches!(byte, b'\t' | b'\n' | 0x0b | 0x0c | b'\r' | b' ')
+}
+
+impl<'a> Iterator for Words<'a> {
+    type Item = &'a str;
+
+    fn next(&mut self) -> Option<&'a str> {
+        let bytes = self.line.as_bytes();
+        let mut at = self.at;
+        while at < bytes.len() && is_whitespace(bytes[at]) {
+            at += 1;
+        }
+        let start = at;
+        while at < bytes.len() && !is_whitespace(bytes[at]) {
+            at += 1;
+        }
+        self.at = at;
+        // Every byte is ASCII (checked by `read`), so every offset is a char boundary.
+        (start < at).then(|| &self.line[start..at])
+    }
 }
 
 /// The chunk's faces as fans of vertex indices of the file; `None` on an index tobj would
@@ -362,17 +423,115 @@ mod tests {
             text.len() > 4 * CHUNK_BYTES,
             "the test needs several chunks"
         );
-        assert!(split_at_lines(&text).len() > 1);
+        assert!(line_pieces(text.as_bytes()).len() > 1);
         assert!(check("generated", text.as_bytes()));
         // The limit's count, summed over pieces, is the triangles made.
         let made = read(text.as_bytes()).unwrap().triangles.len() as u64;
         assert_eq!(crate::obj::count_triangles(text.as_bytes()), made);
     }
 
+    /// The byte-at-a-time words are `str::split_whitespace`'s on ASCII lines: every ASCII
+    /// byte (the whitespace of `char::is_whitespace` and of `u8::is_ascii_whitespace` differ
+    /// in the vertical tab) in random lines of up to 40 bytes.
+    #[test]
+    fn words_are_split_whitespace_words() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut random = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..200_000 {
+            let length = (random() % 41) as usize;
+            // Half the bytes from all of ASCII, half from the whitespace and three others.
+            let line: String = (0..length)
+                .map(|_| {
+                    let r = random();
+                    if r & 1 == 0 {
+                        ((r >> 8) % 128) as u8 as char
+                    } else {
+                        let bytes = b"\t\n\x0b\x0c\r v1#";
+                        bytes[((r >> 8) % bytes.len() as u64) as usize] as char
+                    }
+                })
+                .collect();
+            let ours: Vec<&str> = Words { line: &line, at: 0 }.collect();
+            let std: Vec<&str> = line.split_whitespace().collect();
+            assert_eq!(ours, std, "{line:?}");
+        }
+    }
+
+    /// `parse_index` is `isize`'s `FromStr`: on the edges of its range, signs alone and
+    /// doubled, corners with slashes, and random words of digits, signs and a few others.
+    #[test]
+    fn indices_parse_as_isize_parses_them() {
+        let max = isize::MAX.to_string();
+        let min = isize::MIN.to_string();
+        let mut words: Vec<String> = [
+            "",
+            "+",
+            "-",
+            "0",
+            "-0",
+            "+0",
+            "7",
+            "+7",
+            "-7",
+            "--1",
+            "+-1",
+            "-+1",
+            "1/2/3",
+            "3//7",
+            "1.0",
+            " 1",
+            "1 ",
+            "0x1f",
+            "٣",
+            "00000000000000000000000000012",
+        ]
+        .iter()
+        .map(|word| word.to_string())
+        .collect();
+        for edge in [&max, &min] {
+            words.push(edge.clone());
+            // One past the edge: the last digit raised (9223372036854775808, ...809).
+            let mut past = edge.clone().into_bytes();
+            *past.last_mut().unwrap() += 1;
+            words.push(String::from_utf8(past).unwrap());
+            words.push(format!("{edge}0"));
+        }
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut random = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for _ in 0..100_000 {
+            let length = (random() % 22) as usize;
+            words.push(
+                (0..length)
+                    .map(|_| {
+                        let bytes = b"0123456789+-/a9";
+                        bytes[(random() % bytes.len() as u64) as usize] as char
+                    })
+                    .collect(),
+            );
+        }
+        for word in &words {
+            assert_eq!(parse_index(word), word.parse::<isize>().ok(), "{word:?}");
+        }
+    }
+
     #[test]
     fn pieces_cover_the_text_and_end_at_line_ends() {
         let text = "v 1 2 3\n".repeat(200_000);
-        let pieces = split_at_lines(&text);
+        let pieces: Vec<&str> = line_pieces(text.as_bytes())
+            .into_iter()
+            .map(|range| &text[range])
+            .collect();
+        assert!(pieces.len() > 1);
         assert_eq!(pieces.concat(), text);
         assert!(pieces.iter().all(|piece| piece.ends_with('\n')));
     }
