@@ -276,16 +276,9 @@ mod tests {
     #[test]
     fn files_read_in_pieces_are_the_files() {
         let directory = tempfile::tempdir().unwrap();
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut random = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15);
         for length in [(2 << 20) - 1, 2 << 20, (3 << 20) + 1, (5 << 20) + 12_345] {
-            let content: Vec<u8> = (0..length)
-                .map(|_| {
-                    state ^= state << 13;
-                    state ^= state >> 7;
-                    state ^= state << 17;
-                    state as u8
-                })
-                .collect();
+            let content: Vec<u8> = (0..length).map(|_| random() as u8).collect();
             let path = directory.path().join(format!("{length}.bin"));
             std::fs::write(&path, &content).unwrap();
             let read = read_file_at_most(&path, length as u64).unwrap();

@@ -57,6 +57,8 @@ mod ply;
 mod rays;
 mod read;
 mod scene_hash;
+#[cfg(test)]
+mod testing;
 mod tree;
 mod values;
 mod xml;

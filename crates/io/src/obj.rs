@@ -158,13 +158,7 @@ mod tests {
                 })
                 .sum()
         }
-        let mut state = 0xd1b5_4a32_d192_ed03u64;
-        let mut random = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut random = crate::testing::xorshift(0xd1b5_4a32_d192_ed03u64);
         for _ in 0..20_000 {
             let length = (random() % 120) as usize;
             let bytes = b"f f1 \n\t\r\x0b\x0cv#/";

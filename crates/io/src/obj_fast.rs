@@ -435,13 +435,7 @@ mod tests {
     /// in the vertical tab) in random lines of up to 40 bytes.
     #[test]
     fn words_are_split_whitespace_words() {
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
-        let mut random = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut random = crate::testing::xorshift(0x9e37_79b9_7f4a_7c15u64);
         for _ in 0..200_000 {
             let length = (random() % 41) as usize;
             // Half the bytes from all of ASCII, half from the whitespace and three others.
@@ -501,13 +495,7 @@ mod tests {
             words.push(String::from_utf8(past).unwrap());
             words.push(format!("{edge}0"));
         }
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut random = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
+        let mut random = crate::testing::xorshift(0x2545_f491_4f6c_dd1du64);
         for _ in 0..100_000 {
             let length = (random() % 22) as usize;
             words.push(
