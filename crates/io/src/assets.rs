@@ -116,14 +116,8 @@ pub fn read_file_at_most(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
     } else {
         0
     };
-    let mut bytes = Vec::new();
-    #[cfg(unix)]
-    if let Some(pieces) = read_in_pieces(&file, expected)? {
-        bytes = pieces;
-    }
-    if bytes.is_empty() {
-        bytes.reserve_exact(usize::try_from(expected).unwrap_or(0));
-    }
+    let mut bytes = read_in_pieces(&file, expected)?
+        .unwrap_or_else(|| Vec::with_capacity(usize::try_from(expected).unwrap_or(0)));
     // What is left after the pieces (none, unless the file grew since its size was read), or
     // the whole file.
     let read = bytes.len() as u64;
@@ -173,6 +167,12 @@ fn read_in_pieces(file: &std::fs::File, length: u64) -> io::Result<Option<Vec<u8
         )
         .try_reduce(|| true, |a, b| Ok(a && b))?;
     Ok(complete.then_some(bytes))
+}
+
+/// Without positional reads, every file is read in order.
+#[cfg(not(unix))]
+fn read_in_pieces(_file: &std::fs::File, _length: u64) -> io::Result<Option<Vec<u8>>> {
+    Ok(None)
 }
 
 /// Files held in memory, by path. Paths are compared after lexical normalisation (`a/./b` and

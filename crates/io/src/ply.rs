@@ -757,13 +757,8 @@ mod tests {
             }
             bytes.extend_from_slice(&raw);
         };
-        let mut state = seed | 1;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 40) as f64 / (1u64 << 24) as f64
-        };
+        let mut random = crate::testing::xorshift(seed | 1);
+        let mut next = || (random() >> 40) as f64 / (1u64 << 24) as f64;
         for _ in 0..vertices {
             if let Some(extra) = extra {
                 put(&mut bytes, extra, next() * 100.0);
