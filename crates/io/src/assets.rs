@@ -116,16 +116,24 @@ pub fn read_file_at_most(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
     } else {
         0
     };
-    let mut bytes = read_in_pieces(&file, expected)?
+    read_sized(&file, expected, limit)
+}
+
+/// `file` from its start, whose size was `expected` bytes when looked at (0 where it has
+/// none): in pieces where that is large enough, then whatever follows in order (nothing,
+/// unless the file grew since); the whole file in order where the pieces came up short (it
+/// shrank). Refused past `limit` bytes, holding at most `limit + 1`.
+fn read_sized(file: &std::fs::File, expected: u64, limit: u64) -> io::Result<Vec<u8>> {
+    let mut bytes = read_in_pieces(file, expected)?
         .unwrap_or_else(|| Vec::with_capacity(usize::try_from(expected).unwrap_or(0)));
-    // What is left after the pieces (none, unless the file grew since its size was read), or
-    // the whole file.
     let read = bytes.len() as u64;
-    let mut rest = &file;
+    let mut rest = file;
+    // Positional reads leave the file's offset at its start; a file read in order from there
+    // (a pipe among them, which cannot seek) needs no seek.
     if read > 0 {
         io::Seek::seek(&mut rest, io::SeekFrom::Start(read))?;
     }
-    rest.take(limit.saturating_add(1) - read)
+    rest.take(limit.saturating_add(1).saturating_sub(read))
         .read_to_end(&mut bytes)?;
     if bytes.len() as u64 > limit {
         return Err(TooLarge { limit }.into());
@@ -299,6 +307,41 @@ mod tests {
                 Some(TooLarge {
                     limit: length as u64 - 1
                 })
+            );
+        }
+    }
+
+    /// A file that grew after its size was read is read whole (the pieces, then the rest in
+    /// order), one that shrank is read in order, and either is refused past the limit.
+    #[cfg(unix)]
+    #[test]
+    fn files_that_grew_or_shrank_are_read_whole() {
+        let directory = tempfile::tempdir().unwrap();
+        let mut random = crate::testing::xorshift(0x2545_f491_4f6c_dd1d);
+        let length: usize = (3 << 20) + 777;
+        let content: Vec<u8> = (0..length).map(|_| random() as u8).collect();
+        let path = directory.path().join("changing.bin");
+        std::fs::write(&path, &content).unwrap();
+        let whole = length as u64;
+        // As if the size had been read that many bytes before the end (it grew since), and
+        // past the end (it shrank); 0 is a file whose size is not known (a pipe).
+        for expected in [
+            whole - 1,
+            whole - 5000,
+            (2 << 20) + 3,
+            whole + 1,
+            whole + 5000,
+            0,
+        ] {
+            let file = std::fs::File::open(&path).unwrap();
+            let read = read_sized(&file, expected, whole).unwrap();
+            assert!(read == content, "size {expected}: read back differently");
+            let file = std::fs::File::open(&path).unwrap();
+            let error = read_sized(&file, expected, whole - 1).unwrap_err();
+            assert_eq!(
+                TooLarge::of(&error),
+                Some(TooLarge { limit: whole - 1 }),
+                "size {expected}"
             );
         }
     }
