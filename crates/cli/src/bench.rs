@@ -323,17 +323,6 @@ fn trace_mode(
 ) -> Result<Traced, String> {
     let mut t = vec![f32::INFINITY; rays.len()];
     let pool = pool(threads)?;
-    let one = |ray: &Ray| -> f32 {
-        if occlusion {
-            if scene.occluded(ray) {
-                0.0
-            } else {
-                f32::INFINITY
-            }
-        } else {
-            scene.intersect(ray).map_or(f32::INFINITY, |h| h.t)
-        }
-    };
     let packet = |rays: &[Ray; PACKET], lanes: u8| -> [f32; PACKET] {
         if occlusion {
             let occluded = scene.occluded_lanes(rays, lanes);
@@ -359,19 +348,15 @@ fn trace_mode(
     for _ in 0..repeat.max(1) {
         let start = Instant::now();
         match mode {
-            Mode::Single if threads <= 1 => {
-                for (out, ray) in t.iter_mut().zip(rays) {
-                    *out = one(ray);
+            Mode::Single if occlusion => single_pass(&pool, threads, &mut t, rays, |ray| {
+                if scene.occluded(ray) {
+                    0.0
+                } else {
+                    f32::INFINITY
                 }
-            }
-            Mode::Single => pool.install(|| {
-                t.par_chunks_mut(CHUNK)
-                    .zip(rays.par_chunks(CHUNK))
-                    .for_each(|(out, rays)| {
-                        for (o, ray) in out.iter_mut().zip(rays) {
-                            *o = one(ray);
-                        }
-                    })
+            }),
+            Mode::Single => single_pass(&pool, threads, &mut t, rays, |ray| {
+                scene.intersect(ray).map_or(f32::INFINITY, |h| h.t)
             }),
             Mode::Packets(p) if threads <= 1 => {
                 for ((out, rays), &lanes) in packet_t.iter_mut().zip(&p.rays).zip(&p.lanes) {
@@ -404,6 +389,35 @@ fn trace_mode(
     }
     let hits = t.iter().filter(|t| t.is_finite()).count();
     Ok(Traced { seconds, hits, t })
+}
+
+/// One timed pass of single rays: `t[i] = one(&rays[i])`, on the calling thread (`threads`
+/// 1) or on `pool`. A loop of its own for each kind of query, as a program tracing rays would
+/// write it (`rtcIntersect1` in a loop is what `embree_native` times): with the kind chosen
+/// per ray inside one closure, the any-hit query's inlined frame was set up around every
+/// closest-hit call too.
+fn single_pass(
+    pool: &rayon::ThreadPool,
+    threads: usize,
+    t: &mut [f32],
+    rays: &[Ray],
+    one: impl Fn(&Ray) -> f32 + Sync,
+) {
+    if threads <= 1 {
+        for (out, ray) in t.iter_mut().zip(rays) {
+            *out = one(ray);
+        }
+    } else {
+        pool.install(|| {
+            t.par_chunks_mut(CHUNK)
+                .zip(rays.par_chunks(CHUNK))
+                .for_each(|(out, rays)| {
+                    for (o, ray) in out.iter_mut().zip(rays) {
+                        *o = one(ray);
+                    }
+                })
+        })
+    }
 }
 
 fn rays(args: &RaysArgs) -> Result<(), String> {
