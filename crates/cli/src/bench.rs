@@ -391,11 +391,11 @@ fn trace_mode(
     Ok(Traced { seconds, hits, t })
 }
 
-/// One timed pass of single rays: `t[i] = one(&rays[i])`, on the calling thread (`threads`
-/// 1) or on `pool`. A loop of its own for each kind of query, as a program tracing rays would
-/// write it (`rtcIntersect1` in a loop is what `embree_native` times): with the kind chosen
-/// per ray inside one closure, the any-hit query's inlined frame was set up around every
-/// closest-hit call too.
+/// One timed pass of single rays: `t[i] = one(&rays[i])`, on the calling thread where
+/// `threads` is 1, else on `pool`. A loop of its own for each kind of query, as a program
+/// tracing rays would write it (`rtcIntersect1` in a loop is what `embree_native` times): with
+/// the kind chosen per ray inside one closure, the any-hit query's inlined frame was set up
+/// around every closest-hit call too.
 fn single_pass(
     pool: &rayon::ThreadPool,
     threads: usize,
