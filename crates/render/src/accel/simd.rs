@@ -150,7 +150,7 @@ pub(crate) fn margin_node(
 /// What the AVX2 kernel's per-ray set-up makes of `ray`, in the scalar forms: `None` for a
 /// ray it rejects, else the box test's planes (with t_min as the kernel holds it), its far
 /// reciprocals and short-path flag, the watertight test's `WoopRay`, and the values the
-/// triangle test broadcasts (origin[kx], origin[ky], origin[kz], sx, sy, −sz), and the margin
+/// triangle test broadcasts (origin[kx], origin[ky], origin[kz], sx, sy, sz), and the margin
 /// test's constants for a ray it serves in a tree of that `magnitude` (an infinite one: none).
 /// For the test that compares them with `BoxPlanes::new` and `WoopRay::new`.
 #[cfg(test)]
@@ -643,7 +643,7 @@ mod x86 {
         // `lanes` reads `origin` and `shear` by their offsets: keep them first, in this order.
         /// origin[kx], origin[ky], origin[kz]; lane 3 unused.
         origin: [f32; 4],
-        /// sx, sy and −sz (as `block_test` uses it); lane 3 unused.
+        /// sx, sy, sz; lane 3 unused.
         shear: [f32; 4],
         /// kx, ky, kz as byte offsets of a corner's rows in a `TriangleBlock` (16 per axis).
         rows: [usize; 3],
@@ -661,7 +661,7 @@ mod x86 {
             let o = woop.origin;
             TriRay {
                 origin: [o[woop.kx], o[woop.ky], o[woop.kz], 0.0],
-                shear: [woop.sx, woop.sy, -woop.sz, 0.0],
+                shear: [woop.sx, woop.sy, woop.sz, 0.0],
                 rows: [woop.kx, woop.ky, woop.kz].map(|k| k * 4 * BLOCK),
             }
         }
@@ -709,8 +709,7 @@ mod x86 {
             for (&k, &value) in [kx, ky, kz].iter().zip(&self.origin) {
                 origin[k] = value;
             }
-            let [sx, sy, negated_sz, _] = self.shear;
-            let sz = -negated_sz;
+            let [sx, sy, sz, _] = self.shear;
             WoopRay {
                 origin,
                 kx,
@@ -901,10 +900,9 @@ mod x86 {
                 _mm_permutevar_ps(d, lanes),
                 _mm_permutevar_ps(inv, lanes),
             );
-            // [d[kx]·sz, d[ky]·sz, ..] with −sz in lane 2 (`TriRay::shear`).
+            // [d[kx]·sz, d[ky]·sz, ..] with sz itself in lane 2.
             let sz = _mm_permute_ps::<0b10_10_10_10>(inv);
-            let negated_sz = _mm_xor_ps(sz, _mm_set1_ps(-0.0));
-            let shear = _mm_blend_ps::<0b0100>(_mm_mul_ps(d, sz), negated_sz);
+            let shear = _mm_blend_ps::<0b0100>(_mm_mul_ps(d, sz), sz);
             let mut tri = TriRay {
                 origin: [0.0; 4],
                 shear: [0.0; 4],
@@ -1088,21 +1086,22 @@ mod x86 {
                 };
             }
             let [kx, ky, kz] = ray.rows;
-            let [ox, oy, oz, sx, sy, negated_sz] = ray.lanes();
-            // `WoopRay::shear` negated: with a = v − o, x = a[kx] − sx·a[kz] and
-            // y = a[ky] − sy·a[kz], these are −a = o − v, −x = −a[kx] − sx·(−a[kz]) and −y,
-            // exactly (rounding to nearest is symmetric about zero, so each operation on
-            // negated operands gives the negated result). In this order the vertex's row is
-            // the second operand of the subtraction, which x86 reads from memory within the
-            // instruction: nine loads fewer a block.
+            let [ox, oy, oz, sx, sy, sz] = ray.lanes();
+            // `WoopRay::shear` with x and y negated: a = v − o, then x = a[kx] − sx·a[kz] and
+            // y = a[ky] − sy·a[kz] are computed as −x = (o[kx] − v[kx]) + sx·a[kz] and −y.
+            // Rounding to nearest is symmetric about zero, so each is exactly −x (−y), but
+            // for the sign of a zero; x and y reach only the edge functions, each a
+            // difference of two products of them, whose non-zero values that sign cannot
+            // change (and a zero edge function goes to the scalar kernel). In this order the
+            // vertex's x and y rows are the second operands of their subtractions, which x86
+            // reads from memory within the instruction: six loads fewer a block. a[kz] keeps
+            // its sign: t is made of it, and t = 0 must keep the scalar kernel's sign.
             macro_rules! negated_shear {
                 ($corner:expr) => {{
-                    let ax = _mm_sub_ps(ox, load!($corner, kx));
-                    let ay = _mm_sub_ps(oy, load!($corner, ky));
-                    let az = _mm_sub_ps(oz, load!($corner, kz));
+                    let az = _mm_sub_ps(load!($corner, kz), oz);
                     (
-                        _mm_sub_ps(ax, _mm_mul_ps(sx, az)),
-                        _mm_sub_ps(ay, _mm_mul_ps(sy, az)),
+                        _mm_add_ps(_mm_sub_ps(ox, load!($corner, kx)), _mm_mul_ps(sx, az)),
+                        _mm_add_ps(_mm_sub_ps(oy, load!($corner, ky)), _mm_mul_ps(sy, az)),
                         az,
                     )
                 }};
@@ -1112,7 +1111,7 @@ mod x86 {
             let (cx, cy, cz) = negated_shear!(2);
             // `triangle::edge(p, q) = q.x·p.y − q.y·p.x`: U = edge(b, c), V = edge(c, a), W = edge(a, b).
             // Each product's operands are both negated, so the edge functions are the scalar
-            // kernel's themselves.
+            // kernel's themselves (where not zero, as above).
             let u = _mm_sub_ps(_mm_mul_ps(cx, by), _mm_mul_ps(cy, bx));
             let v = _mm_sub_ps(_mm_mul_ps(ax, cy), _mm_mul_ps(ay, cx));
             let w = _mm_sub_ps(_mm_mul_ps(bx, ay), _mm_mul_ps(by, ax));
@@ -1133,13 +1132,12 @@ mod x86 {
             if _mm_movemask_ps(valid) == 0 {
                 return (0, BlockLanes::NONE);
             }
-            // sz·a[kz] as (−sz)·(−a[kz]), the same product.
             let t_scaled = _mm_add_ps(
                 _mm_add_ps(
-                    _mm_mul_ps(u, _mm_mul_ps(negated_sz, az)),
-                    _mm_mul_ps(v, _mm_mul_ps(negated_sz, bz)),
+                    _mm_mul_ps(u, _mm_mul_ps(sz, az)),
+                    _mm_mul_ps(v, _mm_mul_ps(sz, bz)),
                 ),
-                _mm_mul_ps(w, _mm_mul_ps(negated_sz, cz)),
+                _mm_mul_ps(w, _mm_mul_ps(sz, cz)),
             );
             let t = _mm_div_ps(t_scaled, det);
             let in_window = _mm_and_ps(
@@ -1984,7 +1982,7 @@ mod x86 {
         pub inv_far: [f32; 3],
         pub no_nan: bool,
         pub woop: WoopRay,
-        /// `TriRay`'s origin[kx], origin[ky], origin[kz], sx, sy, −sz.
+        /// `TriRay`'s origin[kx], origin[ky], origin[kz], sx, sy, sz.
         pub frame: [f32; 6],
         /// The margin test's near and far constants (`SlabMargin`), for a ray it serves.
         pub margin: Option<[[f32; 3]; 2]>,
@@ -2214,7 +2212,7 @@ mod x86 {
                     w.origin[w.kz],
                     w.sx,
                     w.sy,
-                    -w.sz,
+                    w.sz,
                 ];
                 assert_eq!(
                     got.frame.map(f32::to_bits),

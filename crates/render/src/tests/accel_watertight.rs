@@ -151,3 +151,52 @@ fn camera_rays_never_leak_through_a_closed_mesh() {
         assert_eq!(misses, 0, "{:?}", wide.isa());
     }
 }
+
+/// Rays that start on a face of the grid cube, in its plane (t_min 0), so that a hit lies at
+/// t = 0 and every vertex there is at the origin's coordinate on the face's axis: each kernel
+/// reports the scalar one's hit bit for bit, the sign of a zero t among it.
+#[test]
+fn hits_at_the_origin_are_the_scalar_kernels_bit_for_bit() {
+    let n = 4;
+    let tris = grid_cube(n);
+    let wides = wide_variants(&shapes_of(&tris));
+    let mut rng = rng(17);
+    let mut zero_hits = 0;
+    for _ in 0..4000 {
+        let axis = (rng.next_u32() % 3) as usize;
+        let side = if rng.next_u32() % 2 == 0 {
+            -1.0f32
+        } else {
+            1.0
+        };
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        let mut origin = [0.0f32; 3];
+        origin[axis] = side;
+        // On the face, at quarter steps of the grid (on edges and vertices too).
+        origin[u] = -1.0 + 0.125 * (rng.next_u32() % 17) as f32;
+        origin[v] = -1.0 + 0.125 * (rng.next_u32() % 17) as f32;
+        // Mostly along the face's axis (so that it is the sheared frame's), either way.
+        let mut d = (random_unit(&mut rng) * 0.5).to_array();
+        d[axis] = if rng.next_u32() % 2 == 0 { 1.0 } else { -1.0 };
+        let ray = Ray {
+            origin: Vec3::from_array(origin),
+            direction: Vec3::from_array(d),
+            t_min: 0.0,
+            t_max: f32::INFINITY,
+        };
+        let bits = |h: Option<crate::accel::wide::LocalHit>| {
+            h.map(|h| (h.t.to_bits(), h.primitive, h.b1.to_bits(), h.b2.to_bits()))
+        };
+        let scalar = bits(wides[0].intersect(&ray));
+        zero_hits += usize::from(scalar.is_some_and(|(t, ..)| f32::from_bits(t) == 0.0));
+        for wide in &wides[1..] {
+            assert_eq!(
+                bits(wide.intersect(&ray)),
+                scalar,
+                "{:?}: {ray:?}",
+                wide.isa()
+            );
+        }
+    }
+    assert!(zero_hits > 1000, "{zero_hits} hits at t = 0");
+}
