@@ -164,7 +164,7 @@ fn hits_at_the_origin_are_the_scalar_kernels_bit_for_bit() {
     let mut zero_hits = 0;
     for _ in 0..4000 {
         let axis = (rng.next_u32() % 3) as usize;
-        let side = if rng.next_u32() % 2 == 0 {
+        let side = if rng.next_u32().is_multiple_of(2) {
             -1.0f32
         } else {
             1.0
@@ -177,7 +177,11 @@ fn hits_at_the_origin_are_the_scalar_kernels_bit_for_bit() {
         origin[v] = -1.0 + 0.125 * (rng.next_u32() % 17) as f32;
         // Mostly along the face's axis (so that it is the sheared frame's), either way.
         let mut d = (random_unit(&mut rng) * 0.5).to_array();
-        d[axis] = if rng.next_u32() % 2 == 0 { 1.0 } else { -1.0 };
+        d[axis] = if rng.next_u32().is_multiple_of(2) {
+            1.0
+        } else {
+            -1.0
+        };
         let ray = Ray {
             origin: Vec3::from_array(origin),
             direction: Vec3::from_array(d),
