@@ -57,13 +57,10 @@ pub(crate) fn count_triangles(bytes: &[u8]) -> u64 {
 
 fn count_triangles_of_lines(bytes: &[u8]) -> u64 {
     let mut triangles = 0u64;
-    let mut start = 0;
-    // Line ends by `memchr`; only `f` lines are walked, a byte at a time, counting the starts
-    // of their words (`u8::is_ascii_whitespace` separates them).
-    let ends = memchr::memchr_iter(b'\n', bytes).chain(std::iter::once(bytes.len()));
-    for end in ends {
-        let line = &bytes[start..end];
-        start = end + 1;
+    // Only `f` lines are walked, a byte at a time, counting the starts of their words
+    // (`u8::is_ascii_whitespace` separates them).
+    for range in crate::obj_fast::line_ranges(bytes) {
+        let line = &bytes[range];
         let Some(rest) = line.strip_prefix(b"f") else {
             continue;
         };

@@ -111,15 +111,24 @@ pub(crate) fn sum_over_lines(bytes: &[u8], f: impl Fn(&[u8]) -> u64 + Sync + Sen
         .sum()
 }
 
+/// The byte ranges of the lines of `bytes` as `split(|&b| b == b'\n')` gives them (the last
+/// one after the last `\n`, empty when `bytes` ends with one), found by `memchr`.
+pub(crate) fn line_ranges(bytes: &[u8]) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+    let mut start = 0;
+    memchr::memchr_iter(b'\n', bytes)
+        .chain(std::iter::once(bytes.len()))
+        .map(move |end| {
+            let line = start..end;
+            start = end + 1;
+            line
+        })
+}
+
 fn parse_chunk(text: &str) -> Option<Chunk> {
     let mut chunk = Chunk::default();
-    let mut start = 0;
-    // The lines of `text` as `str::split('\n')` gives them (the last one after the last `\n`,
-    // empty when `text` ends with one), found by `memchr`.
-    let ends = memchr::memchr_iter(b'\n', text.as_bytes()).chain(std::iter::once(text.len()));
-    for end in ends {
-        let line = &text[start..end];
-        start = end + 1;
+    for range in line_ranges(text.as_bytes()) {
+        // `\n` is ASCII: every line range lies on char boundaries.
+        let line = &text[range];
         // tobj reads lines with `BufRead::lines`, which drops a `\r` before the `\n`.
         let line = line.strip_suffix('\r').unwrap_or(line);
         let mut words = Words { line, at: 0 };
