@@ -2,14 +2,21 @@
 //! (`Scene::intersect_lanes`) and hands the hits to the integrator; the frames it makes are
 //! bit for bit the frames of tracing every camera ray on its own, which this test computes
 //! with the loop written out here (the lecture's jittered grid, one random stream per sample,
-//! `CourseIntegrator::radiance` on each ray).
+//! `CourseIntegrator::radiance` on each ray). The path tracer's camera rays travel in packets
+//! too (eight samples of a pixel at a time); its frames are held to `PathIntegrator::trace` on
+//! each camera ray alone in the same way, feature layers included.
 
 use std::path::{Path, PathBuf};
 
+use std::ops::Range;
+
 use glint_render::integrator::course::{shade_camera_ray, SampleContext};
+use glint_render::integrator::path::{PathIntegrator, PathSettings};
+use glint_render::integrator::FirstHit;
 use glint_render::light::sampler::LightSampler;
+use glint_render::sampling::sobol::{PathSampler, SobolPixel};
 use glint_render::sampling::Rng;
-use glint_render::{render, Color, RenderSettings, Scene};
+use glint_render::{render, Color, IntegratorKind, RenderSettings, Scene, ThinLens, Vec3};
 
 fn course_scene(relative: &str) -> Scene {
     let path: PathBuf = Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -112,4 +119,124 @@ fn area_lights_mirrors_and_glass() {
     check("scenes_A/CornellRoom_wMirroredSpheres.xml", 32, 16);
     check("scenes_B/threeEggs_SoftShadows.xml", 32, 9);
     check("scenes_B/CornellBox_Dielectric.json", 32, 16);
+}
+
+/// The path tracer one camera ray at a time, as `PathIntegrator::pixel_samples` took them
+/// before its packets: per pixel the scrambled Sobol' sampler of each sample, the camera ray
+/// through the sample's first two dimensions (and the lens's next two), `trace` on it; the
+/// film's averages of the finite samples and features. (pixels, features, rays traced).
+fn single_ray_path_frame(
+    scene: &Scene,
+    settings: &RenderSettings,
+) -> (Vec<Color>, Vec<(Color, Vec3, f32)>, u64) {
+    let (width, height) = (settings.width, settings.height);
+    let aspect = width as f32 / height as f32;
+    let integrator = PathIntegrator::new(scene, PathSettings::with_max_depth(settings.max_depth()));
+    let (mut pixels, mut features, mut rays) = (Vec::new(), Vec::new(), 0);
+    for y in 0..height {
+        for x in 0..width {
+            let pixel_index = y as u64 * width as u64 + x as u64;
+            let sobol = SobolPixel::new(settings.seed, pixel_index, settings.samples_per_pixel);
+            let (mut sum, mut valid) = (Color::ZERO, 0u32);
+            let (mut albedo, mut normal, mut depth, mut counted) =
+                (Color::ZERO, Vec3::ZERO, 0.0f32, 0u32);
+            for s in settings.samples() {
+                let mut sampler = sobol.sampler(s);
+                let (ox, oy) = sampler.sample_2d(0);
+                let lens = match scene.camera.lens {
+                    Some(_) => sampler.sample_2d(2),
+                    None => (0.5, 0.5),
+                };
+                let j = height - 1 - y;
+                let ray = scene.camera.lens_ray(
+                    x as f32 + ox,
+                    j as f32 + oy,
+                    width,
+                    height,
+                    aspect,
+                    lens,
+                );
+                let mut first_hit = FirstHit::default();
+                let c = integrator.trace(scene, &ray, &mut sampler, &mut rays, &mut first_hit);
+                if c.is_finite() {
+                    sum += c;
+                    valid += 1;
+                }
+                if first_hit.albedo.is_finite()
+                    && first_hit.normal.is_finite()
+                    && first_hit.depth.is_finite()
+                {
+                    albedo += first_hit.albedo;
+                    normal += first_hit.normal;
+                    depth += first_hit.depth;
+                    counted += 1;
+                }
+            }
+            pixels.push(if valid > 0 {
+                sum / valid as f32
+            } else {
+                Color::ZERO
+            });
+            let n = counted.max(1) as f32;
+            features.push((albedo / n, normal / n, depth / n));
+        }
+    }
+    (pixels, features, rays)
+}
+
+fn check_path(scene: &Scene, name: &str, samples_per_pixel: u32, range: Option<Range<u32>>) {
+    let settings = RenderSettings {
+        width: 24,
+        height: 18,
+        samples_per_pixel,
+        seed: 5,
+        integrator: IntegratorKind::Path,
+        features: true,
+        sample_range: range.clone(),
+        ..RenderSettings::default()
+    };
+    let (film, stats) = render(scene, &settings, &|_| true).expect("not cancelled");
+    let (expected, expected_features, rays) = single_ray_path_frame(scene, &settings);
+    let what = format!("{name} at {samples_per_pixel} spp, samples {range:?}");
+    assert_eq!(stats.rays, rays, "{what}: rays traced");
+    let layers = film.features.as_ref().expect("feature layers");
+    let bits = |c: Color| c.to_array().map(f32::to_bits);
+    for (k, (a, b)) in film.pixels.iter().zip(&expected).enumerate() {
+        let (albedo, normal, depth) = expected_features[k];
+        let at = (k as u32 % settings.width, k as u32 / settings.width);
+        assert!(
+            bits(*a) == bits(*b),
+            "{what}, pixel {at:?}: packets {a:?}, single rays {b:?}"
+        );
+        assert!(
+            bits(layers.albedo[k]) == bits(albedo)
+                && layers.normal[k].to_array().map(f32::to_bits)
+                    == normal.to_array().map(f32::to_bits)
+                && layers.depth[k].to_bits() == depth.to_bits(),
+            "{what}, pixel {at:?}: features differ"
+        );
+    }
+}
+
+/// Packets of eight camera rays and partial ones (12 samples: 8 + 4; a farm's sample range
+/// 3..21 of 24: 8 + 8 + 2), a pinhole and a thin lens, triangles, spheres and instanced meshes.
+#[test]
+fn path_tracer_frames() {
+    let cornell = course_scene("scenes_A/CornellRoom_wMirroredSpheres.xml");
+    check_path(&cornell, "Cornell room", 12, None);
+    check_path(&cornell, "Cornell room", 24, Some(3..21));
+    let mut lens = course_scene("scenes_B/CornellBox_Dielectric.json");
+    lens.camera.lens = Some(ThinLens {
+        focus_distance: 3.0,
+        radius: 0.1,
+    });
+    check_path(&lens, "Cornell box with a lens", 8, None);
+    check_path(
+        &course_scene("scenes_B/rowOfBunnys.json"),
+        "bunnies",
+        9,
+        None,
+    );
+    // Fewer than eight samples go ray by ray.
+    check_path(&cornell, "Cornell room", 4, None);
 }

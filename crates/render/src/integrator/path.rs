@@ -9,6 +9,10 @@
 //! the light-sampling density, one light sample per non-specular vertex weighted against the
 //! BSDF density.
 //!
+//! A pixel's camera rays go eight at a time (`Scene::intersect_lanes`) where it takes eight
+//! samples or more, and each path goes on from its given first hit: the same hits, so the same
+//! image as ray by ray (`crates/io/tests/packet_frames.rs`).
+//!
 //! Every random number is a function of (seed, pixel, sample, dimension) (`path_sampler.rs`:
 //! scrambled Sobol' points stratified over the pixel's samples, then the sample's own PCG
 //! stream, keyed as the course renderer keys it), so the image is bit-identical for any thread
@@ -17,6 +21,8 @@
 
 use std::ops::Range;
 
+use crate::accel::instances::PreliminaryHit;
+use crate::accel::PACKET;
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 use crate::light::sampler::LightSampler;
 use crate::material::bsdf::Bsdf;
@@ -25,7 +31,7 @@ use crate::math::Color;
 use crate::math::Frame;
 use crate::ray::Ray;
 use crate::sampling::sobol::{PathSampler, SobolPixel};
-use crate::scene::{Scene, SurfaceNeeds};
+use crate::scene::{AnyHit, Scene, SurfaceNeeds};
 
 /// Path-length controls of the path tracer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -157,7 +163,10 @@ impl PathIntegrator {
 
     /// Radiance arriving along `camera_ray` (whose direction need not be unit), with random
     /// numbers from `sampler` (dimensions from `first_path_dimension` on; the camera's are
-    /// below). Adds the rays it traces to `rays` and fills `first_hit`.
+    /// below). Adds the rays it traces to `rays` and fills `first_hit`. One path on its own:
+    /// the render loop (`pixel_samples`) traces camera rays in packets; the tests hold it to
+    /// this.
+    #[cfg(any(test, feature = "bench"))]
     pub fn trace<S: PathSampler>(
         &self,
         scene: &Scene,
@@ -166,11 +175,22 @@ impl PathIntegrator {
         rays: &mut u64,
         first_hit: &mut FirstHit,
     ) -> Color {
-        // Unit directions make every hit's t a distance (Beer's law, light pdfs).
-        let mut ray = Ray {
-            direction: camera_ray.direction.normalized(),
-            ..*camera_ray
-        };
+        let ray = unit_ray(camera_ray);
+        self.trace_unit(scene, ray, None, sampler, rays, first_hit)
+    }
+
+    /// `trace` of a camera ray with a unit direction (`unit_ray`), whose first hit, where
+    /// `given`, was traced already (in a packet: `pixel_samples`); the same radiance.
+    #[inline(always)]
+    fn trace_unit<S: PathSampler>(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        mut given: Option<Option<PreliminaryHit>>,
+        sampler: &mut S,
+        rays: &mut u64,
+        first_hit: &mut FirstHit,
+    ) -> Color {
         let mut radiance = Color::ZERO;
         let mut throughput = Color::ONE;
         // Product of η² over refractions: Russian roulette looks at throughput × this, so the
@@ -187,10 +207,16 @@ impl PathIntegrator {
             // samples are stratified against each other vertex by vertex.
             let dimension = first_dimension + DIMENSIONS_PER_VERTEX * depth;
             // The light's and the direction's numbers do not depend on the hit: their work
-            // can run beside the traversal.
-            sampler.prepare([dimension, dimension + 3]);
+            // can run beside the traversal (a given hit's, before it: `pixel_samples`).
+            if given.is_none() {
+                sampler.prepare([dimension, dimension + 3]);
+            }
             *rays += 1;
-            let Some(hit) = scene.intersect_preliminary(&ray) else {
+            let found = match given.take() {
+                Some(found) => found,
+                None => scene.intersect_preliminary(&ray),
+            };
+            let Some(hit) = found else {
                 let background = scene.background_radiance(ray.direction);
                 if depth == 0 {
                     first_hit.albedo = background.clamp01();
@@ -362,21 +388,71 @@ impl Integrator for PathIntegrator {
         sink: &mut impl FnMut(Sample),
     ) {
         let sobol = SobolPixel::new(pixel.seed, pixel.index(), pixel.samples_per_pixel);
-        for s in samples {
+        // Sample `s`'s sampler and camera ray (with a unit direction).
+        let camera_sample = |s: u32| {
             let mut sampler = sobol.sampler(s);
             let (ox, oy) = sampler.sample_2d(0);
             let lens = match scene.camera.lens {
                 Some(_) => sampler.sample_2d(LENS_DIMENSION),
                 None => (0.5, 0.5),
             };
-            let ray = pixel.camera_ray(scene, ox, oy, lens);
-            let mut first_hit = FirstHit::default();
-            let radiance = self.trace(scene, &ray, &mut sampler, rays, &mut first_hit);
+            let ray = unit_ray(&pixel.camera_ray(scene, ox, oy, lens));
+            (sampler, ray)
+        };
+        let mut emit = |radiance: Color, first_hit: FirstHit| {
             sink(Sample {
                 radiance,
                 features: pixel.features.then_some(first_hit),
-            });
+            })
+        };
+        // With eight samples or more a pixel's camera rays, which nearly coincide, are traced
+        // eight at a time (`Scene::intersect_lanes`, the same hits as ray by ray), as the
+        // course integrator's are; each path then goes on from its hit alone.
+        if pixel.samples_per_pixel < PACKET as u32 {
+            for s in samples {
+                let (mut sampler, ray) = camera_sample(s);
+                let mut first_hit = FirstHit::default();
+                let radiance =
+                    self.trace_unit(scene, ray, None, &mut sampler, rays, &mut first_hit);
+                emit(radiance, first_hit);
+            }
+            return;
         }
+        let mut first = samples.start;
+        while first < samples.end {
+            let count = (samples.end - first).min(PACKET as u32) as usize;
+            let mut taken: [Option<_>; PACKET] = Default::default();
+            let dimension = first_path_dimension(scene);
+            for (l, t) in taken.iter_mut().enumerate().take(count) {
+                let (mut sampler, ray) = camera_sample(first + l as u32);
+                sampler.prepare([dimension, dimension + 3]);
+                *t = Some((sampler, ray));
+            }
+            // Lanes past `count` repeat the last ray; they are not traced.
+            let packet: [Ray; PACKET] = std::array::from_fn(|l| {
+                let (_, ray) = taken[l.min(count - 1)].as_ref().expect("taken");
+                *ray
+            });
+            let hits = scene.intersect_lanes(&packet, ((1u32 << count) - 1) as u8);
+            for (l, (mut sampler, ray)) in taken.into_iter().flatten().enumerate() {
+                let given = Some(hits[l].map(|h| h.preliminary()));
+                let mut first_hit = FirstHit::default();
+                let radiance =
+                    self.trace_unit(scene, ray, given, &mut sampler, rays, &mut first_hit);
+                emit(radiance, first_hit);
+            }
+            first += count as u32;
+        }
+    }
+}
+
+/// `ray` with its direction made unit: every hit's t is then a distance (Beer's law, light
+/// pdfs).
+#[inline]
+fn unit_ray(ray: &Ray) -> Ray {
+    Ray {
+        direction: ray.direction.normalized(),
+        ..*ray
     }
 }
 

@@ -377,7 +377,7 @@ impl LightSampler {
     /// quad light are sampled as one quad), at the cost of log2(lights) bits of its precision.
     /// `None` when nothing can arrive (no lights, or the reference is behind the chosen
     /// one-sided emitter).
-    #[inline]
+    #[inline(always)]
     pub fn sample(&self, scene: &Scene, reference: Vec3, u: (f32, f32)) -> Option<LightSample> {
         let (index, probability, remapped) = sample_cdf(&self.selection_cdf, u.0)?;
         let u = (remapped, u.1);

@@ -1,6 +1,7 @@
 //! The path tracer's per-sample work allocates nothing (ARCHITECTURE.md invariant): every
 //! material (a textured one too), every kind of light and a cube-map environment, traced through
-//! a counting global allocator with the renderer's own Sobol' sampler and with the plain `Rng`.
+//! a counting global allocator with the renderer's own Sobol' sampler, with the plain `Rng`, and
+//! through the render loop's call (`pixel_samples`, whose camera rays go in packets).
 //! Alone in its test binary so no other test allocates on the counted thread.
 
 // The one unsafe item: a global allocator must implement the unsafe `GlobalAlloc` trait. It
@@ -11,7 +12,7 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::cell::Cell;
 
 use crate::integrator::path::{PathIntegrator, PathSettings};
-use crate::integrator::FirstHit;
+use crate::integrator::{FirstHit, Integrator, PixelContext};
 use crate::sampling::sobol::{PathSampler, SobolPixel};
 use crate::sampling::Rng;
 use crate::{
@@ -225,6 +226,22 @@ fn tracing_paths_does_not_allocate() {
                 let mut first_hit = FirstHit::default();
                 sum += integrator.trace(&scene, &ray, &mut sampler, &mut rays, &mut first_hit);
             }
+            // The render loop's own call, whose camera rays go in packets of eight (12
+            // samples: a packet of eight and one of four), with the feature layers.
+            let pixel = PixelContext {
+                x,
+                y,
+                width,
+                height,
+                aspect: width as f32 / height as f32,
+                seed: 1,
+                samples_per_pixel: 12,
+                max_depth: PathSettings::default().max_depth,
+                features: true,
+            };
+            integrator.pixel_samples(&scene, &pixel, 0..12, &mut rays, &mut |sample| {
+                sum += sample.radiance;
+            });
         }
     }
     let allocations = ALLOCATIONS.with(Cell::get) - before;
