@@ -6,9 +6,8 @@
 //! too (eight samples of a pixel at a time); its frames are held to `PathIntegrator::trace` on
 //! each camera ray alone in the same way, feature layers included.
 
-use std::path::{Path, PathBuf};
-
 use std::ops::Range;
+use std::path::{Path, PathBuf};
 
 use glint_render::integrator::course::{shade_camera_ray, SampleContext};
 use glint_render::integrator::path::{PathIntegrator, PathSettings};
