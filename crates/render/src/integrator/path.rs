@@ -421,24 +421,26 @@ impl Integrator for PathIntegrator {
         let mut first = samples.start;
         while first < samples.end {
             let count = (samples.end - first).min(PACKET as u32) as usize;
-            let mut taken: [Option<_>; PACKET] = Default::default();
             let dimension = first_path_dimension(scene);
-            for (l, t) in taken.iter_mut().enumerate().take(count) {
+            let (mut first_sampler, first_ray) = camera_sample(first);
+            first_sampler.prepare([dimension, dimension + 3]);
+            let mut samplers: [Option<_>; PACKET] = Default::default();
+            samplers[0] = Some(first_sampler);
+            // Lanes past `count` keep the first ray; the lane mask leaves them out.
+            let mut packet = [first_ray; PACKET];
+            let lanes = samplers.iter_mut().zip(&mut packet).enumerate();
+            for (l, (slot, lane)) in lanes.take(count).skip(1) {
                 let (mut sampler, ray) = camera_sample(first + l as u32);
                 sampler.prepare([dimension, dimension + 3]);
-                *t = Some((sampler, ray));
+                *slot = Some(sampler);
+                *lane = ray;
             }
-            // Lanes past `count` repeat the last ray; they are not traced.
-            let packet: [Ray; PACKET] = std::array::from_fn(|l| {
-                let (_, ray) = taken[l.min(count - 1)].as_ref().expect("taken");
-                *ray
-            });
             let hits = scene.intersect_lanes(&packet, ((1u32 << count) - 1) as u8);
-            for (l, (mut sampler, ray)) in taken.into_iter().flatten().enumerate() {
+            for (l, mut sampler) in samplers.into_iter().flatten().enumerate() {
                 let given = Some(hits[l].map(|h| h.preliminary()));
                 let mut first_hit = FirstHit::default();
                 let radiance =
-                    self.trace_unit(scene, ray, given, &mut sampler, rays, &mut first_hit);
+                    self.trace_unit(scene, packet[l], given, &mut sampler, rays, &mut first_hit);
                 emit(radiance, first_hit);
             }
             first += count as u32;
