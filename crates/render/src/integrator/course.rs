@@ -6,7 +6,7 @@
 use std::ops::Range;
 
 use crate::accel::PACKET;
-use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
+use crate::integrator::{camera_ray_packets, FirstHit, Integrator, PixelContext, Sample};
 
 use crate::accel::instances::Hit;
 use crate::light::sampler::{course_light_point, LightPoint, LightSampler};
@@ -219,21 +219,10 @@ pub(crate) fn grid_samples(
     };
     match from_first_hit {
         Some(shade_hit) if all >= PACKET as u32 => {
-            let mut first = samples.start;
-            while first < samples.end {
-                let count = (samples.end - first).min(PACKET as u32) as usize;
-                let mut taken: [Option<(Ray, SampleContext)>; PACKET] = Default::default();
-                for (l, t) in taken.iter_mut().enumerate().take(count) {
-                    *t = Some(camera_sample(first + l as u32));
-                }
-                let packet = std::array::from_fn(|l| taken[l.min(count - 1)].as_ref().unwrap().0);
-                let hits = scene.intersect_lanes(&packet, ((1u32 << count) - 1) as u8);
-                for (l, (ray, mut ctx)) in taken.into_iter().flatten().enumerate() {
-                    let c = shade_hit(&ray, hits[l], &mut ctx);
-                    emit(c, &ray, &ctx, rays);
-                }
-                first += count as u32;
-            }
+            camera_ray_packets(scene, samples, &camera_sample, |ray, hit, mut ctx| {
+                let c = shade_hit(&ray, hit, &mut ctx);
+                emit(c, &ray, &ctx, rays);
+            })
         }
         _ => {
             for s in samples {

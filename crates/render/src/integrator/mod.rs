@@ -13,6 +13,8 @@ pub mod path;
 
 use std::ops::Range;
 
+use crate::accel::instances::Hit;
+use crate::accel::PACKET;
 use crate::material::bsdf::Bsdf;
 use crate::material::Material;
 use crate::math::{Color, Vec3};
@@ -152,5 +154,39 @@ impl TileCounters {
                     .map_or(pixel_index, |p| p.min(pixel_index)),
             );
         }
+    }
+}
+
+/// Samples `samples` of a pixel with their camera rays traced eight at a time
+/// (`Scene::intersect_lanes`, in each lane the hit the ray would get alone): `make(s)` gives
+/// sample `s`'s camera ray and whatever else its shading needs, `finish` takes them back with
+/// the ray's hit, sample by sample in order. A last packet of fewer than eight rays fills its
+/// other lanes with its first ray, which the lane mask leaves out of the walk. The course
+/// family's and the path tracer's loops both stand on it.
+#[inline(always)]
+pub(crate) fn camera_ray_packets<T>(
+    scene: &Scene,
+    samples: Range<u32>,
+    mut make: impl FnMut(u32) -> (Ray, T),
+    mut finish: impl FnMut(Ray, Option<Hit>, T),
+) {
+    let mut first = samples.start;
+    while first < samples.end {
+        let count = (samples.end - first).min(PACKET as u32) as usize;
+        let (first_ray, first_state) = make(first);
+        let mut states: [Option<T>; PACKET] = Default::default();
+        states[0] = Some(first_state);
+        let mut packet = [first_ray; PACKET];
+        let lanes = states.iter_mut().zip(&mut packet).enumerate();
+        for (l, (state, ray)) in lanes.take(count).skip(1) {
+            let (next_ray, next_state) = make(first + l as u32);
+            *state = Some(next_state);
+            *ray = next_ray;
+        }
+        let hits = scene.intersect_lanes(&packet, ((1u32 << count) - 1) as u8);
+        for (l, state) in states.into_iter().flatten().enumerate() {
+            finish(packet[l], hits[l], state);
+        }
+        first += count as u32;
     }
 }

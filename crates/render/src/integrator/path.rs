@@ -23,7 +23,7 @@ use std::ops::Range;
 
 use crate::accel::instances::PreliminaryHit;
 use crate::accel::PACKET;
-use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
+use crate::integrator::{camera_ray_packets, FirstHit, Integrator, PixelContext, Sample};
 use crate::light::sampler::LightSampler;
 use crate::material::bsdf::Bsdf;
 use crate::material::{Material, MaterialId};
@@ -176,11 +176,15 @@ impl PathIntegrator {
         first_hit: &mut FirstHit,
     ) -> Color {
         let ray = unit_ray(camera_ray);
+        let dimension = first_path_dimension(scene);
+        sampler.prepare([dimension, dimension + 3]);
         self.trace_unit(scene, ray, None, sampler, rays, first_hit)
     }
 
     /// `trace` of a camera ray with a unit direction (`unit_ray`), whose first hit, where
-    /// `given`, was traced already (in a packet: `pixel_samples`); the same radiance.
+    /// `given`, was traced already (in a packet: `pixel_samples`); the same radiance. The
+    /// caller has started the first vertex's look-ahead (`PathSampler::prepare`), so that it
+    /// runs beside the camera ray's walk (or the packet's).
     #[inline(always)]
     fn trace_unit<S: PathSampler>(
         &self,
@@ -207,8 +211,8 @@ impl PathIntegrator {
             // samples are stratified against each other vertex by vertex.
             let dimension = first_dimension + DIMENSIONS_PER_VERTEX * depth;
             // The light's and the direction's numbers do not depend on the hit: their work
-            // can run beside the traversal (a given hit's, before it: `pixel_samples`).
-            if given.is_none() {
+            // can run beside the traversal (the first vertex's is the caller's).
+            if depth > 0 {
                 sampler.prepare([dimension, dimension + 3]);
             }
             *rays += 1;
@@ -388,7 +392,9 @@ impl Integrator for PathIntegrator {
         sink: &mut impl FnMut(Sample),
     ) {
         let sobol = SobolPixel::new(pixel.seed, pixel.index(), pixel.samples_per_pixel);
-        // Sample `s`'s sampler and camera ray (with a unit direction).
+        let dimension = first_path_dimension(scene);
+        // Sample `s`'s camera ray (with a unit direction) and sampler, the first vertex's
+        // look-ahead started.
         let camera_sample = |s: u32| {
             let mut sampler = sobol.sampler(s);
             let (ox, oy) = sampler.sample_2d(0);
@@ -397,7 +403,8 @@ impl Integrator for PathIntegrator {
                 None => (0.5, 0.5),
             };
             let ray = unit_ray(&pixel.camera_ray(scene, ox, oy, lens));
-            (sampler, ray)
+            sampler.prepare([dimension, dimension + 3]);
+            (ray, sampler)
         };
         let mut emit = |radiance: Color, first_hit: FirstHit| {
             sink(Sample {
@@ -410,7 +417,7 @@ impl Integrator for PathIntegrator {
         // course integrator's are; each path then goes on from its hit alone.
         if pixel.samples_per_pixel < PACKET as u32 {
             for s in samples {
-                let (mut sampler, ray) = camera_sample(s);
+                let (ray, mut sampler) = camera_sample(s);
                 let mut first_hit = FirstHit::default();
                 let radiance =
                     self.trace_unit(scene, ray, None, &mut sampler, rays, &mut first_hit);
@@ -418,33 +425,12 @@ impl Integrator for PathIntegrator {
             }
             return;
         }
-        let mut first = samples.start;
-        while first < samples.end {
-            let count = (samples.end - first).min(PACKET as u32) as usize;
-            let dimension = first_path_dimension(scene);
-            let (mut first_sampler, first_ray) = camera_sample(first);
-            first_sampler.prepare([dimension, dimension + 3]);
-            let mut samplers: [Option<_>; PACKET] = Default::default();
-            samplers[0] = Some(first_sampler);
-            // Lanes past `count` keep the first ray; the lane mask leaves them out.
-            let mut packet = [first_ray; PACKET];
-            let lanes = samplers.iter_mut().zip(&mut packet).enumerate();
-            for (l, (slot, lane)) in lanes.take(count).skip(1) {
-                let (mut sampler, ray) = camera_sample(first + l as u32);
-                sampler.prepare([dimension, dimension + 3]);
-                *slot = Some(sampler);
-                *lane = ray;
-            }
-            let hits = scene.intersect_lanes(&packet, ((1u32 << count) - 1) as u8);
-            for (l, mut sampler) in samplers.into_iter().flatten().enumerate() {
-                let given = Some(hits[l].map(|h| h.preliminary()));
-                let mut first_hit = FirstHit::default();
-                let radiance =
-                    self.trace_unit(scene, packet[l], given, &mut sampler, rays, &mut first_hit);
-                emit(radiance, first_hit);
-            }
-            first += count as u32;
-        }
+        camera_ray_packets(scene, samples, &camera_sample, |ray, hit, mut sampler| {
+            let given = Some(hit.map(|h| h.preliminary()));
+            let mut first_hit = FirstHit::default();
+            let radiance = self.trace_unit(scene, ray, given, &mut sampler, rays, &mut first_hit);
+            emit(radiance, first_hit);
+        });
     }
 }
 
