@@ -36,6 +36,22 @@ pub struct SampleContext<'a> {
     pub rays: u64,
 }
 
+/// A sample's first hit as `direct` will shade it, worked out ahead in a packet
+/// (`first_hit_shadows`): the unit direction to each light's sampled point, drawn from the
+/// sample's random stream as `direct` would draw it, and which lights are hidden (bit i:
+/// light i).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct FirstShadows {
+    /// The hit's point, which the `direct` taking these must be at.
+    point: Vec3,
+    to_light: [Vec3; SHADOWS_AHEAD_LIGHTS],
+    occluded: u8,
+}
+
+/// At most this many lights have their first-hit shadow rays traced ahead; a scene with more
+/// traces them ray by ray.
+const SHADOWS_AHEAD_LIGHTS: usize = 8;
+
 impl SampleContext<'_> {
     /// A stratified 2-D sample for light or glossy sampling: the pixel's N² cells are shuffled
     /// by a per-pixel permutation (slide_DistributionRays pp.20-25) so light cells do not line
@@ -147,7 +163,7 @@ impl Integrator for CourseIntegrator {
             Some(&self.lights),
             rays,
             sink,
-            Some(&|ray, first, ctx| shade(scene, ray, first, 0, true, ctx)),
+            Some(&|ray, first, ctx, ahead| shade(scene, ray, first, 0, true, ctx, ahead)),
             &|ray, ctx| shade_camera_ray(scene, ray, ctx),
         );
     }
@@ -158,8 +174,10 @@ pub(crate) fn grid_size(requested: u32) -> u32 {
     ((requested.max(1) as f64).sqrt().floor() as u32).max(1)
 }
 
-/// The shading of a camera ray whose first hit is already known (traced in a packet).
-pub(crate) type ShadeFirstHit<'a> = &'a dyn Fn(&Ray, Option<Hit>, &mut SampleContext) -> Color;
+/// The shading of a camera ray whose first hit is already known (traced in a packet), with
+/// that hit's shadow rays where they were traced ahead (`first_hit_shadows`).
+pub(crate) type ShadeFirstHit<'a> =
+    &'a dyn Fn(&Ray, Option<Hit>, &mut SampleContext, Option<&FirstShadows>) -> Color;
 
 /// The course family's pixel samples `samples` of `pixel`: the camera ray of each on the
 /// jittered grid, its radiance from `radiance`, handed to `sink` in order. With
@@ -219,10 +237,16 @@ pub(crate) fn grid_samples(
     };
     match from_first_hit {
         Some(shade_hit) if all >= PACKET as u32 => {
-            camera_ray_packets(scene, samples, &camera_sample, |ray, hit, mut ctx| {
-                let c = shade_hit(&ray, hit, &mut ctx);
-                emit(c, &ray, &ctx, rays);
-            })
+            let ahead = |packet: &_, hits: &_, ctxs: &mut _| match lights {
+                Some(_) => first_hit_shadows(scene, packet, hits, ctxs),
+                None => [None; PACKET],
+            };
+            let finish =
+                |ray, hit, mut ctx, lane: usize, shadows: &[Option<FirstShadows>; PACKET]| {
+                    let c = shade_hit(&ray, hit, &mut ctx, shadows[lane].as_ref());
+                    emit(c, &ray, &ctx, rays);
+                };
+            camera_ray_packets(scene, samples, &camera_sample, ahead, finish)
         }
         _ => {
             for s in samples {
@@ -248,10 +272,20 @@ fn ray_color(
     count_emission: bool,
     ctx: &mut SampleContext,
 ) -> Color {
-    shade(scene, ray, scene.intersect(ray), depth, count_emission, ctx)
+    shade(
+        scene,
+        ray,
+        scene.intersect(ray),
+        depth,
+        count_emission,
+        ctx,
+        None,
+    )
 }
 
-/// `ray_color` with the ray's closest hit (`scene.intersect(ray)`) given.
+/// `ray_color` with the ray's closest hit (`scene.intersect(ray)`) given, and where they were
+/// traced ahead, the hit's shadow rays (for the materials of `shades_direct_first`).
+#[allow(clippy::too_many_arguments)]
 fn shade(
     scene: &Scene,
     ray: &Ray,
@@ -259,6 +293,7 @@ fn shade(
     depth: u32,
     count_emission: bool,
     ctx: &mut SampleContext,
+    ahead: Option<&FirstShadows>,
 ) -> Color {
     let Some(hit) = hit else {
         return scene.background_radiance(ray.direction);
@@ -275,7 +310,7 @@ fn shade(
     match Material::get(&scene.materials, si.material) {
         Material::Lambertian { diffuse } => {
             let kd = diffuse.resolve(&scene.textures, si.uv);
-            direct(scene, &si, ctx, |l| kd * n.dot(l).max(0.0))
+            direct(scene, &si, ctx, ahead, |l| kd * n.dot(l).max(0.0))
         }
         Material::BlinnPhong {
             diffuse,
@@ -285,7 +320,7 @@ fn shade(
         } => {
             let kd = diffuse.resolve(&scene.textures, si.uv);
             let ks = specular.resolve(&scene.textures, si.uv);
-            let shaded = blinn_phong(scene, &si, n, v, kd, ks, *phong_exponent, ctx);
+            let shaded = blinn_phong(scene, &si, n, v, kd, ks, *phong_exponent, ctx, ahead);
             if *mirror_coef > 0.0 {
                 shaded * (1.0 - mirror_coef)
                     + mirror(scene, &si, d, n, 0.0, depth, ctx) * *mirror_coef
@@ -301,7 +336,7 @@ fn shade(
             let kd = diffuse.resolve(&scene.textures, si.uv);
             let ks = specular.resolve(&scene.textures, si.uv);
             let p = *phong_exponent;
-            direct(scene, &si, ctx, |l| {
+            direct(scene, &si, ctx, ahead, |l| {
                 let r = -l + n * (2.0 * l.dot(n));
                 kd * n.dot(l).max(0.0) + ks * v.dot(r).max(0.0).powf(p)
             })
@@ -313,7 +348,7 @@ fn shade(
         } => {
             // Additive, as the lecture writes it (FORMAT.md A7): c = c_Lambertian + km·c_mirror.
             let kd = diffuse.resolve(&scene.textures, si.uv);
-            direct(scene, &si, ctx, |l| kd * n.dot(l).max(0.0))
+            direct(scene, &si, ctx, ahead, |l| kd * n.dot(l).max(0.0))
                 + mirror(scene, &si, d, n, 0.0, depth, ctx) * *mirror_coef
         }
         Material::BlinnPhongMirrored {
@@ -325,7 +360,7 @@ fn shade(
         } => {
             let kd = diffuse.resolve(&scene.textures, si.uv);
             let ks = specular.resolve(&scene.textures, si.uv);
-            let shaded = blinn_phong(scene, &si, n, v, kd, ks, *phong_exponent, ctx);
+            let shaded = blinn_phong(scene, &si, n, v, kd, ks, *phong_exponent, ctx, ahead);
             shaded * (1.0 - mirror_coef)
                 + mirror(scene, &si, d, n, *roughness, depth, ctx) * *mirror_coef
         }
@@ -381,15 +416,28 @@ fn shade(
 /// Sums `shade(l, intensity)` over the lights that see the point: for each light one shadow
 /// ray toward one point on it (the light's centre with one ray per pixel). `shade` gets the
 /// unit direction to the light and returns the per-unit-intensity response; the course has no
-/// distance falloff and no cosine at the light (FORMAT.md 4.1, 4.5).
+/// distance falloff and no cosine at the light (FORMAT.md 4.1, 4.5). With `ahead` (a camera
+/// ray's first hit, its light points drawn and shadow rays traced in a packet) nothing is
+/// drawn or traced again.
 fn direct(
     scene: &Scene,
     si: &SurfaceInteraction,
     ctx: &mut SampleContext,
+    ahead: Option<&FirstShadows>,
     shade: impl Fn(Vec3) -> Color,
 ) -> Color {
-    let exact = ctx.grid_size <= 1;
     let mut sum = Color::ZERO;
+    if let Some(ahead) = ahead {
+        debug_assert_eq!(ahead.point, si.point);
+        for (index, light) in scene.lights.iter().enumerate() {
+            ctx.rays += 1;
+            if ahead.occluded >> index & 1 == 0 {
+                sum += shade(ahead.to_light[index]).mul_elem(light.intensity());
+            }
+        }
+        return sum;
+    }
+    let exact = ctx.grid_size <= 1;
     for (index, light) in scene.lights.iter().enumerate() {
         let sample = sample_light(light, index, si.point, ctx, exact);
         let to_light = sample.position - si.point;
@@ -403,6 +451,73 @@ fn direct(
     sum
 }
 
+/// Whether `shade` at a hit on `material` starts with `direct` there, before any other use of
+/// the sample's random stream: the materials whose first-hit shadow rays can be traced ahead.
+fn shades_direct_first(material: &Material) -> bool {
+    matches!(
+        material,
+        Material::Lambertian { .. }
+            | Material::BlinnPhong { .. }
+            | Material::Phong { .. }
+            | Material::Glaze { .. }
+            | Material::BlinnPhongMirrored { .. }
+    )
+}
+
+/// The shadow rays of a packet's first hits, light by light as packets (`occluded_lanes`)
+/// instead of one by one inside each sample's `direct`: rays from the neighbouring points of
+/// one pixel towards one light are coherent. Each lane whose hit's material shades with
+/// `direct` first gets its `FirstShadows`, the light points drawn from its context light by
+/// light as `direct` would draw them (the same stratified cells and random numbers; `direct`
+/// then draws none), so the samples, the images and the rays counted are those of tracing each
+/// shadow ray alone.
+fn first_hit_shadows(
+    scene: &Scene,
+    rays: &[Ray; PACKET],
+    hits: &[Option<Hit>; PACKET],
+    ctxs: &mut [Option<SampleContext>; PACKET],
+) -> [Option<FirstShadows>; PACKET] {
+    let mut out = [None; PACKET];
+    let lights = &scene.lights;
+    if lights.is_empty() || lights.len() > SHADOWS_AHEAD_LIGHTS {
+        return out;
+    }
+    let mut lanes = 0u8;
+    for (l, ((ray, hit), ctx)) in rays.iter().zip(hits).zip(ctxs.iter()).enumerate() {
+        if let (Some(hit), Some(_)) = (hit, ctx) {
+            if shades_direct_first(Material::get(&scene.materials, scene.material_at(hit))) {
+                out[l] = Some(FirstShadows {
+                    point: ray.at(hit.t),
+                    to_light: [Vec3::ZERO; SHADOWS_AHEAD_LIGHTS],
+                    occluded: 0,
+                });
+                lanes |= 1 << l;
+            }
+        }
+    }
+    if lanes == 0 {
+        return out;
+    }
+    let mut shadows = [rays[0]; PACKET];
+    for (index, light) in lights.iter().enumerate() {
+        for ((first, ctx), shadow) in out.iter_mut().zip(ctxs.iter_mut()).zip(&mut shadows) {
+            if let (Some(first), Some(ctx)) = (first, ctx) {
+                let exact = ctx.grid_size <= 1;
+                let sample = sample_light(light, index, first.point, ctx, exact);
+                first.to_light[index] = (sample.position - first.point).normalized();
+                *shadow = Ray::spawn_to(first.point, sample.position);
+            }
+        }
+        let mask = scene.occluded_lanes(&shadows, lanes);
+        for (l, first) in out.iter_mut().enumerate() {
+            if let Some(first) = first {
+                first.occluded |= (mask >> l & 1) << index;
+            }
+        }
+    }
+    out
+}
+
 #[allow(clippy::too_many_arguments)]
 fn blinn_phong(
     scene: &Scene,
@@ -413,8 +528,9 @@ fn blinn_phong(
     ks: Color,
     exponent: f32,
     ctx: &mut SampleContext,
+    ahead: Option<&FirstShadows>,
 ) -> Color {
-    direct(scene, si, ctx, |l| {
+    direct(scene, si, ctx, ahead, |l| {
         let h = (v + l).normalized();
         kd * n.dot(l).max(0.0) + ks * n.dot(h).max(0.0).powf(exponent)
     })

@@ -159,16 +159,19 @@ impl TileCounters {
 
 /// Samples `samples` of a pixel with their camera rays traced eight at a time
 /// (`Scene::intersect_lanes`, in each lane the hit the ray would get alone): `make(s)` gives
-/// sample `s`'s camera ray and whatever else its shading needs, `finish` takes them back with
-/// the ray's hit, sample by sample in order. A last packet of fewer than eight rays fills its
-/// other lanes with its first ray, which the lane mask leaves out of the walk. The course
-/// family's and the path tracer's loops both stand on it.
+/// sample `s`'s camera ray and whatever else its shading needs, `ahead` sees the whole packet
+/// (rays, hits, each lane's state; `None` in lanes past the last sample) and returns what the
+/// packet's samples share, then `finish` takes each sample back with its ray, hit, lane and
+/// that, sample by sample in order. A last packet of fewer than eight rays fills its other
+/// lanes with its first ray, which the lane mask leaves out of the walk. The course family's
+/// and the path tracer's loops both stand on it.
 #[inline(always)]
-pub(crate) fn camera_ray_packets<T>(
+pub(crate) fn camera_ray_packets<T, A>(
     scene: &Scene,
     samples: Range<u32>,
     mut make: impl FnMut(u32) -> (Ray, T),
-    mut finish: impl FnMut(Ray, Option<Hit>, T),
+    mut ahead: impl FnMut(&[Ray; PACKET], &[Option<Hit>; PACKET], &mut [Option<T>; PACKET]) -> A,
+    mut finish: impl FnMut(Ray, Option<Hit>, T, usize, &A),
 ) {
     let mut first = samples.start;
     while first < samples.end {
@@ -184,8 +187,9 @@ pub(crate) fn camera_ray_packets<T>(
             *ray = next_ray;
         }
         let hits = scene.intersect_lanes(&packet, ((1u32 << count) - 1) as u8);
+        let shared = ahead(&packet, &hits, &mut states);
         for (l, state) in states.into_iter().flatten().enumerate() {
-            finish(packet[l], hits[l], state);
+            finish(packet[l], hits[l], state, l, &shared);
         }
         first += count as u32;
     }

@@ -425,12 +425,20 @@ impl Integrator for PathIntegrator {
             }
             return;
         }
-        camera_ray_packets(scene, samples, &camera_sample, |ray, hit, mut sampler| {
-            let given = Some(hit.map(|h| h.preliminary()));
-            let mut first_hit = FirstHit::default();
-            let radiance = self.trace_unit(scene, ray, given, &mut sampler, rays, &mut first_hit);
-            emit(radiance, first_hit);
-        });
+        let ahead = |_: &_, _: &_, _: &mut _| {};
+        camera_ray_packets(
+            scene,
+            samples,
+            &camera_sample,
+            ahead,
+            |ray, hit, mut sampler, _, _| {
+                let given = Some(hit.map(|h| h.preliminary()));
+                let mut first_hit = FirstHit::default();
+                let radiance =
+                    self.trace_unit(scene, ray, given, &mut sampler, rays, &mut first_hit);
+                emit(radiance, first_hit);
+            },
+        );
     }
 }
 

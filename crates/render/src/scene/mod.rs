@@ -240,6 +240,17 @@ impl Scene {
         self.accel.occluded_lanes(rays, lanes)
     }
 
+    /// The material at a hit: `surface(..).material` without the rest (`surface` repeats
+    /// these lines: calling this from there made it too big to inline in the path tracer).
+    #[inline]
+    pub(crate) fn material_at(&self, hit: &impl AnyHit) -> MaterialId {
+        let prelim = hit.preliminary();
+        let inst = &self.accel.instances[prelim.instance as usize];
+        let geom = &self.accel.geometries[inst.geometry as usize];
+        inst.material
+            .unwrap_or(geom.materials.get(prelim.primitive))
+    }
+
     /// Shading data for any hit the queries return: point, geometric normal, material, and
     /// with `SurfaceNeeds::Uv` the texture coordinates (completing a preliminary hit's
     /// barycentrics, exactly as `intersect` would have found them).
