@@ -25,12 +25,21 @@ Glint runs as `glint render SCENE --integrator path --spp N --seed S -w 256 -h 2
 Usage: bench/cornell_vs_mitsuba.py [--repeats 5] [--skip-setup]
 Needs: ../shared/bench/setup-peers.sh (run first unless --skip-setup), cargo.
 """
-import argparse, math, os, re, shutil, subprocess, sys, tempfile, time
+
+import argparse
+import math
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-SHARED = os.path.normpath(os.path.join(ROOT, '..', 'shared'))
-SCENE = os.path.join(SHARED, 'refs', 'cornell', 'cornell.json')
-REFERENCE = os.path.join(SHARED, 'refs', 'cornell', 'mitsuba_256_4096spp.exr')
+SHARED = os.path.normpath(os.path.join(ROOT, "..", "shared"))
+SCENE = os.path.join(SHARED, "refs", "cornell", "cornell.json")
+REFERENCE = os.path.join(SHARED, "refs", "cornell", "mitsuba_256_4096spp.exr")
 REFERENCE_SPP = 4096
 MITSUBA_SPP = 64
 SIZE = 256
@@ -43,11 +52,12 @@ def run(cmd, **kwargs):
 def read_exr(path):
     import mitsuba as mi
     import numpy as np
+
     return np.array(mi.Bitmap(path), dtype=np.float64)[:, :, :3]
 
 
 def relative_mse(image, reference):
-    return float(((image - reference) ** 2 / (reference ** 2 + 0.01)).mean())
+    return float(((image - reference) ** 2 / (reference**2 + 0.01)).mean())
 
 
 # Runs make_cornell_ref.py (argv[1:]) unchanged, with time.time kept: the script times
@@ -75,29 +85,61 @@ def run_mitsuba(out_dir):
     process (Python start, import, scene construction, render, EXR and PNG write) and the
     EXR's path."""
     start = time.perf_counter()
-    result = run([sys.executable, '-c', PRECISE_TIMER,
-                  os.path.join(SHARED, 'bench', 'make_cornell_ref.py'),
-                  '--spp', str(MITSUBA_SPP), '--size', str(SIZE), '--out', out_dir])
+    result = run(
+        [
+            sys.executable,
+            "-c",
+            PRECISE_TIMER,
+            os.path.join(SHARED, "bench", "make_cornell_ref.py"),
+            "--spp",
+            str(MITSUBA_SPP),
+            "--size",
+            str(SIZE),
+            "--out",
+            out_dir,
+        ]
+    )
     process_seconds = time.perf_counter() - start
-    precise = re.search(r'precise: ([0-9.]+) s', result.stdout)
+    precise = re.search(r"precise: ([0-9.]+) s", result.stdout)
     if precise is None:
-        sys.exit('make_cornell_ref.py called time.time() other than twice: no precise timing')
+        sys.exit(
+            "make_cornell_ref.py called time.time() other than twice: no precise timing"
+        )
     seconds = float(precise.group(1))
-    return seconds, process_seconds, os.path.join(out_dir, f'mitsuba_{SIZE}_{MITSUBA_SPP}spp.exr')
+    return (
+        seconds,
+        process_seconds,
+        os.path.join(out_dir, f"mitsuba_{SIZE}_{MITSUBA_SPP}spp.exr"),
+    )
 
 
 class Glint:
     """Runs Glint's path tracer on the Cornell box through the release CLI."""
 
     def __init__(self):
-        run(['cargo', 'build', '--release', '--quiet', '-p', 'glint'], cwd=ROOT)
-        self.cli = os.path.join(ROOT, 'target', 'release', 'glint')
-        self.how = 'glint CLI'
+        run(["cargo", "build", "--release", "--quiet", "-p", "glint"], cwd=ROOT)
+        self.cli = os.path.join(ROOT, "target", "release", "glint")
+        self.how = "glint CLI"
 
     def render(self, spp, seed, out):
         """Renders and returns the process's wall time."""
-        command = [self.cli, 'render', SCENE, '--integrator', 'path', '--spp', str(spp),
-                   '--seed', str(seed), '-w', str(SIZE), '-h', str(SIZE), '-o', out]
+        command = [
+            self.cli,
+            "render",
+            SCENE,
+            "--integrator",
+            "path",
+            "--spp",
+            str(spp),
+            "--seed",
+            str(seed),
+            "-w",
+            str(SIZE),
+            "-h",
+            str(SIZE),
+            "-o",
+            out,
+        ]
         start = time.perf_counter()
         run(command)
         return time.perf_counter() - start
@@ -105,34 +147,46 @@ class Glint:
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument('--repeats', type=int, default=5)
-    ap.add_argument('--skip-setup', action='store_true')
+    ap.add_argument("--repeats", type=int, default=5)
+    ap.add_argument("--skip-setup", action="store_true")
     args = ap.parse_args()
     if not args.skip_setup:
-        subprocess.run(['bash', os.path.join(SHARED, 'bench', 'setup-peers.sh')], check=True,
-                       stdout=subprocess.DEVNULL)
+        subprocess.run(
+            ["bash", os.path.join(SHARED, "bench", "setup-peers.sh")],
+            check=True,
+            stdout=subprocess.DEVNULL,
+        )
     import mitsuba as mi
-    mi.set_variant('scalar_rgb')
+
+    mi.set_variant("scalar_rgb")
     reference = read_exr(REFERENCE)
-    work = tempfile.mkdtemp(prefix='cornell_bench_')
+    work = tempfile.mkdtemp(prefix="cornell_bench_")
     try:
         # The first run also compiles Dr.Jit's kernels (later runs find them cached); its image
         # sets the target error.
-        first_seconds, first_process_seconds, mitsuba_exr = run_mitsuba(work)
+        first_seconds, _first_process_seconds, mitsuba_exr = run_mitsuba(work)
         target = relative_mse(read_exr(mitsuba_exr), reference)
         # Mitsuba's error is a_M (1/64 + 1/4096) for per-sample variance a_M; the reference's
         # share of every error measured against it is c = a_M / 4096.
-        reference_noise = target / (1 + MITSUBA_SPP / REFERENCE_SPP) * MITSUBA_SPP / REFERENCE_SPP
+        reference_noise = (
+            target / (1 + MITSUBA_SPP / REFERENCE_SPP) * MITSUBA_SPP / REFERENCE_SPP
+        )
 
         glint = Glint()
-        probe_exr = os.path.join(work, 'glint_probe.exr')
+        probe_exr = os.path.join(work, "glint_probe.exr")
         glint.render(MITSUBA_SPP, 1, probe_exr)
         probe = relative_mse(read_exr(probe_exr), reference)
-        spp = max(1, math.ceil(MITSUBA_SPP * max(probe - reference_noise, 1e-12)
-                               / max(target - reference_noise, 1e-12)))
+        spp = max(
+            1,
+            math.ceil(
+                MITSUBA_SPP
+                * max(probe - reference_noise, 1e-12)
+                / max(target - reference_noise, 1e-12)
+            ),
+        )
         tried = []
         while True:
-            out = os.path.join(work, f'glint_{spp}.exr')
+            out = os.path.join(work, f"glint_{spp}.exr")
             glint.render(spp, 1, out)
             error = relative_mse(read_exr(out), reference)
             tried.append((spp, error))
@@ -149,26 +203,39 @@ def main():
             seconds, process_seconds, _ = run_mitsuba(work)
             mitsuba_seconds = min(mitsuba_seconds, seconds)
             mitsuba_process_seconds = min(mitsuba_process_seconds, process_seconds)
-            glint_seconds = min(glint_seconds,
-                                glint.render(spp, 1, os.path.join(work, 'timed.exr')))
+            glint_seconds = min(
+                glint_seconds, glint.render(spp, 1, os.path.join(work, "timed.exr"))
+            )
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
     reached = tried[-1][1] <= target
-    print(f'Cornell box {SIZE}x{SIZE}, 2 cores, best of {args.repeats}; relMSE against '
-          f'Mitsuba {REFERENCE_SPP} spp (includes its noise, ~{reference_noise:.2e})')
-    print(f'  Mitsuba 3 {mi.__version__} llvm_ad_rgb, {MITSUBA_SPP} spp: relMSE {target:.4e}, '
-          f'{mitsuba_seconds:.3f} s (load_dict + render); whole process '
-          f'{mitsuba_process_seconds:.2f} s')
-    print(f'  Glint ({glint.how}): probe {MITSUBA_SPP} spp relMSE {probe:.4e}; tried '
-          + ', '.join(f'{s} spp -> {e:.4e}' for s, e in tried))
-    print(f'  Glint, {spp} spp: relMSE {tried[-1][1]:.4e}, {glint_seconds:.3f} s'
-          + ('' if reached else '  (did NOT reach the target)'))
-    print(f'time ratio Glint / Mitsuba at equal error: {glint_seconds / mitsuba_seconds:.3f} '
-          f'(Glint\'s whole process against Mitsuba\'s render-only time)')
-    print(f'  whole process against whole process: '
-          f'{glint_seconds / mitsuba_process_seconds:.3f}')
+    print(
+        f"Cornell box {SIZE}x{SIZE}, 2 cores, best of {args.repeats}; relMSE against "
+        f"Mitsuba {REFERENCE_SPP} spp (includes its noise, ~{reference_noise:.2e})"
+    )
+    print(
+        f"  Mitsuba 3 {mi.__version__} llvm_ad_rgb, {MITSUBA_SPP} spp: relMSE {target:.4e}, "
+        f"{mitsuba_seconds:.3f} s (load_dict + render); whole process "
+        f"{mitsuba_process_seconds:.2f} s"
+    )
+    print(
+        f"  Glint ({glint.how}): probe {MITSUBA_SPP} spp relMSE {probe:.4e}; tried "
+        + ", ".join(f"{s} spp -> {e:.4e}" for s, e in tried)
+    )
+    print(
+        f"  Glint, {spp} spp: relMSE {tried[-1][1]:.4e}, {glint_seconds:.3f} s"
+        + ("" if reached else "  (did NOT reach the target)")
+    )
+    print(
+        f"time ratio Glint / Mitsuba at equal error: {glint_seconds / mitsuba_seconds:.3f} "
+        f"(Glint's whole process against Mitsuba's render-only time)"
+    )
+    print(
+        f"  whole process against whole process: "
+        f"{glint_seconds / mitsuba_process_seconds:.3f}"
+    )
 
 
-if __name__ == '__main__':
+if __name__ == "__main__":
     main()

@@ -5,8 +5,8 @@
 #                          OpenEXR (the tests' EXR reader) and mypy (stubtest)
 #   python/ci.sh test      builds the wheel once (pip install ./python: maturin, release), builds
 #                          the `glint` CLI for the equality tests, runs pytest, ruff, rustfmt and
-#                          clippy on the module; ends with `python: N passed, N failed` (the
-#                          pytest tests and the four lint checks)
+#                          clippy on the module and ruff on bench/ and scripts/; ends with
+#                          `python: N passed, N failed` (the pytest tests and the six lint checks)
 # With CI set, anything missing is a failure, never a skip.
 set -euo pipefail
 
@@ -68,6 +68,9 @@ test_suite() {
     local lint_failed=0
     ruff check "$HERE" || lint_failed=$((lint_failed + 1))
     ruff format --check "$HERE" || lint_failed=$((lint_failed + 1))
+    # The repository's other Python (bench scripts, scripts/), with ruff's defaults.
+    ruff check "$HERE/../bench" "$HERE/../scripts" || lint_failed=$((lint_failed + 1))
+    ruff format --check "$HERE/../bench" "$HERE/../scripts" || lint_failed=$((lint_failed + 1))
     cargo fmt --manifest-path "$HERE/Cargo.toml" --check || lint_failed=$((lint_failed + 1))
     cargo clippy -q --manifest-path "$HERE/Cargo.toml" --all-targets -- -D warnings \
         || lint_failed=$((lint_failed + 1))
@@ -76,7 +79,7 @@ test_suite() {
     if [ "$failed" -ne 0 ] && [ "$total_failed" -eq 0 ]; then
         total_failed=1 # pytest failed without a count (collection or usage error)
     fi
-    echo "python: $((passed + 4 - lint_failed)) passed, $total_failed failed"
+    echo "python: $((passed + 6 - lint_failed)) passed, $total_failed failed"
     [ "$total_failed" -eq 0 ]
 }
 

@@ -7,6 +7,7 @@ look anywhere. Exit status 1 if there is a cycle.
 
     scripts/module-cycles.py [crates/render/src]
 """
+
 import re
 import sys
 from pathlib import Path
@@ -53,12 +54,22 @@ for module, text in files.items():
     # `use crate::{a::X, b::{Y, Z}}` and `crate::a::b::c` paths.
     for match in re.finditer(r"crate::((?:[a-z_][a-z0-9_]*::)*[a-z_][a-z0-9_]*)", text):
         target = resolve(match.group(1))
-        if target in modules and target != module and not module.startswith(target + "::"):
+        if (
+            target in modules
+            and target != module
+            and not module.startswith(target + "::")
+        ):
             edges[module].add(target)
-    for match in re.finditer(r"use crate::\{([^;]*)\};", text, re.S):
-        for item in re.findall(r"([a-z_][a-z0-9_]*(?:::[a-z_][a-z0-9_]*)*)", match.group(1)):
+    for match in re.finditer(r"use crate::\{([^;]*)\};", text, re.DOTALL):
+        for item in re.findall(
+            r"([a-z_][a-z0-9_]*(?:::[a-z_][a-z0-9_]*)*)", match.group(1)
+        ):
             target = resolve(item)
-            if target in modules and target != module and not module.startswith(target + "::"):
+            if (
+                target in modules
+                and target != module
+                and not module.startswith(target + "::")
+            ):
                 edges[module].add(target)
     # `super::x` inside a submodule.
     if "::" in module:
