@@ -79,7 +79,10 @@ fn single_ray_frame(scene: &Scene, settings: &RenderSettings) -> (Vec<Color>, u6
 }
 
 fn check(relative: &str, size: u32, rays_per_pixel: u32) {
-    let scene = course_scene(relative);
+    check_scene(&course_scene(relative), relative, size, rays_per_pixel);
+}
+
+fn check_scene(scene: &Scene, relative: &str, size: u32, rays_per_pixel: u32) {
     let settings = RenderSettings {
         width: size,
         height: size * 3 / 4,
@@ -87,8 +90,8 @@ fn check(relative: &str, size: u32, rays_per_pixel: u32) {
         seed: 7,
         ..RenderSettings::default()
     };
-    let (film, stats) = render(&scene, &settings, &|_| true).expect("not cancelled");
-    let (expected, rays) = single_ray_frame(&scene, &settings);
+    let (film, stats) = render(scene, &settings, &|_| true).expect("not cancelled");
+    let (expected, rays) = single_ray_frame(scene, &settings);
     assert_eq!(stats.rays, rays, "{relative}: rays traced");
     for (k, (a, b)) in film.pixels.iter().zip(&expected).enumerate() {
         assert!(
@@ -118,6 +121,65 @@ fn area_lights_mirrors_and_glass() {
     check("scenes_A/CornellRoom_wMirroredSpheres.xml", 32, 16);
     check("scenes_B/threeEggs_SoftShadows.xml", 32, 9);
     check("scenes_B/CornellBox_Dielectric.json", 32, 16);
+}
+
+/// A course scene with `lights` point lights around two spheres on a floor of triangles, in
+/// Lambertian, Blinn-Phong and glaze, written to a file and loaded as the CLI loads it.
+fn lights_scene(lights: usize) -> Scene {
+    let light = |i: usize| {
+        let a = i as f32 * 0.7;
+        format!(
+            r#"{{"position": "{} {} {}", "intensity": "0.15 0.12 0.1", "_type": "point"}}"#,
+            6.0 * a.cos(),
+            3.0 + (i % 3) as f32,
+            6.0 * a.sin() - 4.0
+        )
+    };
+    let lights: Vec<String> = (0..lights).map(light).collect();
+    let json = format!(
+        r#"{{"scene": {{
+  "camera": [{{"position": "0 1 4", "viewDir": "0 -0.2 -1", "focalLength": 0.4,
+    "imagePlaneWidth": 0.5, "_name": "main", "_type": "perspective"}}],
+  "light": [{}],
+  "shader": [
+    {{"diffuse": "0.7 0.6 0.5", "_name": "matte", "_type": "Lambertian"}},
+    {{"diffuse": "0.2 0.4 0.8", "specular": "1 1 1", "phongExp": 32.0, "_name": "shiny",
+      "_type": "BlinnPhong"}},
+    {{"diffuse": "0.5 0.5 0.5", "mirrorCoef": 0.4, "_name": "glazed", "_type": "Glaze"}}
+  ],
+  "shape": [
+    {{"shader": {{"_ref": "shiny"}}, "center": "-0.8 0 -4", "radius": 0.9, "_name": "a",
+      "_type": "sphere"}},
+    {{"shader": {{"_ref": "matte"}}, "center": "1.2 -0.2 -5", "radius": 0.7, "_name": "b",
+      "_type": "sphere"}},
+    {{"shader": {{"_ref": "glazed"}}, "v0": "-8 -1 0", "v1": "8 -1 0", "v2": "8 -1 -12",
+      "_name": "f0", "_type": "triangle"}},
+    {{"shader": {{"_ref": "glazed"}}, "v0": "-8 -1 0", "v1": "8 -1 -12", "v2": "-8 -1 -12",
+      "_name": "f1", "_type": "triangle"}}
+  ],
+  "_bgColor": "0.1 0.1 0.2"
+}}}}"#,
+        lights.join(",\n    ")
+    );
+    let dir = std::env::temp_dir().join(format!("glint-packet-frames-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(format!("lights_{}.json", lights.len()));
+    std::fs::write(&path, json).unwrap();
+    let loaded = glint_io::load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    std::fs::remove_file(&path).unwrap();
+    let _ = std::fs::remove_dir(&dir);
+    Scene::new(loaded.parts)
+}
+
+/// The first-hit shadow rays of a packet are traced ahead for up to eight lights (a bit each),
+/// ray by ray beyond: both hold the frames of the single-ray loop, at the limit and past it.
+#[test]
+fn first_hit_shadows_up_to_eight_lights_and_past() {
+    for lights in [1, 8, 9] {
+        let scene = lights_scene(lights);
+        assert_eq!(scene.lights.len(), lights);
+        check_scene(&scene, &format!("{lights} lights"), 32, 16);
+    }
 }
 
 /// The path tracer one camera ray at a time, as `PathIntegrator::pixel_samples` took them
