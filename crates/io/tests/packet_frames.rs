@@ -109,6 +109,22 @@ fn instanced_meshes() {
     check("scenes_B/rowOfBunnys.json", 32, 9);
 }
 
+/// At 1 and 4 rays a pixel the camera rays of neighbouring pixels share packets (runs of up to
+/// eight pixels of a row): 37 pixels wide, so that tiles end in runs of 5 pixels (5 lanes at
+/// 1 ray a pixel go ray by ray; 20 at 4 rays, two packets and a partial one).
+#[test]
+fn pixel_runs_at_one_and_four_rays_a_pixel() {
+    for rays_per_pixel in [1, 4] {
+        check("scenes_B/StanfordDragon_Instanced.json", 37, rays_per_pixel);
+        check("scenes_A/spheres_1K.xml", 37, rays_per_pixel);
+        check("scenes_B/threeEggs_SoftShadows.xml", 37, rays_per_pixel);
+        for lights in [8, 9] {
+            let scene = lights_scene(lights);
+            check_scene(&scene, &format!("{lights} lights"), 37, rays_per_pixel);
+        }
+    }
+}
+
 #[test]
 fn spheres_boxes_and_triangles() {
     check("scenes_A/spheres_1K.xml", 40, 16);

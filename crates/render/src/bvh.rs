@@ -316,7 +316,7 @@ struct PacketInverse {
 impl PacketInverse {
     #[inline]
     fn new(rays: &[Ray; 8]) -> PacketInverse {
-        let inv = rays.each_ref().map(RayInverse::new);
+        let inv: [RayInverse; 8] = std::array::from_fn(|l| RayInverse::new(&rays[l]));
         PacketInverse {
             avx2: Avx2::detect(),
             t_min: rays.each_ref().map(|r| r.t_min),

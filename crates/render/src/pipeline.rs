@@ -15,6 +15,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
 
+use crate::accel::PACKET;
 use crate::film::{Features, Film, SampleSums};
 use crate::integrator::course::grid_size;
 use crate::integrator::course::CourseIntegrator;
@@ -371,6 +372,87 @@ struct PixelValue {
     depth: f32,
 }
 
+/// What a pixel's samples add up to while they arrive (`PixelSums::add`), in sample order.
+#[derive(Clone, Copy, Debug, Default)]
+struct PixelSums {
+    value: PixelValue,
+    sum: Color,
+    valid: u32,
+    dropped: u32,
+    feature_count: u32,
+}
+
+impl PixelSums {
+    /// The one place a sample becomes part of a pixel.
+    #[inline]
+    fn add(&mut self, sample: Sample) {
+        if sample.radiance.is_finite() {
+            self.sum += sample.radiance;
+            self.valid += 1;
+        } else {
+            self.dropped += 1;
+        }
+        if let Some(features) = sample.features {
+            // Feature samples are dropped on their own: a NaN normal (a degenerate surface)
+            // must not reach the layer, nor cost the beauty its sample.
+            if features.albedo.is_finite()
+                && features.normal.is_finite()
+                && features.depth.is_finite()
+            {
+                self.value.albedo += features.albedo;
+                self.value.normal += features.normal;
+                self.value.depth += features.depth;
+                self.feature_count += 1;
+            } else if sample.radiance.is_finite() {
+                self.dropped += 1;
+            }
+        }
+    }
+
+    /// The finished pixel (`pixel_index`'s dropped samples counted in `counters`).
+    fn finish(self, features: bool, pixel_index: u64, counters: &mut TileCounters) -> PixelValue {
+        let PixelSums {
+            mut value,
+            sum,
+            valid,
+            mut dropped,
+            feature_count,
+        } = self;
+        // Unnormalised, for farm parts that are added up later (`Film::sums`).
+        value.sum = sum;
+        value.count = valid;
+        if valid > 0 {
+            value.beauty = sum / valid as f32;
+            // Finite samples can still overflow their sum (two of 3e38): then none of them is
+            // usable, and all are counted as dropped.
+            if !value.beauty.is_finite() {
+                value.beauty = Color::ZERO;
+                value.sum = Color::ZERO;
+                value.count = 0;
+                dropped += valid;
+            }
+        }
+        if features {
+            let count = feature_count.max(1) as f32;
+            value.albedo = value.albedo / count;
+            value.normal = value.normal / count;
+            value.depth /= count;
+            if !(value.albedo.is_finite() && value.normal.is_finite() && value.depth.is_finite()) {
+                value.albedo = Color::ZERO;
+                value.normal = Vec3::ZERO;
+                value.depth = 0.0;
+                dropped += feature_count;
+            }
+        }
+        counters.dropped_samples(pixel_index, dropped);
+        value
+    }
+}
+
+/// Pixels of a row the tile loop hands over at once (`Integrator::run_samples`), so that an
+/// integrator may trace the camera rays of several pixels together.
+const RUN: usize = PACKET;
+
 /// The per-pixel sample loop over the tile scheduler.
 fn render_with<I: Integrator>(
     scene: &Scene,
@@ -396,76 +478,23 @@ fn render_with<I: Integrator>(
         width,
         progress,
         |value: &PixelValue| value.beauty,
-        |x, y, counters| {
-            let pixel = context(x, y);
-            let pixel_index = pixel.index();
-            let mut value = PixelValue::default();
-            let mut sum = Color::ZERO;
-            let mut valid = 0u32;
-            let mut dropped = 0u32;
-            let mut feature_count = 0u32;
-            let mut sink = |sample: Sample| {
-                // The one place a sample becomes part of a pixel.
-                if sample.radiance.is_finite() {
-                    sum += sample.radiance;
-                    valid += 1;
-                } else {
-                    dropped += 1;
-                }
-                if let Some(features) = sample.features {
-                    // Feature samples are dropped on their own: a NaN normal (a degenerate
-                    // surface) must not reach the layer, nor cost the beauty its sample.
-                    if features.albedo.is_finite()
-                        && features.normal.is_finite()
-                        && features.depth.is_finite()
-                    {
-                        value.albedo += features.albedo;
-                        value.normal += features.normal;
-                        value.depth += features.depth;
-                        feature_count += 1;
-                    } else if sample.radiance.is_finite() {
-                        dropped += 1;
-                    }
-                }
-            };
-            integrator.pixel_samples(
+        |xs, y, counters, out| {
+            let mut pixels = [context(xs.start, y); RUN];
+            let count = xs.len();
+            for (pixel, x) in pixels.iter_mut().zip(xs) {
+                pixel.x = x;
+            }
+            let mut sums = [PixelSums::default(); RUN];
+            integrator.run_samples(
                 scene,
-                &pixel,
+                &pixels[..count],
                 samples.clone(),
                 &mut counters.rays,
-                &mut sink,
+                &mut |i, sample| sums[i].add(sample),
             );
-            // Unnormalised, for farm parts that are added up later (`Film::sums`).
-            value.sum = sum;
-            value.count = valid;
-            if valid > 0 {
-                value.beauty = sum / valid as f32;
-                // Finite samples can still overflow their sum (two of 3e38): then none of
-                // them is usable, and all are counted as dropped.
-                if !value.beauty.is_finite() {
-                    value.beauty = Color::ZERO;
-                    value.sum = Color::ZERO;
-                    value.count = 0;
-                    dropped += valid;
-                }
+            for (pixel, sums) in pixels[..count].iter().zip(sums) {
+                out.push(sums.finish(settings.features, pixel.index(), counters));
             }
-            if settings.features {
-                let count = feature_count.max(1) as f32;
-                value.albedo = value.albedo / count;
-                value.normal = value.normal / count;
-                value.depth /= count;
-                if !(value.albedo.is_finite()
-                    && value.normal.is_finite()
-                    && value.depth.is_finite())
-                {
-                    value.albedo = Color::ZERO;
-                    value.normal = Vec3::ZERO;
-                    value.depth = 0.0;
-                    dropped += feature_count;
-                }
-            }
-            counters.dropped_samples(pixel_index, dropped);
-            value
         },
     )?;
     let bounds = settings.bounds();
@@ -522,9 +551,10 @@ impl<P: Default + Sync> TilePixels<P> {
     }
 }
 
-/// The tile scheduler: `pixel(x, y, counters)` computes one pixel (x, y from the top-left of
-/// the whole image `width` wide), tiles of `bounds` run on the current rayon pool, each pixel
-/// is computed by exactly one task and kept in its tile's buffer, so neither thread count nor
+/// The tile scheduler: `run(xs, y, counters, out)` computes the pixels xs of row y (at most
+/// `RUN` of them, x and y from the top-left of the whole image `width` wide) and pushes them
+/// to `out` in order; tiles of `bounds` run on the current rayon pool, each pixel is computed
+/// by exactly one task and kept in its tile's buffer, so neither thread count nor
 /// scheduling can change the image. Returns the pixels of `bounds` by tile
 /// ([`TilePixels::gather`] lays them out row-major).
 fn render_tiles<P: Copy + Default + Send>(
@@ -532,7 +562,7 @@ fn render_tiles<P: Copy + Default + Send>(
     width: u32,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
     beauty: impl Fn(&P) -> Color + Sync,
-    pixel: impl Fn(u32, u32, &mut TileCounters) -> P + Sync,
+    run: impl Fn(Range<u32>, u32, &mut TileCounters, &mut Vec<P>) + Sync,
 ) -> Result<(TilePixels<P>, RenderStats), RenderError> {
     let tiles_x = bounds.width().div_ceil(TILE_SIZE);
     let tiles_y = bounds.height().div_ceil(TILE_SIZE);
@@ -561,8 +591,8 @@ fn render_tiles<P: Copy + Default + Send>(
             let area = tile_bounds(tile);
             let mut out = Vec::with_capacity((area.width() * area.height()) as usize);
             for y in area.y0..area.y1 {
-                for x in area.x0..area.x1 {
-                    out.push(pixel(x, y, &mut counters));
+                for x in (area.x0..area.x1).step_by(RUN) {
+                    run(x..(x + RUN as u32).min(area.x1), y, &mut counters, &mut out);
                 }
             }
             let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -694,9 +724,11 @@ mod tests {
                     64,
                     &|_: &Progress| true,
                     |_: &(u32, u32)| Color::ZERO,
-                    |x, y, counters| {
-                        counters.rays += 1;
-                        (x, y)
+                    |xs, y, counters, out| {
+                        for x in xs {
+                            counters.rays += 1;
+                            out.push((x, y));
+                        }
                     },
                 )
             })

@@ -3,6 +3,7 @@
 //! of the lecture's N x N jittered grid (the pixel centre with one sample), with its own
 //! random stream keyed by (seed, pixel, s).
 
+use std::borrow::BorrowMut;
 use std::ops::Range;
 
 use crate::accel::PACKET;
@@ -167,6 +168,35 @@ impl Integrator for CourseIntegrator {
             &|ray, ctx| shade_camera_ray(scene, ray, ctx),
         );
     }
+
+    fn run_samples(
+        &self,
+        scene: &Scene,
+        pixels: &[PixelContext],
+        samples: Range<u32>,
+        rays: &mut u64,
+        sink: &mut impl FnMut(usize, Sample),
+    ) {
+        let few = pixels
+            .first()
+            .is_some_and(|p| p.samples_per_pixel < PACKET as u32);
+        if few && pixels.len() * samples.len() >= PACKET {
+            let lights = Some(&self.lights);
+            grid_run_samples(
+                scene,
+                pixels,
+                samples,
+                lights,
+                rays,
+                sink,
+                &|ray, first, ctx, ahead| shade(scene, ray, first, 0, true, ctx, ahead),
+            );
+            return;
+        }
+        for (i, pixel) in pixels.iter().enumerate() {
+            self.pixel_samples(scene, pixel, samples.clone(), rays, &mut |s| sink(i, s));
+        }
+    }
 }
 
 /// Samples per axis of the course's jittered grid for `requested` rays per pixel.
@@ -181,9 +211,10 @@ pub(crate) type ShadeFirstHit<'a> =
 
 /// The course family's pixel samples `samples` of `pixel`: the camera ray of each on the
 /// jittered grid, its radiance from `radiance`, handed to `sink` in order. With
-/// `from_first_hit`, nine or more samples travel as packets of eight camera rays
-/// (`Scene::intersect_lanes`) and each hit is handed over; the samples are the same. (Fewer
-/// than eight samples, 1 or 4, go ray by ray: half-empty packets did not pay.)
+/// `from_first_hit`, eight or more samples a pixel travel as packets of eight camera rays
+/// (`Scene::intersect_lanes`) and each hit is handed over; the samples are the same. Fewer
+/// (1 or 4 rays a pixel) go ray by ray here, half-empty packets did not pay; the render loop
+/// hands the course integrator runs of neighbouring pixels (`grid_run_samples`) instead.
 #[allow(clippy::too_many_arguments)] // One call per integrator family; a struct would only rename them.
 pub(crate) fn grid_samples(
     scene: &Scene,
@@ -195,45 +226,10 @@ pub(crate) fn grid_samples(
     from_first_hit: Option<ShadeFirstHit>,
     radiance: &dyn Fn(&Ray, &mut SampleContext) -> Color,
 ) {
-    let pixel_index = pixel.index();
-    let all = pixel.samples_per_pixel;
-    let grid = grid_size(all);
-    // Sample `s`: its camera ray and context.
-    let camera_sample = |s: u32| {
-        let mut rng = Rng::for_sample(pixel.seed, pixel_index, s as u64);
-        let (p, q) = (s % grid, s / grid);
-        // Pixel centre with one sample (FORMAT.md 4.4); jittered grid otherwise.
-        let (ox, oy) = if all == 1 {
-            (0.5, 0.5)
-        } else {
-            (
-                (p as f32 + rng.next_f32()) / grid as f32,
-                (q as f32 + rng.next_f32()) / grid as f32,
-            )
-        };
-        let mut ctx = SampleContext {
-            rng,
-            lights,
-            sample_index: s,
-            grid_size: grid,
-            pixel_key: pixel_index ^ pixel.seed.rotate_left(32),
-            max_depth: pixel.max_depth,
-            rays: 1,
-        };
-        // With depth of field, a point on the lens from the sample's stratified lens cell
-        // (the grid's cells shuffled against the pixel's, as for area lights); drawn after
-        // the pixel jitter, so that without a lens nothing changes.
-        let lens = match scene.camera.lens {
-            Some(_) => ctx.stratified_2d(SALT_LENS),
-            None => (0.5, 0.5),
-        };
-        let ray = pixel.camera_ray(scene, ox, oy, lens);
-        (ray, ctx)
-    };
+    let (all, grid) = (pixel.samples_per_pixel, grid_size(pixel.samples_per_pixel));
+    let camera_sample = |s: u32| course_camera_sample(scene, pixel, lights, grid, s);
     let mut emit = |radiance: Color, ray: &Ray, ctx: &SampleContext, rays: &mut u64| {
-        *rays += ctx.rays;
-        let features = pixel.features.then(|| FirstHit::trace(scene, ray, rays));
-        sink(Sample { radiance, features });
+        sink(course_sample(scene, pixel, radiance, ray, ctx, rays));
     };
     match from_first_hit {
         Some(shade_hit) if all >= PACKET as u32 => {
@@ -256,6 +252,107 @@ pub(crate) fn grid_samples(
             }
         }
     }
+}
+
+/// `grid_samples` for a run of neighbouring pixels of a row whose samples (fewer than eight
+/// each: 1 or 4 rays a pixel) make at least one packet together: the camera rays of a pixel's
+/// samples, then of the next pixel's, travel as packets of eight, each sample shaded from its
+/// given hit (`shade_hit`, with its first-hit shadow rays traced ahead); `sink` gets each
+/// sample with its pixel's position in `pixels`, pixel by pixel, in sample order. The same
+/// samples as pixel by pixel.
+fn grid_run_samples(
+    scene: &Scene,
+    pixels: &[PixelContext],
+    samples: Range<u32>,
+    lights: Option<&LightSampler>,
+    rays: &mut u64,
+    sink: &mut impl FnMut(usize, Sample),
+    shade_hit: ShadeFirstHit,
+) {
+    let per_pixel = samples.len() as u32;
+    let grid = pixels.first().map_or(1, |p| grid_size(p.samples_per_pixel));
+    // Lane k: sample `samples.start + k mod per_pixel` of pixel `k div per_pixel`.
+    let camera_sample = |k: u32| {
+        let i = (k / per_pixel) as usize;
+        let s = samples.start + k % per_pixel;
+        let (ray, ctx) = course_camera_sample(scene, &pixels[i], lights, grid, s);
+        (ray, (i, ctx))
+    };
+    let ahead = |packet: &_, hits: &_, states: &mut [Option<(usize, SampleContext)>; PACKET]| {
+        let mut ctxs = states.each_mut().map(|s| s.as_mut().map(|(_, ctx)| ctx));
+        match lights {
+            Some(_) => first_hit_shadows(scene, packet, hits, &mut ctxs),
+            None => [None; PACKET],
+        }
+    };
+    let finish = |ray,
+                  hit,
+                  (i, mut ctx): (usize, SampleContext),
+                  lane: usize,
+                  shadows: &[Option<FirstShadows>; PACKET]| {
+        let c = shade_hit(&ray, hit, &mut ctx, shadows[lane].as_ref());
+        sink(i, course_sample(scene, &pixels[i], c, &ray, &ctx, rays));
+    };
+    let lanes = per_pixel * pixels.len() as u32;
+    camera_ray_packets(scene, 0..lanes, camera_sample, ahead, finish);
+}
+
+/// Sample `s` of `pixel` in the course family: its camera ray through the lecture's jittered
+/// grid (`grid` cells a side) and its context.
+#[inline(always)]
+fn course_camera_sample<'a>(
+    scene: &Scene,
+    pixel: &PixelContext,
+    lights: Option<&'a LightSampler>,
+    grid: u32,
+    s: u32,
+) -> (Ray, SampleContext<'a>) {
+    let pixel_index = pixel.index();
+    let mut rng = Rng::for_sample(pixel.seed, pixel_index, s as u64);
+    let (p, q) = (s % grid, s / grid);
+    // Pixel centre with one sample (FORMAT.md 4.4); jittered grid otherwise.
+    let (ox, oy) = if pixel.samples_per_pixel == 1 {
+        (0.5, 0.5)
+    } else {
+        (
+            (p as f32 + rng.next_f32()) / grid as f32,
+            (q as f32 + rng.next_f32()) / grid as f32,
+        )
+    };
+    let mut ctx = SampleContext {
+        rng,
+        lights,
+        sample_index: s,
+        grid_size: grid,
+        pixel_key: pixel_index ^ pixel.seed.rotate_left(32),
+        max_depth: pixel.max_depth,
+        rays: 1,
+    };
+    // With depth of field, a point on the lens from the sample's stratified lens cell (the
+    // grid's cells shuffled against the pixel's, as for area lights); drawn after the pixel
+    // jitter, so that without a lens nothing changes.
+    let lens = match scene.camera.lens {
+        Some(_) => ctx.stratified_2d(SALT_LENS),
+        None => (0.5, 0.5),
+    };
+    let ray = pixel.camera_ray(scene, ox, oy, lens);
+    (ray, ctx)
+}
+
+/// A finished course sample of `pixel` (its rays added to `rays`; with features, the first
+/// hit's, traced again).
+#[inline(always)]
+fn course_sample(
+    scene: &Scene,
+    pixel: &PixelContext,
+    radiance: Color,
+    ray: &Ray,
+    ctx: &SampleContext,
+    rays: &mut u64,
+) -> Sample {
+    *rays += ctx.rays;
+    let features = pixel.features.then(|| FirstHit::trace(scene, ray, rays));
+    Sample { radiance, features }
 }
 
 /// The course integrator's radiance along a camera ray, traced on its own.
@@ -471,11 +568,11 @@ fn shades_direct_first(material: &Material) -> bool {
 /// light as `direct` would draw them (the same stratified cells and random numbers; `direct`
 /// then draws none), so the samples, the images and the rays counted are those of tracing each
 /// shadow ray alone.
-fn first_hit_shadows(
+fn first_hit_shadows<'a, C: BorrowMut<SampleContext<'a>>>(
     scene: &Scene,
     rays: &[Ray; PACKET],
     hits: &[Option<Hit>; PACKET],
-    ctxs: &mut [Option<SampleContext>; PACKET],
+    ctxs: &mut [Option<C>; PACKET],
 ) -> [Option<FirstShadows>; PACKET] {
     let mut out = [None; PACKET];
     let lights = &scene.lights;
@@ -502,6 +599,7 @@ fn first_hit_shadows(
     for (index, light) in lights.iter().enumerate() {
         for ((first, ctx), shadow) in out.iter_mut().zip(ctxs.iter_mut()).zip(&mut shadows) {
             if let (Some(first), Some(ctx)) = (first, ctx) {
+                let ctx = ctx.borrow_mut();
                 let exact = ctx.grid_size <= 1;
                 let sample = sample_light(light, index, first.point, ctx, exact);
                 first.to_light[index] = (sample.position - first.point).normalized();

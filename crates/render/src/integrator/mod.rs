@@ -132,6 +132,23 @@ pub(crate) trait Integrator: Sync {
         rays: &mut u64,
         sink: &mut impl FnMut(Sample),
     );
+
+    /// `pixel_samples` for a run of neighbouring pixels of one row (at most eight): samples
+    /// `samples` of each, handed to `sink` with the pixel's position in `pixels`, each pixel's
+    /// in sample order. By default pixel by pixel; an integrator may trace the run's camera
+    /// rays together where a pixel alone has too few to fill a packet. The same samples.
+    fn run_samples(
+        &self,
+        scene: &Scene,
+        pixels: &[PixelContext],
+        samples: Range<u32>,
+        rays: &mut u64,
+        sink: &mut impl FnMut(usize, Sample),
+    ) {
+        for (i, pixel) in pixels.iter().enumerate() {
+            self.pixel_samples(scene, pixel, samples.clone(), rays, &mut |s| sink(i, s));
+        }
+    }
 }
 
 /// Counters a tile keeps while its pixels render; summed into `RenderStats` at the end.
