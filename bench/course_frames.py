@@ -12,12 +12,9 @@ first's. Scenes (the issue's whole-frame workloads and one more mesh scene): sph
 (StanfordDragon_Instanced.json), bunnies (rowOfBunnys.json); square frames --size wide.
 """
 
-import argparse
 import os
-import statistics
-import sys
 
-from path_frames import SHARED, render_seconds
+from path_frames import alternate, frames_arguments, medians, render_seconds
 
 
 def scenes(shared):
@@ -31,38 +28,21 @@ def scenes(shared):
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--glint", required=True, help="comma-separated glint binaries")
-    ap.add_argument("--rpp", default="1,4,16", help="comma-separated rays a pixel")
-    ap.add_argument("--rounds", type=int, default=3)
-    ap.add_argument("--size", type=int, default=1024)
-    ap.add_argument("--threads", type=int, default=1)
-    ap.add_argument("--shared", default=SHARED)
-    ap.add_argument("--out", default="/tmp/glint-course-frames.png")
-    ap.add_argument(
-        "scenes", nargs="*", default=["spheres", "room", "dragon", "bunnies"]
-    )
-    a = ap.parse_args()
-    bins = a.glint.split(",")
-    table = scenes(a.shared)
-    unknown = [s for s in a.scenes if s not in table]
-    if unknown:
-        sys.exit(f"unknown scene(s) {unknown}; known: {sorted(table)}")
+    def extra(ap):
+        ap.add_argument("--rpp", default="1,4,16", help="comma-separated rays a pixel")
+        ap.add_argument("--size", type=int, default=1024)
+
+    parse = frames_arguments(__doc__, scenes, 3, "/tmp/glint-course-frames.png")
+    a, bins, table = parse(extra)
     size = str(a.size)
     for rpp in a.rpp.split(","):
         for scene in a.scenes:
-            args = [table[scene], "-r", rpp, "-w", size, "-h", size]
-            times = {b: [] for b in bins}
-            for r in range(a.rounds):
-                for b in bins if r % 2 == 0 else bins[::-1]:
-                    times[b].append(render_seconds(b, args, a.threads, a.out))
-            first = statistics.median(times[bins[0]])
-            cells = "  ".join(
-                f"{b}: {statistics.median(times[b]):.3f} s "
-                f"({statistics.median(times[b]) / first:.3f})"
-                for b in bins
-            )
-            print(f"{scene:8} {rpp:>3} rpp  {cells}", flush=True)
+
+            def render(b, args=(table[scene], "-r", rpp, "-w", size, "-h", size)):
+                return render_seconds(b, list(args), a.threads, a.out)
+
+            times = alternate(bins, a.rounds, render)
+            print(f"{scene:8} {rpp:>3} rpp  {medians(bins, times)}", flush=True)
 
 
 if __name__ == "__main__":

@@ -51,34 +51,62 @@ def render_seconds(glint, args, threads, out):
     return float(re.search(r" in ([0-9.]+) s", result.stderr).group(1))
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--glint", required=True, help="comma-separated glint binaries")
-    ap.add_argument("--rounds", type=int, default=5)
-    ap.add_argument("--threads", type=int, default=1)
-    ap.add_argument("--shared", default=SHARED)
-    ap.add_argument("--out", default="/tmp/glint-path-frames.exr")
-    ap.add_argument(
-        "scenes", nargs="*", default=["cornell", "dragon", "room", "bunnies"]
+def alternate(bins, rounds, render):
+    """`render(b)` for every binary b, `rounds` times, the order reversed every other round:
+    the times of each binary."""
+    times = {b: [] for b in bins}
+    for r in range(rounds):
+        for b in bins if r % 2 == 0 else bins[::-1]:
+            times[b].append(render(b))
+    return times
+
+
+def medians(bins, times):
+    """Each binary's median time and its ratio to the first binary's, as one line's cells."""
+    first = statistics.median(times[bins[0]])
+    return "  ".join(
+        f"{b}: {statistics.median(times[b]):.3f} s "
+        f"({statistics.median(times[b]) / first if first > 0 else float('nan'):.3f})"
+        for b in bins
     )
-    a = ap.parse_args()
-    bins = a.glint.split(",")
-    table = scenes(a.shared)
-    unknown = [s for s in a.scenes if s not in table]
-    if unknown:
-        sys.exit(f"unknown scene(s) {unknown}; known: {sorted(table)}")
+
+
+def frames_arguments(doc, table, rounds, out):
+    """The options these frame benchmarks share (--glint, --rounds, --threads, --shared, --out
+    and the scenes, names of `table(shared)`), with `extra(parser)` adding a script's own:
+    the parsed options, the binaries and the scene table."""
+
+    def parse(extra=lambda ap: None):
+        ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+        ap.add_argument("--glint", required=True, help="comma-separated glint binaries")
+        ap.add_argument("--rounds", type=int, default=rounds)
+        ap.add_argument("--threads", type=int, default=1)
+        ap.add_argument("--shared", default=SHARED)
+        ap.add_argument("--out", default=out)
+        extra(ap)
+        names = list(table(SHARED))
+        ap.add_argument("scenes", nargs="*", default=names)
+        a = ap.parse_args()
+        scenes_of = table(a.shared)
+        unknown = [s for s in a.scenes if s not in scenes_of]
+        if unknown:
+            sys.exit(f"unknown scene(s) {unknown}; known: {sorted(scenes_of)}")
+        return a, a.glint.split(","), scenes_of
+
+    return parse
+
+
+def main():
+    parse = frames_arguments(__doc__, scenes, 5, "/tmp/glint-path-frames.exr")
+    a, bins, table = parse()
     for scene in a.scenes:
-        times = {b: [] for b in bins}
-        for r in range(a.rounds):
-            for b in bins if r % 2 == 0 else bins[::-1]:
-                times[b].append(render_seconds(b, table[scene], a.threads, a.out))
-        first = statistics.median(times[bins[0]])
-        cells = "  ".join(
-            f"{b}: {statistics.median(times[b]):.3f} s ({statistics.median(times[b]) / first:.3f})"
-            for b in bins
-        )
+
+        def render(b, args=table[scene]):
+            return render_seconds(b, args, a.threads, a.out)
+
+        times = alternate(bins, a.rounds, render)
         rounds = [round(x / y, 3) for x, y in zip(times[bins[-1]], times[bins[0]])]
-        print(f"{scene:8} {cells}  last/first by round {rounds}")
+        print(f"{scene:8} {medians(bins, times)}  last/first by round {rounds}")
 
 
 if __name__ == "__main__":
