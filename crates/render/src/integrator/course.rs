@@ -7,7 +7,9 @@ use std::borrow::BorrowMut;
 use std::ops::Range;
 
 use crate::accel::PACKET;
-use crate::integrator::{camera_ray_packets, FirstHit, Integrator, PixelContext, Sample};
+use crate::integrator::{
+    camera_ray_packets, pixel_by_pixel, FirstHit, Integrator, PixelContext, Sample,
+};
 
 use crate::accel::instances::Hit;
 use crate::light::sampler::{course_light_point, LightPoint, LightSampler};
@@ -180,22 +182,25 @@ impl Integrator for CourseIntegrator {
         let few = pixels
             .first()
             .is_some_and(|p| p.samples_per_pixel < PACKET as u32);
-        if few && pixels.len() * samples.len() >= PACKET {
-            let lights = Some(&self.lights);
-            grid_run_samples(
-                scene,
-                pixels,
-                samples,
-                lights,
-                rays,
-                sink,
-                &|ray, first, ctx, ahead| shade(scene, ray, first, 0, true, ctx, ahead),
-            );
+        let per_pixel = samples.len() as u32;
+        let lanes = per_pixel * pixels.len() as u32;
+        if !few || lanes < PACKET as u32 {
+            pixel_by_pixel(self, scene, pixels, samples, rays, sink);
             return;
         }
-        for (i, pixel) in pixels.iter().enumerate() {
-            self.pixel_samples(scene, pixel, samples.clone(), rays, &mut |s| sink(i, s));
-        }
+        // Lane k: sample `samples.start + k mod per_pixel` of pixel `k div per_pixel`.
+        let locate = |k: u32| ((k / per_pixel) as usize, samples.start + k % per_pixel);
+        let lights = Some(&self.lights);
+        grid_packets(
+            scene,
+            pixels,
+            0..lanes,
+            locate,
+            lights,
+            rays,
+            sink,
+            &|ray, first, ctx, ahead| shade(scene, ray, first, 0, true, ctx, ahead),
+        );
     }
 }
 
@@ -214,7 +219,7 @@ pub(crate) type ShadeFirstHit<'a> =
 /// `from_first_hit`, eight or more samples a pixel travel as packets of eight camera rays
 /// (`Scene::intersect_lanes`) and each hit is handed over; the samples are the same. Fewer
 /// (1 or 4 rays a pixel) go ray by ray here, half-empty packets did not pay; the render loop
-/// hands the course integrator runs of neighbouring pixels (`grid_run_samples`) instead.
+/// hands the course integrator runs of neighbouring pixels (`run_samples`) instead.
 #[allow(clippy::too_many_arguments)] // One call per integrator family; a struct would only rename them.
 pub(crate) fn grid_samples(
     scene: &Scene,
@@ -227,63 +232,59 @@ pub(crate) fn grid_samples(
     radiance: &dyn Fn(&Ray, &mut SampleContext) -> Color,
 ) {
     let (all, grid) = (pixel.samples_per_pixel, grid_size(pixel.samples_per_pixel));
-    let camera_sample = |s: u32| course_camera_sample(scene, pixel, lights, grid, s);
-    let mut emit = |radiance: Color, ray: &Ray, ctx: &SampleContext, rays: &mut u64| {
-        sink(course_sample(scene, pixel, radiance, ray, ctx, rays));
-    };
     match from_first_hit {
         Some(shade_hit) if all >= PACKET as u32 => {
-            let ahead = |packet: &_, hits: &_, ctxs: &mut _| match lights {
-                Some(_) => first_hit_shadows(scene, packet, hits, ctxs),
-                None => [None; PACKET],
-            };
-            let finish =
-                |ray, hit, mut ctx, lane: usize, shadows: &[Option<FirstShadows>; PACKET]| {
-                    let c = shade_hit(&ray, hit, &mut ctx, shadows[lane].as_ref());
-                    emit(c, &ray, &ctx, rays);
-                };
-            camera_ray_packets(scene, samples, &camera_sample, ahead, finish)
+            let pixels = std::slice::from_ref(pixel);
+            let sink = &mut |_, sample| sink(sample);
+            grid_packets(
+                scene,
+                pixels,
+                samples,
+                |s| (0, s),
+                lights,
+                rays,
+                sink,
+                shade_hit,
+            );
         }
         _ => {
             for s in samples {
-                let (ray, mut ctx) = camera_sample(s);
+                let (ray, mut ctx) = course_camera_sample(scene, pixel, lights, grid, s);
                 let c = radiance(&ray, &mut ctx);
-                emit(c, &ray, &ctx, rays);
+                sink(course_sample(scene, pixel, c, &ray, &ctx, rays));
             }
         }
     }
 }
 
-/// `grid_samples` for a run of neighbouring pixels of a row whose samples (fewer than eight
-/// each: 1 or 4 rays a pixel) make at least one packet together: the camera rays of a pixel's
-/// samples, then of the next pixel's, travel as packets of eight, each sample shaded from its
-/// given hit (`shade_hit`, with its first-hit shadow rays traced ahead); `sink` gets each
-/// sample with its pixel's position in `pixels`, pixel by pixel, in sample order. The same
-/// samples as pixel by pixel.
-fn grid_run_samples(
+/// The course family's samples `lanes` of `pixels` with their camera rays in packets of eight
+/// (`camera_ray_packets`): lane k is sample `locate(k).1` of pixel `locate(k).0`, lanes in
+/// the order of each pixel's samples. Each sample is shaded from its given hit (`shade_hit`,
+/// with its first-hit shadow rays traced ahead, `first_hit_shadows`) and handed to `sink`
+/// with its pixel's position in `pixels`. A pixel's own samples where it takes eight or more
+/// (`grid_samples`); below that, at 1 or 4 rays a pixel, a run of neighbouring pixels'
+/// (`CourseIntegrator::run_samples`). The same samples as ray by ray.
+#[allow(clippy::too_many_arguments)] // Its two callers' pieces; a struct would only rename them.
+#[inline(always)]
+fn grid_packets(
     scene: &Scene,
     pixels: &[PixelContext],
-    samples: Range<u32>,
+    lanes: Range<u32>,
+    locate: impl Fn(u32) -> (usize, u32),
     lights: Option<&LightSampler>,
     rays: &mut u64,
     sink: &mut impl FnMut(usize, Sample),
     shade_hit: ShadeFirstHit,
 ) {
-    let per_pixel = samples.len() as u32;
     let grid = pixels.first().map_or(1, |p| grid_size(p.samples_per_pixel));
-    // Lane k: sample `samples.start + k mod per_pixel` of pixel `k div per_pixel`.
     let camera_sample = |k: u32| {
-        let i = (k / per_pixel) as usize;
-        let s = samples.start + k % per_pixel;
+        let (i, s) = locate(k);
         let (ray, ctx) = course_camera_sample(scene, &pixels[i], lights, grid, s);
         (ray, (i, ctx))
     };
     let ahead = |packet: &_, hits: &_, states: &mut [Option<(usize, SampleContext)>; PACKET]| {
         let mut ctxs = states.each_mut().map(|s| s.as_mut().map(|(_, ctx)| ctx));
-        match lights {
-            Some(_) => first_hit_shadows(scene, packet, hits, &mut ctxs),
-            None => [None; PACKET],
-        }
+        first_hit_shadows(scene, packet, hits, &mut ctxs)
     };
     let finish = |ray,
                   hit,
@@ -293,8 +294,7 @@ fn grid_run_samples(
         let c = shade_hit(&ray, hit, &mut ctx, shadows[lane].as_ref());
         sink(i, course_sample(scene, &pixels[i], c, &ray, &ctx, rays));
     };
-    let lanes = per_pixel * pixels.len() as u32;
-    camera_ray_packets(scene, 0..lanes, camera_sample, ahead, finish);
+    camera_ray_packets(scene, lanes, camera_sample, ahead, finish);
 }
 
 /// Sample `s` of `pixel` in the course family: its camera ray through the lecture's jittered

@@ -145,9 +145,21 @@ pub(crate) trait Integrator: Sync {
         rays: &mut u64,
         sink: &mut impl FnMut(usize, Sample),
     ) {
-        for (i, pixel) in pixels.iter().enumerate() {
-            self.pixel_samples(scene, pixel, samples.clone(), rays, &mut |s| sink(i, s));
-        }
+        pixel_by_pixel(self, scene, pixels, samples, rays, sink);
+    }
+}
+
+/// `Integrator::run_samples` pixel by pixel (`pixel_samples` on each).
+pub(crate) fn pixel_by_pixel<I: Integrator + ?Sized>(
+    integrator: &I,
+    scene: &Scene,
+    pixels: &[PixelContext],
+    samples: Range<u32>,
+    rays: &mut u64,
+    sink: &mut impl FnMut(usize, Sample),
+) {
+    for (i, pixel) in pixels.iter().enumerate() {
+        integrator.pixel_samples(scene, pixel, samples.clone(), rays, &mut |s| sink(i, s));
     }
 }
 
