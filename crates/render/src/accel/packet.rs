@@ -21,7 +21,9 @@
 //! zero edge function sent to the scalar test as single rays are. Hits merge with the same tie
 //! rule, so each ray's closest hit is the hit with the smallest (t, source index), whatever the
 //! order of the walk. The winners' barycentrics are computed in one pass too (`finish` ray by
-//! ray otherwise).
+//! ray otherwise). A leaf of other shapes tests each sphere against the active rays in one
+//! 8-lane pass of `intersect_sphere`'s arithmetic (the AVX2 kernel; the course's sphere scenes
+//! spend most of their shadow rays there), boxes and single triangles ray by ray.
 //!
 //! **Incoherent packets** (rays whose direction signs differ, so no interval bounds) go ray by
 //! ray with the single-ray traversal, which costs less than testing each child exactly for the
@@ -36,6 +38,8 @@ use crate::accel::wide::{
     self, ray_is_valid, ArrayStack, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel,
     TriangleBlock, WideBvh, WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
 };
+use crate::geometry::{intersect_sphere, Shape};
+use crate::math::Vec3;
 use crate::ray::Ray;
 
 /// Rays per packet.
@@ -77,6 +81,8 @@ pub(crate) struct PacketRays<'a> {
     /// Box test: origin and reciprocal direction per axis.
     pub origin: [Lanes; 3],
     pub inv_dir: [Lanes; 3],
+    /// The direction per axis (the sphere test's quadratic).
+    pub direction: [Lanes; 3],
     pub t_min: Lanes,
     /// The search window's far end per ray (`Ray::t_max`).
     pub t_max: Lanes,
@@ -122,6 +128,7 @@ impl<'a> PacketRays<'a> {
             };
             for a in 0..3 {
                 p.origin[a].0[l] = ray.origin[a];
+                p.direction[a].0[l] = ray.direction[a];
                 dir[a][l] = ray.direction[a];
             }
             p.t_min.0[l] = ray.t_min;
@@ -180,6 +187,7 @@ impl<'a> PacketRays<'a> {
         PacketRays {
             origin: [Lanes::INFINITY; 3],
             inv_dir: [Lanes::INFINITY; 3],
+            direction: [Lanes::INFINITY; 3],
             t_min: Lanes::INFINITY,
             t_max: Lanes::INFINITY,
             axes: [[0; PACKET]; 3],
@@ -307,6 +315,35 @@ pub(crate) trait PacketKernel {
     ) -> u32;
     /// The rays of `lanes` that meet any triangle of the block within their window.
     fn block_any(&self, block: &TriangleBlock, p: &PacketRays, lanes: u32) -> u32;
+    /// `intersect_sphere` for each ray in `lanes` within [t_min, t_max]: the mask of rays
+    /// that hit, and their t in `t`. Here ray by ray; the AVX2 kernel runs the same
+    /// arithmetic on eight lanes.
+    #[inline(always)]
+    fn sphere(
+        &self,
+        center: Vec3,
+        radius: f32,
+        p: &PacketRays,
+        lanes: u32,
+        t_max: &Lanes,
+        t: &mut Lanes,
+    ) -> u32 {
+        let mut hits = 0;
+        let mut m = lanes;
+        while m != 0 {
+            let l = m.trailing_zeros() as usize;
+            m &= m - 1;
+            let window = Ray {
+                t_max: t_max.0[l],
+                ..p.rays[l]
+            };
+            if let Some(h) = intersect_sphere(&window, center, radius) {
+                t.0[l] = h.t;
+                hits |= 1 << l;
+            }
+        }
+        hits
+    }
     /// The inner node `child` refers to (as `Kernel::node_at`).
     #[inline(always)]
     fn node_at<'a>(&self, bvh: &'a WideBvh, child: ChildRef) -> &'a WideNode {
@@ -667,22 +704,37 @@ pub(crate) fn closest<K: PacketKernel, S: PacketStack>(
                 }
             } else {
                 for s in first..first + count {
-                    let mut m = active;
-                    while m != 0 {
-                        let l = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        let window = Ray {
-                            t_max: best_t.0[l],
-                            ..p.rays[l]
-                        };
-                        if let Some(h) = bvh.shapes[s].intersect(&window) {
-                            let prim = lanes_total + s as u32;
-                            if h.t < best_t.0[l]
-                                || (h.t == best_t.0[l] && bvh.earlier(prim, best_prim[l]))
-                            {
-                                best_t.0[l] = h.t;
-                                best_prim[l] = prim;
+                    let prim = lanes_total + s as u32;
+                    let mut hits = match bvh.shapes[s] {
+                        Shape::Sphere { center, radius } => {
+                            kernel.sphere(center, radius, p, active, &best_t, &mut block_t)
+                        }
+                        ref shape => {
+                            let mut hits = 0;
+                            let mut m = active;
+                            while m != 0 {
+                                let l = m.trailing_zeros() as usize;
+                                m &= m - 1;
+                                let window = Ray {
+                                    t_max: best_t.0[l],
+                                    ..p.rays[l]
+                                };
+                                if let Some(h) = shape.intersect(&window) {
+                                    block_t.0[l] = h.t;
+                                    hits |= 1 << l;
+                                }
                             }
+                            hits
+                        }
+                    };
+                    while hits != 0 {
+                        let l = hits.trailing_zeros() as usize;
+                        hits &= hits - 1;
+                        let t = block_t.0[l];
+                        if t < best_t.0[l] || (t == best_t.0[l] && bvh.earlier(prim, best_prim[l]))
+                        {
+                            best_t.0[l] = t;
+                            best_prim[l] = prim;
                         }
                     }
                 }
@@ -755,16 +807,27 @@ pub(crate) fn any<K: PacketKernel, S: PacketStack>(
                     }
                 }
             } else {
+                let mut t = Lanes::INFINITY;
                 for s in first..first + count {
-                    let mut m = active;
-                    while m != 0 {
-                        let l = m.trailing_zeros() as usize;
-                        m &= m - 1;
-                        if bvh.shapes[s].intersect(&p.rays[l]).is_some() {
-                            done |= 1 << l;
-                            active &= !(1 << l);
+                    let hits = match bvh.shapes[s] {
+                        Shape::Sphere { center, radius } => {
+                            kernel.sphere(center, radius, p, active, &p.t_max, &mut t)
                         }
-                    }
+                        ref shape => {
+                            let mut hits = 0;
+                            let mut m = active;
+                            while m != 0 {
+                                let l = m.trailing_zeros() as usize;
+                                m &= m - 1;
+                                if shape.intersect(&p.rays[l]).is_some() {
+                                    hits |= 1 << l;
+                                }
+                            }
+                            hits
+                        }
+                    };
+                    done |= hits;
+                    active &= !hits;
                     if active == 0 {
                         break;
                     }

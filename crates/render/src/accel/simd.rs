@@ -291,6 +291,7 @@ mod x86 {
         self, BlockHit, ChildRef, Kernel, LocalHit, ScalarKernel, Stack, TriangleBlock, WideBvh,
         WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
     };
+    use crate::math::Vec3;
     use crate::ray::Ray;
 
     /// # Safety
@@ -1380,6 +1381,20 @@ mod x86 {
         }
 
         #[inline(always)]
+        fn sphere(
+            &self,
+            center: Vec3,
+            radius: f32,
+            p: &PacketRays,
+            lanes: u32,
+            t_max: &Lanes,
+            t: &mut Lanes,
+        ) -> u32 {
+            // SAFETY: as above.
+            unsafe { packet_sphere(center, radius, p, lanes, t_max, t) }
+        }
+
+        #[inline(always)]
         fn node_at<'a>(&self, bvh: &'a WideBvh, child: ChildRef) -> &'a WideNode {
             node_at(bvh, child)
         }
@@ -1710,9 +1725,10 @@ mod x86 {
             _mm256_div_ps(one, dy),
             _mm256_div_ps(one, dz),
         ];
-        for (a, (&o, &i)) in [ox, oy, oz].iter().zip(&inv).enumerate() {
+        for (a, ((&o, &i), &d)) in [ox, oy, oz].iter().zip(&inv).zip(&[dx, dy, dz]).enumerate() {
             store(&mut p.origin[a], o);
             store(&mut p.inv_dir[a], i);
+            store(&mut p.direction[a], d);
         }
         store(&mut p.t_min, t_min);
         store(&mut p.t_max, t_max);
@@ -1838,6 +1854,83 @@ mod x86 {
     fn load(v: &Lanes) -> __m256 {
         // SAFETY: `Lanes` is 8 f32, 32-byte aligned.
         unsafe { _mm256_load_ps(v.0.as_ptr()) }
+    }
+
+    /// `geometry::intersect_sphere` on eight lanes (rays): the same operations in the same
+    /// order, so each lane's t is the scalar test's bit for bit (no contraction into FMAs;
+    /// its early returns are masks). Returns the rays of `lanes` hit within [t_min, t_max]
+    /// and their t in `t` (other lanes hold whatever their arithmetic gave).
+    #[target_feature(enable = "avx2,fma")]
+    #[inline]
+    fn packet_sphere(
+        center: Vec3,
+        radius: f32,
+        p: &PacketRays,
+        lanes: u32,
+        t_max: &Lanes,
+        t: &mut Lanes,
+    ) -> u32 {
+        let (mul, add, sub) = (_mm256_mul_ps, _mm256_add_ps, _mm256_sub_ps);
+        // `Vec3::dot`: (x·x' + y·y') + z·z'.
+        let dot = |a: [__m256; 3], b: [__m256; 3]| {
+            add(add(mul(a[0], b[0]), mul(a[1], b[1])), mul(a[2], b[2]))
+        };
+        let d = [
+            load(&p.direction[0]),
+            load(&p.direction[1]),
+            load(&p.direction[2]),
+        ];
+        let oc = [
+            sub(load(&p.origin[0]), _mm256_set1_ps(center.x)),
+            sub(load(&p.origin[1]), _mm256_set1_ps(center.y)),
+            sub(load(&p.origin[2]), _mm256_set1_ps(center.z)),
+        ];
+        let a = dot(d, d);
+        let half_b = dot(d, oc);
+        let r2 = _mm256_set1_ps(radius * radius);
+        let c = sub(dot(oc, oc), r2);
+        let k = _mm256_div_ps(half_b, a);
+        let perpendicular = [
+            sub(oc[0], mul(d[0], k)),
+            sub(oc[1], mul(d[1], k)),
+            sub(oc[2], mul(d[2], k)),
+        ];
+        let disc = mul(a, sub(r2, dot(perpendicular, perpendicular)));
+        let zero = _mm256_setzero_ps();
+        // The scalar test returns where a = 0 and where disc < 0 (NaN goes on, and fails the
+        // window below as it does there).
+        let goes_on = _mm256_and_ps(
+            _mm256_cmp_ps::<_CMP_NEQ_UQ>(a, zero),
+            _mm256_cmp_ps::<_CMP_NLT_UQ>(disc, zero),
+        );
+        let sq = _mm256_sqrt_ps(disc);
+        let minus_b = _mm256_xor_ps(half_b, _mm256_set1_ps(-0.0));
+        let q = _mm256_blendv_ps(
+            add(minus_b, sq),
+            sub(minus_b, sq),
+            _mm256_cmp_ps::<_CMP_GT_OQ>(half_b, zero),
+        );
+        // Both roots +0 where q = 0.
+        let q_zero = _mm256_cmp_ps::<_CMP_EQ_OQ>(q, zero);
+        let t0 = _mm256_andnot_ps(q_zero, _mm256_div_ps(q, a));
+        let t1 = _mm256_andnot_ps(q_zero, _mm256_div_ps(c, q));
+        let swap = _mm256_cmp_ps::<_CMP_GT_OQ>(t0, t1);
+        let (near, far) = (
+            _mm256_blendv_ps(t0, t1, swap),
+            _mm256_blendv_ps(t1, t0, swap),
+        );
+        let (t_min, t_max) = (load(&p.t_min), load(t_max));
+        let within = |v: __m256| {
+            _mm256_and_ps(
+                _mm256_cmp_ps::<_CMP_GE_OQ>(v, t_min),
+                _mm256_cmp_ps::<_CMP_LE_OQ>(v, t_max),
+            )
+        };
+        let near_in = within(near);
+        let hit = _mm256_and_ps(goes_on, _mm256_or_ps(near_in, within(far)));
+        // SAFETY: `Lanes` is 8 f32, 32-byte aligned.
+        unsafe { _mm256_store_ps(t.0.as_mut_ptr(), _mm256_blendv_ps(far, near, near_in)) };
+        _mm256_movemask_ps(hit) as u32 & lanes
     }
 
     /// All-ones in the lanes whose bit is set in `lanes`.
@@ -2064,6 +2157,24 @@ mod x86 {
         packet_rays(rays, lanes)
     }
 
+    /// `packet_sphere`, for the test that compares it with `geometry::intersect_sphere`.
+    ///
+    /// # Safety
+    /// The CPU must have AVX2 and FMA.
+    #[cfg(test)]
+    #[target_feature(enable = "avx2,fma")]
+    pub(super) unsafe fn sphere_lanes(
+        center: Vec3,
+        radius: f32,
+        rays: &[Ray; PACKET],
+        lanes: u8,
+    ) -> (u32, Lanes) {
+        let p = packet_rays(rays, lanes);
+        let mut t = Lanes::INFINITY;
+        let hits = packet_sphere(center, radius, &p, p.valid, &p.t_max, &mut t);
+        (hits, t)
+    }
+
     /// The per-ray constants `prepare_box` and `prepare_tri` make, against the scalar
     /// constructors, bit for bit; the packet set-up against `PacketRays::new`; the margin box
     /// tests against the scalar kernel's.
@@ -2283,6 +2394,134 @@ mod x86 {
             }
             // Most coherent packets are bounded (the interval's fields were compared).
             assert!(bounded > 6000, "{bounded}");
+        }
+
+        /// The sphere test on eight lanes against `intersect_sphere` ray by ray, t bit for
+        /// bit: rays from outside, from inside, from the surface (a root at t = 0) outwards,
+        /// inwards and along it (q = 0: both roots +0, in exact cases), grazing rays, spheres
+        /// far away and tiny, windows cutting one root or both, zero directions (a = 0), zero
+        /// and negative radii, lanes left out.
+        #[test]
+        fn sphere_lanes_match_the_scalar_test() {
+            use crate::accel::packet::PACKET;
+            use crate::geometry::intersect_sphere;
+            let Some(_avx2) = avx2_or_skip() else {
+                return;
+            };
+            // Counts of rays hit, rays whose window cut off every root, hits at t = 0.
+            let check = |center: Vec3, radius: f32, rays: &[Ray; PACKET], lanes: u8| {
+                let mut seen = [0; 3];
+                // SAFETY: `avx2_or_skip` found AVX2 and FMA.
+                let (got, t) = unsafe { super::sphere_lanes(center, radius, rays, lanes) };
+                for (l, ray) in rays.iter().enumerate() {
+                    let asked = lanes & (1 << l) != 0 && ray_is_valid(ray);
+                    let want = asked
+                        .then(|| intersect_sphere(ray, center, radius))
+                        .flatten();
+                    let at = format!("{l} {ray:?} {center:?} {radius}");
+                    assert_eq!(got & (1 << l) != 0, want.is_some(), "{at}");
+                    if let Some(h) = want {
+                        assert_eq!(t.0[l].to_bits(), h.t.to_bits(), "{at}");
+                        seen[0] += 1;
+                        seen[2] += usize::from(h.t == 0.0);
+                    } else if asked {
+                        let whole = Ray {
+                            t_min: 0.0,
+                            t_max: f32::INFINITY,
+                            ..*ray
+                        };
+                        seen[1] += usize::from(intersect_sphere(&whole, center, radius).is_some());
+                    }
+                }
+                seen
+            };
+            // Exact tangents: from (r, 0, 0) along ±y and ±z half_b = 0 and disc = 0, so q = 0
+            // (and q = -0 + 0 = +0); with an offset origin, the same from outside.
+            let tangents: [Ray; PACKET] = std::array::from_fn(|l| {
+                let d = [
+                    Vec3::new(0.0, 1.0, 0.0),
+                    Vec3::new(0.0, -1.0, 0.0),
+                    Vec3::new(0.0, 0.0, 2.0),
+                    Vec3::new(0.0, 0.0, -0.5),
+                ][l % 4];
+                let o = if l < 4 {
+                    Vec3::new(2.0, 0.0, 0.0)
+                } else {
+                    Vec3::new(2.0, 0.0, 0.0) - d * 3.0
+                };
+                Ray::new(o, d)
+            });
+            let both = check(Vec3::ZERO, 2.0, &tangents, 0xff);
+            let some = check(Vec3::ZERO, -2.0, &tangents, 0b0101_1010);
+            assert_eq!(
+                (both, some),
+                ([8, 0, 4], [4, 0, 2]),
+                "every tangent meets the sphere"
+            );
+            let mut seen = [0; 3];
+            let mut r = crate::testing::rng(11);
+            let mut u = move |lo: f32, hi: f32| lo + (hi - lo) * r.next_f32();
+            for k in 0..30_000 {
+                let center = Vec3::new(u(-3.0, 3.0), u(-3.0, 3.0), u(-3.0, 3.0));
+                let center = if k % 11 == 0 { center * 1.0e4 } else { center };
+                let radius = match k % 7 {
+                    0 => 0.0,
+                    1 => -u(0.1, 2.0),
+                    2 => u(1.0e-4, 1.0e-3),
+                    _ => u(0.1, 2.0),
+                };
+                let rays: [Ray; PACKET] = std::array::from_fn(|l| {
+                    let d = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+                    let near = Vec3::new(u(-1.0, 1.0), u(-1.0, 1.0), u(-1.0, 1.0));
+                    let (o, d) = match (k + l) % 8 {
+                        // Aimed near the sphere from outside.
+                        0 | 1 => {
+                            let o = center + d * (3.0 + 3.0 * radius.abs());
+                            (o, center + near * radius.abs() - o)
+                        }
+                        // From inside.
+                        2 => (center + d * (0.5 * radius.abs()), d),
+                        // From a point of the surface, outwards, inwards and along it.
+                        3 => {
+                            let n = d.normalized();
+                            let dir = match l % 3 {
+                                0 => n,
+                                1 => -n,
+                                _ => n.cross(Vec3::new(0.0, 1.0, 0.0)),
+                            };
+                            (center + n * radius.abs(), dir)
+                        }
+                        // No direction.
+                        4 if l % 2 == 0 => (d, Vec3::ZERO),
+                        // Grazing: offset from the centre by about the radius.
+                        5 => {
+                            let n = d.normalized();
+                            let side = n.cross(Vec3::new(0.3, 1.0, -0.2)).normalized();
+                            let o = center + side * (radius.abs() * u(0.999, 1.001)) - n * 4.0;
+                            (o, n * u(0.5, 3.0))
+                        }
+                        _ => (center + near * 5.0, d),
+                    };
+                    let mut ray = Ray::new(o, d);
+                    match l % 4 {
+                        1 => ray.t_min = u(0.0, 2.0),
+                        2 => ray.t_max = u(0.0, 3.0),
+                        3 => {
+                            ray.t_min = u(0.0, 1.0);
+                            ray.t_max = ray.t_min + u(0.0, 1.0);
+                        }
+                        _ => {}
+                    }
+                    ray
+                });
+                let lanes = if k % 5 == 0 { (k * 37) as u8 } else { 0xff };
+                let counts = check(center, radius, &rays, lanes);
+                for (s, c) in seen.iter_mut().zip(counts) {
+                    *s += c;
+                }
+            }
+            let [hits, cut, zero] = seen;
+            assert!(hits > 40_000 && cut > 5_000 && zero > 1_000, "{seen:?}");
         }
 
         /// Nodes whose planes pass through points of the ray (so slab distances cancel, or
