@@ -145,7 +145,7 @@ pub(crate) struct CourseIntegrator {
 impl CourseIntegrator {
     pub fn new(scene: &Scene) -> CourseIntegrator {
         CourseIntegrator {
-            lights: LightSampler::new(scene),
+            lights: LightSampler::without_environment(scene),
         }
     }
 }

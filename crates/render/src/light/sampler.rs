@@ -26,6 +26,7 @@ use crate::sampling::warp::{
 };
 use crate::scene::{Background, Scene};
 use crate::texture::CubeMap;
+use rayon::prelude::*;
 
 use std::f32::consts::PI;
 
@@ -196,6 +197,19 @@ impl LightSampler {
     /// Prepares the scene's lights (index i here is `scene.lights[i]`) and, when the background
     /// is not black, the environment as one more light at index `scene.lights.len()`.
     pub fn new(scene: &Scene) -> LightSampler {
+        LightSampler::prepare(scene, true)
+    }
+
+    /// The scene's lights alone, as `new` prepares them for a black background: for the course
+    /// integrator, which takes points on its lights one light at a time (`course_light_point`)
+    /// and gathers the background by cosine rays, so never samples the environment. An
+    /// environment map's distribution is a pass over every texel (6 M for the course's reef
+    /// cube map: a tenth of a second on one thread before the first pixel).
+    pub fn without_environment(scene: &Scene) -> LightSampler {
+        LightSampler::prepare(scene, false)
+    }
+
+    fn prepare(scene: &Scene, with_environment: bool) -> LightSampler {
         let mut lights = Vec::with_capacity(scene.lights.len() + 1);
         let mut triangles = Vec::new();
         let mut power = Vec::with_capacity(scene.lights.len() + 1);
@@ -302,7 +316,9 @@ impl LightSampler {
             lights.push(prepared);
             power.push(if phi.is_finite() { phi.max(0.0) } else { 0.0 });
         }
-        let environment = EnvironmentDistribution::new(&scene.background);
+        let environment = with_environment
+            .then(|| EnvironmentDistribution::new(&scene.background))
+            .flatten();
         if let Some(env) = &environment {
             // pbrt-v4's power of an infinite light: what it sends through a disk the size of
             // the scene, π r² ∫ L dω.
@@ -895,41 +911,71 @@ impl CubeDistribution {
             first_row[face + 1] = first_row[face] + sizes[face].1;
         }
         let rows = first_row[6] as usize;
-        let mut row_weight = Vec::with_capacity(rows);
-        let mut column_cdf = Vec::new();
+        // Each row's distribution is its own (rows in parallel, a block of them at a time);
+        // ∫ L dω is one running sum over every texel in order, so each block's terms are made
+        // in parallel and then added in order (the same sum, bit for bit, as one loop).
+        const BLOCK_ROWS: usize = 64;
         let mut column_start = Vec::with_capacity(rows);
+        let mut column_cdf = Vec::new();
+        let mut row_weight = Vec::with_capacity(rows);
+        let mut integral = 0.0f64;
+        let mut terms = Vec::new();
         for (face, image) in map.faces.iter().enumerate() {
             let (width, height) = sizes[face];
-            for y in 0..height {
-                column_start.push(column_cdf.len() as u32);
-                let start = column_cdf.len();
-                column_cdf.push(0.0f32);
-                let mut running = 0.0f64;
-                for x in 0..width {
-                    let s = (x as f32 + 0.5) / width as f32;
-                    let t = (y as f32 + 0.5) / height as f32;
-                    let texel = image.texels[(y * width + x) as usize];
-                    let luminance = texel.luminance();
-                    let luminance = if luminance.is_finite() {
-                        luminance.max(0.0)
-                    } else {
-                        0.0
-                    };
-                    // Luminance times the texel's solid angle: the share of light it sends.
-                    running += luminance as f64 * cube_solid_angle_per_area(s, t) as f64
-                        / (width as f64 * height as f64);
-                    column_cdf.push(running as f32);
+            if height == 0 {
+                continue;
+            }
+            let stride = width as usize + 1;
+            let start = column_cdf.len();
+            column_start.extend((0..height as usize).map(|y| (start + y * stride) as u32));
+            column_cdf.resize(start + height as usize * stride, 0.0f32);
+            terms.resize(BLOCK_ROWS * width as usize, 0.0f64);
+            let texels = width as f64 * height as f64;
+            for (block, cdf) in column_cdf[start..]
+                .chunks_mut(BLOCK_ROWS * stride)
+                .enumerate()
+            {
+                let terms = &mut terms[..cdf.len() / stride * width as usize];
+                let weights: Vec<f64> = cdf
+                    .par_chunks_mut(stride)
+                    .zip(terms.par_chunks_mut(width as usize))
+                    .enumerate()
+                    .map(|(i, (row, terms))| {
+                        let y = (block * BLOCK_ROWS + i) as u32;
+                        let mut running = 0.0f64;
+                        for x in 0..width {
+                            let s = (x as f32 + 0.5) / width as f32;
+                            let t = (y as f32 + 0.5) / height as f32;
+                            let texel = image.texels[(y * width + x) as usize];
+                            let luminance = texel.luminance();
+                            let luminance = if luminance.is_finite() {
+                                luminance.max(0.0)
+                            } else {
+                                0.0
+                            };
+                            let per_area = cube_solid_angle_per_area(s, t) as f64;
+                            // Luminance times the texel's solid angle: the share of light
+                            // it sends.
+                            running += luminance as f64 * per_area / texels;
+                            row[x as usize + 1] = running as f32;
+                            terms[x as usize] =
+                                mean(texel.max(Color::ZERO)) as f64 * per_area / texels;
+                        }
+                        if running > 0.0 {
+                            for c in row.iter_mut() {
+                                *c = (*c as f64 / running) as f32;
+                            }
+                            if let Some(last) = row.last_mut() {
+                                *last = 1.0;
+                            }
+                        }
+                        running
+                    })
+                    .collect();
+                row_weight.extend(weights);
+                for &term in terms.iter() {
+                    integral += term;
                 }
-                let row = &mut column_cdf[start..];
-                if running > 0.0 {
-                    for c in row.iter_mut() {
-                        *c = (*c as f64 / running) as f32;
-                    }
-                    if let Some(last) = row.last_mut() {
-                        *last = 1.0;
-                    }
-                }
-                row_weight.push(running);
             }
         }
         let total: f64 = row_weight.iter().sum();
@@ -945,20 +991,6 @@ impl CubeDistribution {
         }
         if let Some(last) = row_cdf.last_mut() {
             *last = 1.0;
-        }
-        // ∫ L dω by channel mean, from the same per-texel solid angles.
-        let mut integral = 0.0f64;
-        for (face, image) in map.faces.iter().enumerate() {
-            let (width, height) = sizes[face];
-            for y in 0..height {
-                for x in 0..width {
-                    let s = (x as f32 + 0.5) / width as f32;
-                    let t = (y as f32 + 0.5) / height as f32;
-                    let texel = image.texels[(y * width + x) as usize].max(Color::ZERO);
-                    integral += mean(texel) as f64 * cube_solid_angle_per_area(s, t) as f64
-                        / (width as f64 * height as f64);
-                }
-            }
         }
         Some((
             CubeDistribution {
@@ -1049,6 +1081,58 @@ mod tests {
             // And the inverse map returns the direction.
             let back = cube_face_direction(face, s, t).normalized();
             assert!((back - d).length() < 1e-5, "{d:?} {back:?}");
+        }
+    }
+
+    /// Faces of 1 to 130 rows (the distribution is made in blocks of 64 rows, in parallel):
+    /// each texel's probability (row times column) is its luminance times its solid angle over
+    /// the whole map's, and the integral is every texel's mean times its solid angle.
+    #[test]
+    fn cube_distribution_weighs_every_texel() {
+        let sizes = [(3, 1), (5, 64), (4, 65), (2, 130), (9, 7), (1, 129)];
+        let mut rng = crate::sampling::Rng::new(8, 2);
+        let faces = sizes.map(|(width, height)| Image {
+            width,
+            height,
+            texels: (0..width * height)
+                .map(|_| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()))
+                .collect(),
+        });
+        let map = CubeMap { faces };
+        let (cube, integral) = CubeDistribution::new(&map).unwrap();
+        let weight = |face: usize, x: u32, y: u32| {
+            let (w, h) = sizes[face];
+            let texel = map.faces[face].texels[(y * w + x) as usize];
+            let per_area =
+                cube_solid_angle_per_area((x as f32 + 0.5) / w as f32, (y as f32 + 0.5) / h as f32)
+                    as f64
+                    / (w as f64 * h as f64);
+            (
+                texel.luminance() as f64 * per_area,
+                mean(texel) as f64 * per_area,
+            )
+        };
+        let (mut total, mut want_integral) = (0.0, 0.0);
+        for (face, &(w, h)) in sizes.iter().enumerate() {
+            for y in 0..h {
+                for x in 0..w {
+                    total += weight(face, x, y).0;
+                    want_integral += weight(face, x, y).1;
+                }
+            }
+        }
+        assert!(((integral as f64) / want_integral - 1.0).abs() < 1e-6);
+        for (face, &(w, h)) in sizes.iter().enumerate() {
+            for y in 0..h {
+                let row = (cube.first_row[face] + y) as usize;
+                let row_p = (cube.row_cdf[row + 1] - cube.row_cdf[row]) as f64;
+                let columns = cube.row_columns(row, w);
+                for x in 0..w as usize {
+                    let p = row_p * (columns[x + 1] - columns[x]) as f64;
+                    let want = weight(face, x as u32, y).0 / total;
+                    assert!((p / want - 1.0).abs() < 2e-3, "{face} {x} {y}: {p} {want}");
+                }
+            }
         }
     }
 

@@ -1194,6 +1194,45 @@ fn cube_map_environment() {
     );
 }
 
+/// The course integrator's sampler (`without_environment`) prepares the same lights as `new`
+/// (the same points on a triangle light) but no environment, whose cube map distribution it
+/// would never sample.
+#[test]
+fn course_lights_leave_the_environment_out() {
+    let triangles = vec![
+        [
+            Vec3::new(0.0, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ],
+        [
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(1.0, 1.0, 2.0),
+            Vec3::new(0.0, 1.0, 1.0),
+        ],
+    ];
+    let scene = scene_with(
+        vec![Light::Triangles {
+            triangles,
+            intensity: Color::ONE,
+        }],
+        Background::CubeMap(Box::new(test_cube_map())),
+    );
+    let (all, course) = (
+        LightSampler::new(&scene),
+        LightSampler::without_environment(&scene),
+    );
+    assert_eq!(all.environment_index(), Some(1));
+    assert_eq!(course.environment_index(), None);
+    let mut rng = Rng::new(5, 9);
+    for _ in 0..100 {
+        let u = (rng.next_f32(), rng.next_f32());
+        let point = |s: &LightSampler| s.triangle_point(0, u, false).map(|(p, _)| p.position);
+        assert!(point(&course).is_some());
+        assert_eq!(point(&course), point(&all));
+    }
+}
+
 #[test]
 fn light_selection_follows_power() {
     // Two rectangles of radiance 1 and 3 and equal area, and a point light of the same power
