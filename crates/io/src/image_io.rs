@@ -6,6 +6,7 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use glint_render::{Color, CubeMap, Film, Image, Vec3};
+use rayon::prelude::*;
 
 use crate::assets::{AssetError, Assets, TooLarge};
 use crate::display::{PngEncoding, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD};
@@ -37,6 +38,16 @@ pub(crate) fn load_image(
     assets: &dyn Assets,
     budget: &mut TextureBudget,
 ) -> Result<Image, AssetError> {
+    read_image(path, assets, budget)?.decode()
+}
+
+/// `load_image`'s first half: the file read, and the dimensions its header declares checked
+/// against the limits and charged to `budget`; `Checked::decode` is the rest.
+fn read_image(
+    path: &Path,
+    assets: &dyn Assets,
+    budget: &mut TextureBudget,
+) -> Result<Checked, AssetError> {
     let bytes = assets
         .read_at_most(path, budget.limits.max_file_bytes)
         .map_err(|error| match TooLarge::of(&error) {
@@ -45,19 +56,33 @@ pub(crate) fn load_image(
             }
             None => AssetError::Failed(error.to_string()),
         })?;
-    decode_image(&bytes, budget)
+    check_image(bytes, budget)
 }
 
 /// Decodes an image held in memory, its format told by its content, after checking the
 /// dimensions its header declares against the limits and charging its memory to `budget`.
+#[cfg(test)]
 pub(crate) fn decode_image(bytes: &[u8], budget: &mut TextureBudget) -> Result<Image, AssetError> {
-    let failed = |error: image::ImageError| AssetError::Failed(error.to_string());
-    let reader = || {
-        image::ImageReader::new(std::io::Cursor::new(bytes))
-            .with_guessed_format()
-            .map_err(|error| AssetError::Failed(error.to_string()))
-    };
-    let (width, height) = reader()?.into_dimensions().map_err(failed)?;
+    check_image(bytes.to_vec(), budget)?.decode()
+}
+
+/// An image file whose header passed the limits and whose memory is charged: what is left is
+/// to decode it (which may still fail), on any thread.
+struct Checked {
+    bytes: Vec<u8>,
+    limits: image::Limits,
+}
+
+fn reader(bytes: &[u8]) -> Result<image::ImageReader<std::io::Cursor<&[u8]>>, AssetError> {
+    image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|error| AssetError::Failed(error.to_string()))
+}
+
+fn check_image(bytes: Vec<u8>, budget: &mut TextureBudget) -> Result<Checked, AssetError> {
+    let (width, height) = reader(&bytes)?
+        .into_dimensions()
+        .map_err(|error| AssetError::Failed(error.to_string()))?;
     let side = budget.limits.max_texture_side;
     if width > side || height > side {
         return Err(AssetError::Refused(format!(
@@ -75,38 +100,46 @@ pub(crate) fn decode_image(bytes: &[u8], budget: &mut TextureBudget) -> Result<I
             format_bytes(budget.limits.max_texture_bytes)
         )));
     }
-    let mut decode_limits = image::Limits::default();
-    decode_limits.max_image_width = Some(side);
-    decode_limits.max_image_height = Some(side);
-    decode_limits.max_alloc = Some(remaining);
-    let mut reader = reader()?;
-    reader.limits(decode_limits);
-    let decoded = reader.decode().map_err(failed)?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(side);
+    limits.max_image_height = Some(side);
+    limits.max_alloc = Some(remaining);
     budget.used += cost;
-    if matches!(
-        decoded,
-        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-    ) {
-        return float_image(decoded.to_rgb32f()).map_err(AssetError::Failed);
-    }
-    let rgb = decoded.to_rgb8();
-    drop(decoded);
-    let (width, height) = rgb.dimensions();
-    let texels = rgb
-        .pixels()
-        .map(|pixel| {
-            Color::new(
-                f32::from(pixel[0]) / 255.0,
-                f32::from(pixel[1]) / 255.0,
-                f32::from(pixel[2]) / 255.0,
-            )
+    Ok(Checked { bytes, limits })
+}
+
+impl Checked {
+    fn decode(self) -> Result<Image, AssetError> {
+        let mut reader = reader(&self.bytes)?;
+        reader.limits(self.limits);
+        let decoded = reader
+            .decode()
+            .map_err(|error| AssetError::Failed(error.to_string()))?;
+        if matches!(
+            decoded,
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+        ) {
+            return float_image(decoded.to_rgb32f()).map_err(AssetError::Failed);
+        }
+        let rgb = decoded.to_rgb8();
+        drop(decoded);
+        let (width, height) = rgb.dimensions();
+        let texels = rgb
+            .pixels()
+            .map(|pixel| {
+                Color::new(
+                    f32::from(pixel[0]) / 255.0,
+                    f32::from(pixel[1]) / 255.0,
+                    f32::from(pixel[2]) / 255.0,
+                )
+            })
+            .collect();
+        Ok(Image {
+            width,
+            height,
+            texels,
         })
-        .collect();
-    Ok(Image {
-        width,
-        height,
-        texels,
-    })
+    }
 }
 
 /// A floating-point image as it is, refusing non-finite and negative texels.
@@ -199,25 +232,49 @@ pub(crate) fn cut_vertical_cross(cross: &Image) -> Result<[Image; 6], String> {
 }
 
 /// Loads the six faces named by `envMapPrefix`, resolved against `directory` (PNG, or EXR or
-/// Radiance HDR, kept as float).
+/// Radiance HDR, kept as float). The files are read and their headers checked against the
+/// limits face by face, then the faces decoded in parallel; the error reported is the one
+/// reading and decoding the faces one after the other would meet first.
 pub(crate) fn load_cube_map(
     directory: &Path,
     prefix: &str,
     assets: &dyn Assets,
     budget: &mut TextureBudget,
 ) -> Result<CubeMap, AssetError> {
-    let mut faces = Vec::with_capacity(6);
     let extension = cube_face_extension(directory, prefix, assets);
-    for name in cube_face_paths(prefix, extension) {
-        let path = directory.join(&name);
+    let in_face = |name: &str, path: &Path, error: AssetError| {
         let in_face = |error: String| format!("face `{name}` ({}): {error}", path.display());
-        let face = load_image(&path, assets, budget).map_err(|error| match error {
+        match error {
             AssetError::Refused(message) => AssetError::Refused(in_face(message)),
             AssetError::Failed(message) => {
                 AssetError::Failed(format!("cannot read {}", in_face(message)))
             }
-        })?;
-        faces.push(face);
+        }
+    };
+    let mut checked = Vec::with_capacity(6);
+    let mut unread = None;
+    for name in cube_face_paths(prefix, extension) {
+        let path = directory.join(&name);
+        match read_image(&path, assets, budget) {
+            Ok(face) => checked.push((name, path, face)),
+            Err(error) => {
+                unread = Some(in_face(&name, &path, error));
+                break;
+            }
+        }
+    }
+    let (names, faces): (Vec<_>, Vec<_>) = checked
+        .into_iter()
+        .map(|(name, path, face)| ((name, path), face))
+        .unzip();
+    let decoded: Vec<Result<Image, AssetError>> =
+        faces.into_par_iter().map(Checked::decode).collect();
+    let mut faces = Vec::with_capacity(6);
+    for ((name, path), face) in names.iter().zip(decoded) {
+        faces.push(face.map_err(|error| in_face(name, path, error))?);
+    }
+    if let Some(error) = unread {
+        return Err(error);
     }
     let faces: [Image; 6] = faces
         .try_into()
@@ -956,6 +1013,74 @@ mod tests {
         .unwrap_err();
         assert!(matches!(error, AssetError::Failed(_)));
         assert!(error.to_string().contains("data/reef_posX.png"), "{error}");
+    }
+
+    /// The faces are decoded in parallel, but come out in face order, and a load that fails
+    /// reports what loading them one after the other would: a corrupt face before a missing
+    /// or oversized later one, a refused face when the faces before it are sound.
+    #[test]
+    fn cube_map_faces_load_in_order_and_fail_at_the_first_bad_face() {
+        let write_faces = |faces: [Option<Vec<u8>>; 6]| {
+            let directory = tempfile::tempdir().unwrap();
+            for (name, bytes) in cube_face_paths("sky_", "png").iter().zip(faces) {
+                if let Some(bytes) = bytes {
+                    std::fs::write(directory.path().join(name), bytes).unwrap();
+                }
+            }
+            directory
+        };
+        let face = |i: u8, side: u32| {
+            let mut bytes = Vec::new();
+            image::RgbImage::from_pixel(side, side, image::Rgb([i * 40, 0, 255 - i]))
+                .write_to(
+                    &mut std::io::Cursor::new(&mut bytes),
+                    image::ImageFormat::Png,
+                )
+                .unwrap();
+            Some(bytes)
+        };
+        let load = |directory: &tempfile::TempDir, limits: Limits| {
+            let mut budget = TextureBudget::new(limits);
+            load_cube_map(directory.path(), "sky_", &crate::FileSystem, &mut budget)
+        };
+        let sound = write_faces(std::array::from_fn(|i| face(i as u8, 3 + i as u32)));
+        let map = load(&sound, Limits::default()).unwrap();
+        for (i, image) in map.faces.iter().enumerate() {
+            assert_eq!(image.width, 3 + i as u32);
+            let blue = 255.0 - i as f32;
+            assert_eq!(
+                image.texels[0],
+                Vec3::new(i as f32 * 40.0 / 255.0, 0.0, blue / 255.0)
+            );
+        }
+        // A sound header (signature and IHDR, 33 bytes) and the start of the pixel data's
+        // chunk, cut off: refused only when decoded.
+        let corrupt = face(1, 4).map(|bytes| bytes[..45].to_vec());
+        // -X corrupt, -Y missing: -X is named.
+        let mut faces: [Option<Vec<u8>>; 6] = std::array::from_fn(|i| face(i as u8, 4));
+        faces[1] = corrupt.clone();
+        faces[3] = None;
+        let error = load(&write_faces(faces), Limits::default()).unwrap_err();
+        assert!(error.to_string().contains("sky_negX.png"), "{error}");
+        // +Y over the memory limit after two sound faces: +Y is refused.
+        let limits = Limits {
+            max_texture_bytes: 2 * 16 * BYTES_PER_TEXEL + 1,
+            ..Limits::default()
+        };
+        let faces: [Option<Vec<u8>>; 6] = std::array::from_fn(|i| face(i as u8, 4));
+        let error = load(&write_faces(faces), limits).unwrap_err();
+        assert!(
+            matches!(&error, AssetError::Refused(m) if m.contains("sky_posY.png")),
+            "{error}"
+        );
+        // The same, with -X corrupt: -X is named.
+        let mut faces: [Option<Vec<u8>>; 6] = std::array::from_fn(|i| face(i as u8, 4));
+        faces[1] = corrupt;
+        let error = load(&write_faces(faces), limits).unwrap_err();
+        assert!(
+            matches!(&error, AssetError::Failed(m) if m.contains("sky_negX.png")),
+            "{error}"
+        );
     }
 
     fn png(width: u32, height: u32) -> Vec<u8> {
