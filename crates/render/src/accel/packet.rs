@@ -38,7 +38,7 @@ use crate::accel::wide::{
     self, ray_is_valid, ArrayStack, BlockHit, BoxPlanes, ChildRef, Kernel, LocalHit, ScalarKernel,
     TriangleBlock, WideBvh, WideNode, BLOCK, FAR_SCALE, STACK_SIZE, WIDTH,
 };
-use crate::geometry::{intersect_sphere, Shape};
+use crate::geometry::Shape;
 use crate::math::Vec3;
 use crate::ray::Ray;
 
@@ -328,21 +328,7 @@ pub(crate) trait PacketKernel {
         t_max: &Lanes,
         t: &mut Lanes,
     ) -> u32 {
-        let mut hits = 0;
-        let mut m = lanes;
-        while m != 0 {
-            let l = m.trailing_zeros() as usize;
-            m &= m - 1;
-            let window = Ray {
-                t_max: t_max.0[l],
-                ..p.rays[l]
-            };
-            if let Some(h) = intersect_sphere(&window, center, radius) {
-                t.0[l] = h.t;
-                hits |= 1 << l;
-            }
-        }
-        hits
+        shape_lanes(&Shape::Sphere { center, radius }, p, lanes, t_max, t)
     }
     /// The inner node `child` refers to (as `Kernel::node_at`).
     #[inline(always)]
@@ -364,6 +350,27 @@ pub(crate) trait PacketKernel {
         b1: &mut Lanes,
         b2: &mut Lanes,
     ) -> u32;
+}
+
+/// `Shape::intersect` for each ray in `lanes` within [t_min, t_max], ray by ray: the mask of
+/// rays that hit, their t in `t`.
+#[inline(always)]
+fn shape_lanes(shape: &Shape, p: &PacketRays, lanes: u32, t_max: &Lanes, t: &mut Lanes) -> u32 {
+    let mut hits = 0;
+    let mut m = lanes;
+    while m != 0 {
+        let l = m.trailing_zeros() as usize;
+        m &= m - 1;
+        let window = Ray {
+            t_max: t_max.0[l],
+            ..p.rays[l]
+        };
+        if let Some(h) = shape.intersect(&window) {
+            t.0[l] = h.t;
+            hits |= 1 << l;
+        }
+    }
+    hits
 }
 
 /// The packet traversal stack: child, mask of rays that entered it, their entry distances.
@@ -709,23 +716,7 @@ pub(crate) fn closest<K: PacketKernel, S: PacketStack>(
                         Shape::Sphere { center, radius } => {
                             kernel.sphere(center, radius, p, active, &best_t, &mut block_t)
                         }
-                        ref shape => {
-                            let mut hits = 0;
-                            let mut m = active;
-                            while m != 0 {
-                                let l = m.trailing_zeros() as usize;
-                                m &= m - 1;
-                                let window = Ray {
-                                    t_max: best_t.0[l],
-                                    ..p.rays[l]
-                                };
-                                if let Some(h) = shape.intersect(&window) {
-                                    block_t.0[l] = h.t;
-                                    hits |= 1 << l;
-                                }
-                            }
-                            hits
-                        }
+                        ref shape => shape_lanes(shape, p, active, &best_t, &mut block_t),
                     };
                     while hits != 0 {
                         let l = hits.trailing_zeros() as usize;
@@ -813,18 +804,7 @@ pub(crate) fn any<K: PacketKernel, S: PacketStack>(
                         Shape::Sphere { center, radius } => {
                             kernel.sphere(center, radius, p, active, &p.t_max, &mut t)
                         }
-                        ref shape => {
-                            let mut hits = 0;
-                            let mut m = active;
-                            while m != 0 {
-                                let l = m.trailing_zeros() as usize;
-                                m &= m - 1;
-                                if shape.intersect(&p.rays[l]).is_some() {
-                                    hits |= 1 << l;
-                                }
-                            }
-                            hits
-                        }
+                        ref shape => shape_lanes(shape, p, active, &p.t_max, &mut t),
                     };
                     done |= hits;
                     active &= !hits;
