@@ -693,12 +693,15 @@ impl Instances {
         let mut out = [None; PACKET];
         // Rays the structures reject (NaN, infinite, an empty window) take the single-ray
         // path, which answers them; the rest travel together.
-        let packet = crate::accel::wide::valid_lanes(rays, lanes);
-        let mut single = lanes & !packet;
-        while single != 0 {
-            let l = single.trailing_zeros() as usize;
-            single &= single - 1;
-            out[l] = self.intersect(&rays[l]);
+        let mut packet = 0u8;
+        for (l, ray) in rays.iter().enumerate() {
+            if lanes & (1 << l) != 0 {
+                if crate::accel::wide::ray_is_valid(ray) {
+                    packet |= 1 << l;
+                } else {
+                    out[l] = self.intersect(ray);
+                }
+            }
         }
         if packet == 0 {
             return out;
@@ -778,12 +781,15 @@ impl Instances {
     /// `occluded_packet` for the rays of `lanes` only: the mask of those occluded.
     pub fn occluded_lanes(&self, rays: &[Ray; PACKET], lanes: u8) -> u8 {
         let mut out = 0u8;
-        let packet = crate::accel::wide::valid_lanes(rays, lanes);
-        let mut single = lanes & !packet;
-        while single != 0 {
-            let l = single.trailing_zeros() as usize;
-            single &= single - 1;
-            out |= u8::from(self.occluded(&rays[l])) << l;
+        let mut packet = 0u8;
+        for (l, ray) in rays.iter().enumerate() {
+            if lanes & (1 << l) != 0 {
+                if crate::accel::wide::ray_is_valid(ray) {
+                    packet |= 1 << l;
+                } else if self.occluded(ray) {
+                    out |= 1 << l;
+                }
+            }
         }
         if packet == 0 {
             return out;

@@ -840,52 +840,6 @@ mod tests {
     use crate::math::Vec3;
     use crate::sampling::Rng;
 
-    /// `wide::valid_lanes` answers `ray_is_valid` lane by lane: infinities and NaNs in each
-    /// component, the largest finite floats, subnormals, zeros of both signs, empty and NaN
-    /// windows, and lanes left out.
-    #[test]
-    fn valid_lanes_are_the_valid_rays() {
-        let odd = [
-            0.0,
-            -0.0,
-            1.5,
-            f32::MAX,
-            -f32::MAX,
-            f32::MIN_POSITIVE / 8.0,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-        ];
-        let mut r = Rng::new(5, 1);
-        let mut pick = || odd[(r.next_f32() * odd.len() as f32) as usize % odd.len()];
-        let (mut valid, mut invalid) = (0, 0);
-        for k in 0..4000 {
-            let rays: [Ray; PACKET] = std::array::from_fn(|l| {
-                let mut c = [1.0f32; 8];
-                // Most rays with one or two odd values, some with many.
-                for _ in 0..(1 + (k + l) % 3) {
-                    let i = ((k * 7 + l * 3) % 8 + (k / 8) % 5) % 8;
-                    c[i] = pick();
-                }
-                Ray {
-                    origin: Vec3::new(c[0], c[1], c[2]),
-                    direction: Vec3::new(c[3], c[4], c[5]),
-                    t_min: c[6],
-                    t_max: c[7],
-                }
-            });
-            let lanes = if k % 3 == 0 { (k * 29) as u8 } else { 0xff };
-            let got = wide::valid_lanes(&rays, lanes);
-            for (l, ray) in rays.iter().enumerate() {
-                let want = lanes & (1 << l) != 0 && ray_is_valid(ray);
-                assert_eq!(got & (1 << l) != 0, want, "{ray:?}");
-                valid += usize::from(want);
-                invalid += usize::from(!want && lanes & (1 << l) != 0);
-            }
-        }
-        assert!(valid > 5000 && invalid > 5000, "{valid} {invalid}");
-    }
-
     /// `intersect` and `occluded` hand packets whose direction signs differ to single rays; the
     /// packet traversal itself still answers them exactly as single rays do, with both kernels.
     #[test]

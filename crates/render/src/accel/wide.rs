@@ -316,20 +316,6 @@ pub(crate) fn ray_is_valid(ray: &Ray) -> bool {
     ray.origin.is_finite() && ray.direction.is_finite() && ray.t_min <= ray.t_max
 }
 
-/// The rays of `lanes` (bit l for `rays[l]`) that `ray_is_valid` accepts, without a branch a
-/// component: a float is finite exactly when 0·x is zero (0·±∞ and 0·NaN are NaN, and a sum
-/// of zeros of either sign is zero).
-#[inline(always)]
-pub(crate) fn valid_lanes(rays: &[Ray; 8], lanes: u8) -> u8 {
-    let mut valid = 0u8;
-    for (l, r) in rays.iter().enumerate() {
-        let (o, d) = (r.origin * 0.0, r.direction * 0.0);
-        let zero = (o.x + o.y + o.z) + (d.x + d.y + d.z);
-        valid |= u8::from(zero == 0.0 && r.t_min <= r.t_max) << l;
-    }
-    valid & lanes
-}
-
 /// The box and block tests of a traversal.
 pub(crate) trait Kernel {
     /// Per-ray constants of the box test.
