@@ -22,8 +22,8 @@
 //! rule, so each ray's closest hit is the hit with the smallest (t, source index), whatever the
 //! order of the walk. The winners' barycentrics are computed in one pass too (`finish` ray by
 //! ray otherwise). A leaf of other shapes tests each sphere against the active rays in one
-//! 8-lane pass of `intersect_sphere`'s arithmetic (the AVX2 kernel; the course's sphere scenes
-//! spend most of their shadow rays there), boxes and single triangles ray by ray.
+//! 8-lane pass of `intersect_sphere`'s arithmetic (the AVX2 kernel), boxes and single
+//! triangles ray by ray.
 //!
 //! **Incoherent packets** (rays whose direction signs differ, so no interval bounds) go ray by
 //! ray with the single-ray traversal, which costs less than testing each child exactly for the
