@@ -263,16 +263,12 @@ pub(crate) fn load_cube_map(
             }
         }
     }
-    let (names, faces): (Vec<_>, Vec<_>) = checked
-        .into_iter()
-        .map(|(name, path, face)| ((name, path), face))
-        .unzip();
-    let decoded: Vec<Result<Image, AssetError>> =
-        faces.into_par_iter().map(Checked::decode).collect();
-    let mut faces = Vec::with_capacity(6);
-    for ((name, path), face) in names.iter().zip(decoded) {
-        faces.push(face.map_err(|error| in_face(name, path, error))?);
-    }
+    let decoded: Vec<Result<Image, AssetError>> = checked
+        .into_par_iter()
+        .map(|(name, path, face)| face.decode().map_err(|error| in_face(&name, &path, error)))
+        .collect();
+    // The first error in face order.
+    let faces = decoded.into_iter().collect::<Result<Vec<Image>, _>>()?;
     if let Some(error) = unread {
         return Err(error);
     }

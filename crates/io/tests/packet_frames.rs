@@ -177,13 +177,11 @@ fn lights_scene(lights: usize) -> Scene {
 }}}}"#,
         lights.join(",\n    ")
     );
-    let dir = std::env::temp_dir().join(format!("glint-packet-frames-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join(format!("lights_{}.json", lights.len()));
+    // A directory of its own per call: the tests calling this run at once.
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join(format!("lights_{}.json", lights.len()));
     std::fs::write(&path, json).unwrap();
     let loaded = glint_io::load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
-    std::fs::remove_file(&path).unwrap();
-    let _ = std::fs::remove_dir(&dir);
     Scene::new(loaded.parts)
 }
 

@@ -3,7 +3,6 @@
 //! of the lecture's N x N jittered grid (the pixel centre with one sample), with its own
 //! random stream keyed by (seed, pixel, s).
 
-use std::borrow::BorrowMut;
 use std::ops::Range;
 
 use crate::accel::PACKET;
@@ -568,11 +567,11 @@ fn shades_direct_first(material: &Material) -> bool {
 /// light as `direct` would draw them (the same stratified cells and random numbers; `direct`
 /// then draws none), so the samples, the images and the rays counted are those of tracing each
 /// shadow ray alone.
-fn first_hit_shadows<'a, C: BorrowMut<SampleContext<'a>>>(
+fn first_hit_shadows(
     scene: &Scene,
     rays: &[Ray; PACKET],
     hits: &[Option<Hit>; PACKET],
-    ctxs: &mut [Option<C>; PACKET],
+    ctxs: &mut [Option<&mut SampleContext>; PACKET],
 ) -> [Option<FirstShadows>; PACKET] {
     let mut out = [None; PACKET];
     let lights = &scene.lights;
@@ -599,7 +598,6 @@ fn first_hit_shadows<'a, C: BorrowMut<SampleContext<'a>>>(
     for (index, light) in lights.iter().enumerate() {
         for ((first, ctx), shadow) in out.iter_mut().zip(ctxs.iter_mut()).zip(&mut shadows) {
             if let (Some(first), Some(ctx)) = (first, ctx) {
-                let ctx = ctx.borrow_mut();
                 let exact = ctx.grid_size <= 1;
                 let sample = sample_light(light, index, first.point, ctx, exact);
                 first.to_light[index] = (sample.position - first.point).normalized();
