@@ -529,6 +529,55 @@ impl Kernel for ScalarKernel {
     }
 }
 
+/// A child's place in the closest-hit walk's order: its entry distance's bits above its
+/// reference, so that keys compare as (entry, reference) pairs do wherever the entries are
+/// not negative (those of rays with t_min >= 0; the bits of a negative entry sort it last,
+/// which costs such a ray time, never a hit: the order decides no hit, see `keep_nearer`).
+#[inline(always)]
+fn child_key(entry: f32, child: u32) -> u64 {
+    u64::from(entry.to_bits()) << 32 | u64::from(child)
+}
+
+/// (reference, entry distance) of a `child_key`.
+#[inline(always)]
+fn key_parts(key: u64) -> (u32, f32) {
+    (key as u32, f32::from_bits((key >> 32) as u32))
+}
+
+/// One comparator of a sorting network: the smaller key first. `min` and `max` on integers
+/// compile to conditional moves, not branches.
+#[inline(always)]
+fn order(a: u64, b: u64) -> (u64, u64) {
+    (a.min(b), a.max(b))
+}
+
+/// Two keys in ascending order.
+#[inline(always)]
+fn sort2([a, b]: [u64; 2]) -> [u64; 2] {
+    let (a, b) = order(a, b);
+    [a, b]
+}
+
+/// Three keys in ascending order (three comparators).
+#[inline(always)]
+fn sort3([a, b, c]: [u64; 3]) -> [u64; 3] {
+    let (a, b) = order(a, b);
+    let (b, c) = order(b, c);
+    let (a, b) = order(a, b);
+    [a, b, c]
+}
+
+/// Four keys in ascending order (five comparators).
+#[inline(always)]
+fn sort4([a, b, c, d]: [u64; 4]) -> [u64; 4] {
+    let (a, b) = order(a, b);
+    let (c, d) = order(c, d);
+    let (a, c) = order(a, c);
+    let (b, d) = order(b, d);
+    let (b, c) = order(b, c);
+    [a, b, c, d]
+}
+
 /// Walks down from `current` through inner nodes until `current` is a leaf: true then; false
 /// where the ray enters none of a node's children within `t_max`. `ORDERED`: the nearest
 /// child first, the others onto the stack sorted by entry distance, nearest on top;
@@ -569,30 +618,49 @@ fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
             *current = ChildRef(node.children[i0]);
             continue;
         }
+        // Two to four children (nearly every visit that enters more than one): each
+        // prefetched, then ordered by a sorting network on their keys (`child_key`) with no
+        // branch on the distances, the nearest taken, the others pushed, the farthest first.
+        // For incoherent rays the order is a coin toss that a branch mispredicts half the
+        // time (bench/README, issue 14, twenty-first pass).
         let i1 = rest.trailing_zeros() as usize;
         let rest = rest & (rest - 1);
+        let key = |i: usize| child_key(entry[i], node.children[i]);
+        let mut push = |key: u64| {
+            let (child, entry) = key_parts(key);
+            stack.set(*sp, child, entry);
+            *sp += 1;
+        };
+        kernel.prefetch(bvh, ChildRef(node.children[i0]));
+        kernel.prefetch(bvh, ChildRef(node.children[i1]));
         if rest == 0 {
-            // A branch, not a selection: where it is predicted (coherent rays take the same
-            // side node after node) the near child's load need not wait for the comparison.
-            // Primary rays +4 to +6 %, others +0.2 to +5 %, path-traced Cornell within noise
-            // (bench/README, issue 14, sixth pass).
-            let (e0, e1) = (entry[i0], entry[i1]);
-            let (c0, c1) = (node.children[i0], node.children[i1]);
-            if e0 <= e1 {
-                stack.set(*sp, c1, e1);
-                *sp += 1;
-                kernel.prefetch(bvh, ChildRef(c1));
-                *current = ChildRef(c0);
-            } else {
-                stack.set(*sp, c0, e0);
-                *sp += 1;
-                kernel.prefetch(bvh, ChildRef(c0));
-                *current = ChildRef(c1);
-            }
+            let [a, b] = sort2([key(i0), key(i1)]);
+            push(b);
+            *current = ChildRef(key_parts(a).0);
             continue;
         }
-        // Three or more: onto the stack sorted by entry distance, nearest on top (among
-        // equals the later slot), then the top taken.
+        let i2 = rest.trailing_zeros() as usize;
+        let rest = rest & (rest - 1);
+        kernel.prefetch(bvh, ChildRef(node.children[i2]));
+        if rest == 0 {
+            let [a, b, c] = sort3([key(i0), key(i1), key(i2)]);
+            push(c);
+            push(b);
+            *current = ChildRef(key_parts(a).0);
+            continue;
+        }
+        let i3 = rest.trailing_zeros() as usize;
+        if rest & (rest - 1) == 0 {
+            kernel.prefetch(bvh, ChildRef(node.children[i3]));
+            let [a, b, c, d] = sort4([key(i0), key(i1), key(i2), key(i3)]);
+            push(d);
+            push(c);
+            push(b);
+            *current = ChildRef(key_parts(a).0);
+            continue;
+        }
+        // Five or more (a few visits in a hundred): onto the stack sorted by entry distance,
+        // nearest on top (among equals the later slot), then the top taken.
         let base = *sp;
         while mask != 0 {
             let i = mask.trailing_zeros() as usize;
@@ -609,7 +677,9 @@ fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
             }
             stack.set(k, node.children[i], d);
             *sp += 1;
-            kernel.prefetch(bvh, ChildRef(node.children[i]));
+            if i > i3 {
+                kernel.prefetch(bvh, ChildRef(node.children[i]));
+            }
         }
         *sp -= 1;
         *current = ChildRef(stack.get(*sp).0);
@@ -942,5 +1012,64 @@ impl Kernel for CountingKernel {
     fn block_any(&self, block: &TriangleBlock, ray: &WoopRay, t_min: f32, t_max: f32) -> bool {
         self.blocks.set(self.blocks.get() + 1);
         ScalarKernel.block_any(block, ray, t_min, t_max)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The sorting networks put every arrangement of two to four keys in ascending order, equal
+    /// keys included (every sequence over four values; by the 0-1 principle sequences over two
+    /// would do).
+    #[test]
+    fn sorting_networks_order_every_arrangement() {
+        for n in 2..=4u32 {
+            for code in 0..4usize.pow(n) {
+                let keys: Vec<u64> = (0..n).map(|k| (code / 4usize.pow(k) % 4) as u64).collect();
+                let got = match n {
+                    2 => sort2([keys[0], keys[1]]).to_vec(),
+                    3 => sort3([keys[0], keys[1], keys[2]]).to_vec(),
+                    _ => sort4([keys[0], keys[1], keys[2], keys[3]]).to_vec(),
+                };
+                let mut expect = keys.clone();
+                expect.sort_unstable();
+                assert_eq!(got, expect, "{keys:?}");
+            }
+        }
+    }
+
+    /// Keys compare as (entry distance, child reference) pairs for entries that are not
+    /// negative, and give both back bit for bit.
+    #[test]
+    fn child_keys_order_by_entry_then_reference() {
+        let entries = [
+            0.0,
+            1e-40,
+            1e-30,
+            0.5,
+            1.0,
+            1.0000001,
+            3.0,
+            f32::MAX,
+            f32::INFINITY,
+        ];
+        let children = [0, 5, 0x4000_0000, 0x8000_0001, u32::MAX];
+        let pairs: Vec<(f32, u32)> = entries
+            .iter()
+            .flat_map(|&e| children.iter().map(move |&c| (e, c)))
+            .collect();
+        for &(e, c) in &pairs {
+            let (child, entry) = key_parts(child_key(e, c));
+            assert_eq!((child, entry.to_bits()), (c, e.to_bits()));
+            for &(f, d) in &pairs {
+                let by_pair = e.partial_cmp(&f).unwrap().then(c.cmp(&d));
+                assert_eq!(
+                    child_key(e, c).cmp(&child_key(f, d)),
+                    by_pair,
+                    "({e}, {c}) against ({f}, {d})"
+                );
+            }
+        }
     }
 }
