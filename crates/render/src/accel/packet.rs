@@ -607,7 +607,7 @@ pub(crate) fn intersect<K: PacketKernel, S: PacketStack>(
                 b2: b2.0[l],
             });
         } else if prim[l] != u32::MAX {
-            *out = Some(bvh.finish_with(&rays[l], &p.woop(l), t.0[l], prim[l]));
+            *out = Some(bvh.finish_with(&p.woop(l), t.0[l], prim[l]));
         }
     }
     out
