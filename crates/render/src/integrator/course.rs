@@ -394,7 +394,7 @@ fn shade(
     let Some(hit) = hit else {
         return scene.background_radiance(ray.direction);
     };
-    let si = scene.surface(ray, &hit, SurfaceNeeds::Uv);
+    let si = scene.surface(ray, &hit, SurfaceNeeds::Shading);
     let d = ray.direction.normalized();
     let v = -d;
     // Two-sided shading (FORMAT.md A6): opaque surfaces face the viewer.

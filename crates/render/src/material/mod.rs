@@ -84,9 +84,99 @@ pub const FALLBACK_MATERIAL: Material = Material::Lambertian {
 };
 
 impl Material {
+    /// Whether the course integrator's shading of it reads texture coordinates: one of its
+    /// colours is textured. Emitters count as reading them (an emitter's own surface may be
+    /// textured), so that this answer is never a wrong "no".
+    pub fn reads_uv(&self) -> bool {
+        let textured = |c: &ColorSource| c.texture.is_some();
+        match self {
+            Material::Lambertian { diffuse }
+            | Material::Glaze { diffuse, .. }
+            | Material::CoolToWarm { diffuse }
+            | Material::Diffuse { diffuse } => textured(diffuse),
+            Material::BlinnPhong {
+                diffuse, specular, ..
+            }
+            | Material::Phong {
+                diffuse, specular, ..
+            }
+            | Material::BlinnPhongMirrored {
+                diffuse, specular, ..
+            } => textured(diffuse) || textured(specular),
+            Material::Mirror { .. } | Material::Dielectric { .. } => false,
+            Material::Emissive { .. } => true,
+        }
+    }
+
     /// The material with index `id`, or the fallback for an index out of range.
     #[inline]
     pub fn get(materials: &[Material], id: MaterialId) -> &Material {
         materials.get(id as usize).unwrap_or(&FALLBACK_MATERIAL)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `reads_uv` is true exactly where one of the material's colours is textured, and for
+    /// emitters.
+    #[test]
+    fn reads_uv_where_a_colour_is_textured() {
+        let colour = |textured: bool| ColorSource {
+            color: Color::splat(0.5),
+            texture: textured.then_some(0),
+        };
+        for code in 0..4 {
+            let (d, s) = (colour(code & 1 != 0), colour(code & 2 != 0));
+            let expect = code != 0;
+            let two_colours = [
+                Material::BlinnPhong {
+                    diffuse: d,
+                    specular: s,
+                    phong_exponent: 8.0,
+                    mirror_coef: 0.5,
+                },
+                Material::Phong {
+                    diffuse: d,
+                    specular: s,
+                    phong_exponent: 8.0,
+                },
+                Material::BlinnPhongMirrored {
+                    diffuse: d,
+                    specular: s,
+                    phong_exponent: 8.0,
+                    mirror_coef: 0.5,
+                    roughness: 0.1,
+                },
+            ];
+            for m in two_colours {
+                assert_eq!(m.reads_uv(), expect, "{m:?}");
+            }
+            let one_colour = [
+                Material::Lambertian { diffuse: d },
+                Material::Glaze {
+                    diffuse: d,
+                    mirror_coef: 0.5,
+                },
+                Material::CoolToWarm { diffuse: d },
+                Material::Diffuse { diffuse: d },
+            ];
+            for m in one_colour {
+                assert_eq!(m.reads_uv(), code & 1 != 0, "{m:?}");
+            }
+        }
+        assert!(!Material::Mirror { roughness: 0.2 }.reads_uv());
+        assert!(!Material::Dielectric {
+            refractive_index: 1.5,
+            attenuation: Color::ONE,
+        }
+        .reads_uv());
+        assert!(Material::Emissive {
+            radiance: Color::ONE,
+            surface: None,
+            light: None,
+        }
+        .reads_uv());
     }
 }

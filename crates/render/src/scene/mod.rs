@@ -97,6 +97,11 @@ pub enum SurfaceNeeds {
     Geometry,
     /// Texture coordinates too, completing the barycentrics of a `PreliminaryHit`.
     Uv,
+    /// Texture coordinates where the hit's material reads them (`Material::reads_uv`), else
+    /// (0, 0) as for `Geometry`: what the course integrator's shading needs. A sphere's
+    /// coordinates take an `acos` and an `atan2`, for every hit of an untextured sphere
+    /// before (bench/README, issue 14, twenty-first pass).
+    Shading,
 }
 
 /// A hit from any of the scene's queries: with barycentrics (`Hit`) or without
@@ -264,27 +269,32 @@ impl Scene {
             Some(xf) => xf.point_to_object(point),
             None => point,
         };
-        let uv = match needs {
-            SurfaceNeeds::Geometry => (0.0, 0.0),
-            SurfaceNeeds::Uv => {
-                let (b1, b2) = hit
-                    .barycentrics()
-                    .unwrap_or_else(|| self.accel.barycentrics(ray, &prelim));
-                let prim_hit = PrimitiveHit {
-                    t: prelim.t,
-                    b1,
-                    b2,
-                };
-                geom.shape(prelim.primitive).uv(local_point, &prim_hit)
-            }
+        let material = inst
+            .material
+            .unwrap_or(geom.materials.get(prelim.primitive));
+        let reads_uv = match needs {
+            SurfaceNeeds::Geometry => false,
+            SurfaceNeeds::Uv => true,
+            SurfaceNeeds::Shading => Material::get(&self.materials, material).reads_uv(),
+        };
+        let uv = if reads_uv {
+            let (b1, b2) = hit
+                .barycentrics()
+                .unwrap_or_else(|| self.accel.barycentrics(ray, &prelim));
+            let prim_hit = PrimitiveHit {
+                t: prelim.t,
+                b1,
+                b2,
+            };
+            geom.shape(prelim.primitive).uv(local_point, &prim_hit)
+        } else {
+            (0.0, 0.0)
         };
         SurfaceInteraction {
             point,
             normal: normal_at(inst, geom, prelim.primitive, local_point),
             uv,
-            material: inst
-                .material
-                .unwrap_or(geom.materials.get(prelim.primitive)),
+            material,
         }
     }
 

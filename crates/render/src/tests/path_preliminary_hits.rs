@@ -101,6 +101,52 @@ fn preliminary_hits_complete_to_the_hits_of_intersect() {
     }
 }
 
+/// `SurfaceNeeds::Shading`, the course integrator's: the surface `Uv` gives where the hit's
+/// material reads texture coordinates, and without them (as `Geometry`) where it does not; on
+/// triangles, spheres and boxes, placed once and three times.
+#[test]
+fn shading_surfaces_have_uv_where_the_material_reads_it() {
+    let textured = ColorSource {
+        color: Color::ONE,
+        texture: Some(0),
+    };
+    let plain = ColorSource::constant(Color::splat(0.5));
+    for instances in [1, 3] {
+        let mut scene = scene(instances, AccelKind::Wide);
+        // Shapes take materials 0, 1, 2 in turn (the sphere 0, the box 1).
+        scene.materials = vec![
+            Material::Lambertian { diffuse: textured },
+            Material::Mirror { roughness: 0.0 },
+            Material::Phong {
+                diffuse: plain,
+                specular: textured,
+                phong_exponent: 8.0,
+            },
+        ];
+        let mut r = rng(9);
+        let (mut with, mut without) = (0, 0);
+        for ray in random_rays(&mut r, scene.bounds(), 4000) {
+            let Some(hit) = scene.intersect(&ray) else {
+                continue;
+            };
+            let full = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
+            let mut expect = full;
+            if full.material == 1 {
+                expect.uv = (0.0, 0.0);
+                without += 1;
+            } else {
+                with += 1;
+            }
+            assert_eq!(
+                scene.surface(&ray, &hit, SurfaceNeeds::Shading),
+                expect,
+                "{ray:?}"
+            );
+        }
+        assert!(with > 300 && without > 150, "{with} {without}");
+    }
+}
+
 /// A square facing the camera, lit by a point light, with material `material` of `materials`.
 fn textured_scene(materials: Vec<Material>, textures: Vec<Image>, material: u32) -> Scene {
     let (a, b, c, d) = (
