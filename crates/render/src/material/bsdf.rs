@@ -170,32 +170,15 @@ impl Bsdf {
     /// Whether `from_material(materials, _, id, uv)` depends on `uv`: whether a texture enters
     /// it. Where none does, one BSDF serves every hit on the material.
     pub fn depends_on_uv(materials: &[Material], id: MaterialId) -> bool {
-        let textured = |source: &ColorSource| source.texture.is_some();
-        let plain = |material: &Material| match material {
-            Material::Lambertian { diffuse }
-            | Material::Diffuse { diffuse }
-            | Material::CoolToWarm { diffuse }
-            | Material::Glaze { diffuse, .. } => textured(diffuse),
-            Material::BlinnPhong {
-                diffuse, specular, ..
-            }
-            | Material::Phong {
-                diffuse, specular, ..
-            }
-            | Material::BlinnPhongMirrored {
-                diffuse, specular, ..
-            } => textured(diffuse) || textured(specular),
-            Material::Mirror { .. } | Material::Dielectric { .. } | Material::Emissive { .. } => {
-                false
-            }
-        };
         match materials.get(id as usize) {
-            None => plain(&Material::fallback()),
+            None => Material::fallback().reads_uv(),
             Some(Material::Emissive {
                 surface: Some(surface),
                 ..
-            }) => materials.get(*surface as usize).is_some_and(plain),
-            Some(other) => plain(other),
+            }) => materials
+                .get(*surface as usize)
+                .is_some_and(Material::reads_uv),
+            Some(other) => other.reads_uv(),
         }
     }
 

@@ -84,9 +84,10 @@ pub const FALLBACK_MATERIAL: Material = Material::Lambertian {
 };
 
 impl Material {
-    /// Whether the course integrator's shading of it reads texture coordinates: one of its
-    /// colours is textured. Emitters count as reading them (an emitter's own surface may be
-    /// textured), so that this answer is never a wrong "no".
+    /// Whether its own colours read texture coordinates: one of them is textured. An
+    /// emitter's radiance never is (the surface it names is a material of its own, which
+    /// `Bsdf::depends_on_uv` looks at); the course integrator's shading of an emitter reads
+    /// none.
     pub fn reads_uv(&self) -> bool {
         let textured = |c: &ColorSource| c.texture.is_some();
         match self {
@@ -103,8 +104,9 @@ impl Material {
             | Material::BlinnPhongMirrored {
                 diffuse, specular, ..
             } => textured(diffuse) || textured(specular),
-            Material::Mirror { .. } | Material::Dielectric { .. } => false,
-            Material::Emissive { .. } => true,
+            Material::Mirror { .. } | Material::Dielectric { .. } | Material::Emissive { .. } => {
+                false
+            }
         }
     }
 
@@ -119,8 +121,7 @@ impl Material {
 mod tests {
     use super::*;
 
-    /// `reads_uv` is true exactly where one of the material's colours is textured, and for
-    /// emitters.
+    /// `reads_uv` is true exactly where one of the material's colours is textured.
     #[test]
     fn reads_uv_where_a_colour_is_textured() {
         let colour = |textured: bool| ColorSource {
@@ -172,9 +173,9 @@ mod tests {
             attenuation: Color::ONE,
         }
         .reads_uv());
-        assert!(Material::Emissive {
+        assert!(!Material::Emissive {
             radiance: Color::ONE,
-            surface: None,
+            surface: Some(0),
             light: None,
         }
         .reads_uv());
