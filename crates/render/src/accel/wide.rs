@@ -652,7 +652,7 @@ fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
             *current = ChildRef(key_parts(a).0);
             continue;
         }
-        // Five or more (rare: the bunny's visits entering four or more were 2-3 % of all,
+        // Five or more (rare: the bunny's visits entering four or more were 1-3 % of all,
         // bench/README, issue 14, seventh pass): onto the stack sorted by entry distance,
         // nearest on top (among equals the later slot), then the top taken.
         let base = *sp;
