@@ -2,9 +2,9 @@
 //! the CPU renderer's private structures: it is built from the public `SceneParts` alone, so
 //! the GPU back end has its own BVHs (binary, binned SAH: one per geometry in its object space,
 //! one over the instances, as glint-render's two-level structure) and its
-//! own copy of the light sampler's tables (selection by power, triangle areas, the cube map's
-//! luminance distribution), computed by the same formulas as `glint-render`'s
-//! `light::sampler`.
+//! own copy of the light sampler's tables (selection by power, triangle areas), computed by the
+//! same formulas as `glint-render`'s `light::sampler`; the cube map's luminance distribution
+//! is glint-render's own (`CubeDistribution`, public for this), uploaded as it is.
 //!
 //! Every buffer is an array of `vec4<f32>` (or of `f32` for `tables`); integers travel as the
 //! bits of an f32 (`bits`). The strides and kinds below are repeated, by name, as constants at
@@ -14,8 +14,8 @@ use std::f32::consts::PI;
 
 use bytemuck::{Pod, Zeroable};
 use glint_render::{
-    Background, Camera, Color, ColorSource, Image, Light, Material, Projection, SceneParts, Shape,
-    Transform, Vec3,
+    Background, Camera, Color, ColorSource, CubeDistribution, Image, Light, Material, Projection,
+    SceneParts, Shape, Transform, Vec3,
 };
 
 pub const NONE: u32 = u32::MAX;
@@ -286,13 +286,13 @@ impl FlatScene {
         let (row_cdf, column_cdf, column_start, first_row) = match &lights.cube {
             Some(cube) => {
                 let row_cdf = tables.len() as u32;
-                tables.extend_from_slice(&cube.row_cdf);
+                tables.extend_from_slice(cube.row_cdf());
                 let column_cdf = tables.len() as u32;
-                tables.extend_from_slice(&cube.column_cdf);
+                tables.extend_from_slice(cube.column_cdf());
                 let column_start = tables.len() as u32;
-                tables.extend(cube.column_start.iter().map(|&s| bits(s)));
+                tables.extend(cube.column_start().iter().map(|&s| bits(s)));
                 let first_row = tables.len() as u32;
-                tables.extend(cube.first_row.iter().map(|&s| bits(s)));
+                tables.extend(cube.first_row().iter().map(|&s| bits(s)));
                 (row_cdf, column_cdf, column_start, first_row)
             }
             // No distribution: a dummy first_row of zeros keeps every read in bounds.
@@ -543,7 +543,7 @@ struct LightTables {
     environment: Option<u32>,
     triangles_offset: u32,
     selection_cdf: Vec<f32>,
-    cube: Option<CubeTables>,
+    cube: Option<CubeDistribution>,
 }
 
 fn mean(c: Color) -> f32 {
@@ -653,7 +653,7 @@ impl LightTables {
                 let integral = 4.0 * PI * mean(c.max(Color::ZERO));
                 ((integral > 0.0 && c.is_finite()).then_some(integral), None)
             }
-            Background::CubeMap(map) => match CubeTables::new(&map.faces) {
+            Background::CubeMap(map) => match CubeDistribution::new(map) {
                 Some((cube, integral)) => (Some(integral), Some(cube)),
                 None => (None, None),
             },
@@ -700,102 +700,6 @@ impl LightTables {
             selection_cdf,
             cube,
         }
-    }
-}
-
-/// The cube map's importance-sampling distribution (sampler.rs `CubeDistribution`): rows of
-/// all six faces in one row CDF, each row's own column CDF.
-struct CubeTables {
-    row_cdf: Vec<f32>,
-    column_cdf: Vec<f32>,
-    column_start: Vec<u32>,
-    first_row: [u32; 7],
-}
-
-fn cube_solid_angle_per_area(s: f32, t: f32) -> f32 {
-    let a = 2.0 * s - 1.0;
-    let b = 2.0 * t - 1.0;
-    let r2 = 1.0 + a * a + b * b;
-    4.0 / (r2 * r2.sqrt())
-}
-
-impl CubeTables {
-    fn new(faces: &[Image; 6]) -> Option<(CubeTables, f32)> {
-        let mut sizes = [(0u32, 0u32); 6];
-        let mut first_row = [0u32; 7];
-        for (face, image) in faces.iter().enumerate() {
-            let usable = image.width > 0
-                && image.height > 0
-                && image.texels.len() >= (image.width * image.height) as usize;
-            sizes[face] = if usable {
-                (image.width, image.height)
-            } else {
-                (0, 0)
-            };
-            first_row[face + 1] = first_row[face] + sizes[face].1;
-        }
-        let mut row_weight = Vec::new();
-        let mut column_cdf = Vec::new();
-        let mut column_start = Vec::new();
-        let mut integral = 0.0f64;
-        for (face, image) in faces.iter().enumerate() {
-            let (width, height) = sizes[face];
-            for y in 0..height {
-                column_start.push(column_cdf.len() as u32);
-                let start = column_cdf.len();
-                column_cdf.push(0.0f32);
-                let mut running = 0.0f64;
-                for x in 0..width {
-                    let s = (x as f32 + 0.5) / width as f32;
-                    let t = (y as f32 + 0.5) / height as f32;
-                    let texel = image.texels[(y * width + x) as usize];
-                    let luminance = texel.luminance();
-                    let luminance = if luminance.is_finite() {
-                        luminance.max(0.0)
-                    } else {
-                        0.0
-                    };
-                    let solid_angle =
-                        cube_solid_angle_per_area(s, t) as f64 / (width as f64 * height as f64);
-                    running += luminance as f64 * solid_angle;
-                    integral += mean(texel.max(Color::ZERO)) as f64 * solid_angle;
-                    column_cdf.push(running as f32);
-                }
-                let row = &mut column_cdf[start..];
-                if running > 0.0 {
-                    for c in row.iter_mut() {
-                        *c = (*c as f64 / running) as f32;
-                    }
-                    if let Some(last) = row.last_mut() {
-                        *last = 1.0;
-                    }
-                }
-                row_weight.push(running);
-            }
-        }
-        let total: f64 = row_weight.iter().sum();
-        if !(total > 0.0 && total.is_finite()) {
-            return None;
-        }
-        let mut row_cdf = Vec::with_capacity(row_weight.len() + 1);
-        row_cdf.push(0.0f32);
-        let mut running = 0.0f64;
-        for w in &row_weight {
-            running += w;
-            row_cdf.push((running / total) as f32);
-        }
-        if let Some(last) = row_cdf.last_mut() {
-            *last = 1.0;
-        }
-        Some((
-            CubeTables {
-                row_cdf,
-                column_cdf,
-                column_start,
-                first_row,
-            },
-            integral as f32,
-        ))
     }
 }
 

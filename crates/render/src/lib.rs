@@ -88,6 +88,7 @@ mod tests;
 pub use accel::build::SplitMethod;
 pub use camera::{Camera, Projection, ThinLens};
 pub use geometry::{Aabb, Shape};
+pub use light::sampler::CubeDistribution;
 pub use light::Light;
 pub use material::{Material, MaterialId};
 pub use math::{Color, Matrix4, Transform, Vec3};

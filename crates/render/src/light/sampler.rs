@@ -825,10 +825,12 @@ struct EnvironmentDistribution {
     cube: Option<CubeDistribution>,
 }
 
-/// Rows of all six faces stacked (face 0's rows first), each row a piecewise-constant
-/// distribution over its texels.
+/// A cube map's importance-sampling distribution, by luminance times each texel's solid angle:
+/// rows of all six faces stacked (face 0's rows first), each row a piecewise-constant
+/// distribution over its texels. Public so that the GPU back end uploads these tables instead
+/// of computing its own.
 #[derive(Clone, Debug)]
-struct CubeDistribution {
+pub struct CubeDistribution {
     /// Face sizes (width, height); empty faces have no rows.
     sizes: [(u32, u32); 6],
     /// Index of each face's first row; entry 6 is the row count.
@@ -896,7 +898,7 @@ fn sample_cdf(cdf: &[f32], u: f32) -> Option<(usize, f32, f32)> {
 
 impl CubeDistribution {
     /// The distribution and ∫ L dω (channel mean); `None` for a black map.
-    fn new(map: &CubeMap) -> Option<(CubeDistribution, f32)> {
+    pub fn new(map: &CubeMap) -> Option<(CubeDistribution, f32)> {
         let mut sizes = [(0u32, 0u32); 6];
         let mut first_row = [0u32; 7];
         for (face, image) in map.faces.iter().enumerate() {
@@ -1002,6 +1004,26 @@ impl CubeDistribution {
             },
             integral as f32,
         ))
+    }
+
+    /// Cumulative probability of the rows before row r (rows + 1 entries, the last 1).
+    pub fn row_cdf(&self) -> &[f32] {
+        &self.row_cdf
+    }
+
+    /// Every row's width + 1 cumulative probabilities within the row, one row after another.
+    pub fn column_cdf(&self) -> &[f32] {
+        &self.column_cdf
+    }
+
+    /// Where row r's entries start in `column_cdf`.
+    pub fn column_start(&self) -> &[u32] {
+        &self.column_start
+    }
+
+    /// Each face's first row; entry 6 is the row count (faces without texels have no rows).
+    pub fn first_row(&self) -> &[u32; 7] {
+        &self.first_row
     }
 
     fn row_columns(&self, row: usize, width: u32) -> &[f32] {
