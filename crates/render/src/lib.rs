@@ -37,6 +37,10 @@
 //! assert!(stats.rays >= 32 * 24 * 4);
 //! ```
 //!
+//! Besides these, [`CubeDistribution`] gives a cube map's importance-sampling tables to a back
+//! end that samples the environment itself (the GPU's), so that it uploads the CPU's tables
+//! rather than recomputing them.
+//!
 //! Everything else is private to the crate. The `bench` cargo feature exposes the ray engine's
 //! internals (`accel`, `bvh`, `scene` queries, the benchmark workloads and the verification
 //! helpers) to `glint bench` and to the tests in glint-io that need real meshes; they are not
