@@ -74,7 +74,7 @@ impl Film {
         self.pixels[(y * self.width + x) as usize]
     }
 
-    /// 8-bit RGB as the course writes it (FORMAT.md 1.3): clamp to [0,1], then floor(c·255),
+    /// 8-bit RGB as the course writes it (FORMAT.md 1.3): clamp to \[0,1\], then floor(c·255),
     /// no gamma. NaN becomes 0.
     /// In parallel on the current rayon pool, a row at a time: the image write is otherwise
     /// serial.

@@ -12,7 +12,7 @@ pub struct Image {
 }
 
 impl Image {
-    /// Nearest-texel lookup at (u, v) in [0,1]², v = 0 at the bottom of the image. Wraps in u,
+    /// Nearest-texel lookup at (u, v) in \[0,1\]², v = 0 at the bottom of the image. Wraps in u,
     /// clamps in v. The course code samples textures with nearest lookup; so do we.
     #[inline]
     pub fn lookup(&self, u: f32, v: f32) -> Color {
