@@ -16,13 +16,18 @@ scaling T(1) / T(N) of both. The render stage's scaling is what the renderer's p
 achieves; the whole frame's includes the load, build and write.
 
   bench/scaling.py [--glint PATH[,PATH...]] [--shared DIR] [--threads 1,4,8,16] [--rounds 3]
-                   [--size F] [--only NAME] [--ceiling] [--json OUT]
+                   [--size F] [--only NAME[,NAME...]] [--ceiling | --copies] [--json OUT]
 
 --size scales every image's side (0.25: a quarter the width and height), for a quick run.
 Several glints (comma-separated) run side by side, alternating within each round.
 --ceiling measures the machine instead: N copies of the single-thread render at once, for each
 N of --threads; N * T(1 copy) / T(N copies) is what N threads could reach at best on it (shared
 caches, memory bandwidth, and clocks that drop as more cores run).
+--copies measures both in the same rounds: after each N-thread frame of the first glint, N
+single-thread copies of it at once; its column "copies x" is T(1 thread) * sum of the copies'
+speeds (1 / each copy's render time, median over the rounds), the throughput of the machine's N
+cores on N independent frames as a speedup, the figure an N-thread render with work stealing
+could reach; "spread" is the slowest copy's render time over the fastest's.
 Needs only Python 3 and a built glint (default target/release/glint).
 """
 
@@ -156,11 +161,19 @@ def main():
     ap.add_argument("--threads", default="1,4,8,16")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--size", type=float, default=1.0)
-    ap.add_argument("--only", default="")
+    ap.add_argument(
+        "--only", default="", help="workloads whose names contain one of these (commas)"
+    )
     ap.add_argument(
         "--ceiling",
         action="store_true",
         help="instead: N single-thread copies at once for each N of --threads",
+    )
+    ap.add_argument(
+        "--copies",
+        action="store_true",
+        help="also N single-thread copies at once after each N-thread frame (the ceiling, "
+        "measured in the same rounds)",
     )
     ap.add_argument("--json", default="")
     a = ap.parse_args()
@@ -168,7 +181,8 @@ def main():
     if 1 not in counts:
         sys.exit("--threads must include 1 (scaling is against one thread)")
     glints = a.glint.split(",")
-    loads = [w for w in workloads(a.shared, a.size) if a.only in w[0]]
+    only = a.only.split(",")
+    loads = [w for w in workloads(a.shared, a.size) if any(o in w[0] for o in only)]
     cpus = (
         len(os.sched_getaffinity(0))
         if hasattr(os, "sched_getaffinity")
@@ -179,7 +193,11 @@ def main():
         f"size {a.size}",
         flush=True,
     )
+    if a.copies and a.ceiling:
+        sys.exit("--copies and --ceiling exclude each other")
     times = {(g, w[0], n): ([], []) for g in glints for w in loads for n in counts}
+    # Per workload and N: each round's sum of the copies' speeds and slowest / fastest copy.
+    copies = {(w[0], n): ([], []) for w in loads for n in counts}
     with tempfile.TemporaryDirectory(prefix="glint-scaling-") as tmp:
         for r in range(max(1, a.rounds)):
             order = counts if r % 2 == 0 else counts[::-1]
@@ -199,6 +217,16 @@ def main():
                             file=sys.stderr,
                             flush=True,
                         )
+                        if a.copies and n > 1 and g == glints[0]:
+                            renders = run_copies(g, scene, args, n, tmp)
+                            copies[(name, n)][0].append(sum(1 / t for t in renders))
+                            copies[(name, n)][1].append(max(renders) / min(renders))
+                            print(
+                                f"round {r} {g} {name} {n:2d} copies: render "
+                                f"{min(renders):7.3f} .. {max(renders):7.3f} s",
+                                file=sys.stderr,
+                                flush=True,
+                            )
     med = statistics.median
     rows = []
     if a.ceiling:
@@ -211,30 +239,36 @@ def main():
         print('"wall": the whole process; "render": the render stage; x: T(1) / T(N)')
     for g in glints:
         print(g)
+        beside = a.copies and g == glints[0]
         print(
             f"{'workload':30} {'threads':>7} {'wall s':>8} {'render s':>8} {'frame x':>8} "
-            f"{'render x':>8}"
+            f"{'render x':>8}" + (f" {'copies x':>8} {'spread':>6}" if beside else "")
         )
         for name, *_ in loads:
             w1, r1 = med(times[(g, name, 1)][0]), med(times[(g, name, 1)][1])
             for n in counts:
                 w, rt = med(times[(g, name, n)][0]), med(times[(g, name, n)][1])
                 k = n if a.ceiling else 1
-                rows.append(
-                    {
-                        "glint": g,
-                        "workload": name,
-                        "threads": n,
-                        "wall_s": w,
-                        "render_s": rt,
-                        "frame_scaling": k * w1 / w,
-                        "render_scaling": k * r1 / rt,
-                    }
-                )
-                print(
+                row = {
+                    "glint": g,
+                    "workload": name,
+                    "threads": n,
+                    "wall_s": w,
+                    "render_s": rt,
+                    "frame_scaling": k * w1 / w,
+                    "render_scaling": k * r1 / rt,
+                }
+                line = (
                     f"{name:30} {n:7d} {w:8.3f} {rt:8.3f} {k * w1 / w:8.2f} "
                     f"{k * r1 / rt:8.2f}"
                 )
+                speeds, spreads = copies[(name, n)]
+                if beside and speeds:
+                    row["copies_scaling"] = r1 * med(speeds)
+                    row["copies_spread"] = med(spreads)
+                    line += f" {r1 * med(speeds):8.2f} {med(spreads):6.2f}"
+                rows.append(row)
+                print(line)
     if a.json:
         with open(a.json, "w") as f:
             json.dump(
@@ -244,6 +278,7 @@ def main():
                     "rounds": a.rounds,
                     "size": a.size,
                     "ceiling": a.ceiling,
+                    "copies": a.copies,
                     "rows": rows,
                 },
                 f,

@@ -9,7 +9,8 @@
 #
 # Options by environment: EC (embree_compare.sh's, default "--rounds 3 --repeat 2"), SC
 # (scaling.py's, default "--rounds 3"), CE (the ceiling's, default "--size 0.5 --rounds 2"),
-# and EC_S, SC_S, CE_S, their limits in seconds (330, 150, 60).
+# and EC_S, SC_S, CE_S, their limits in seconds (330, 150, 60); EC_GLINTS, the glints
+# embree_compare.sh runs (default all of them, comma-separated paths under target/device/bin).
 set -u
 cd "$(dirname "$0")/../.."
 D=target/device
@@ -32,7 +33,7 @@ FIRST=${GLINTS%%,*}
 export SHARED=$PWD/$D/shared RAYS=/tmp/device-rays EMBREE=$PWD/$D/bin/embree_native
 el setup
 # shellcheck disable=SC2086
-GLINT=$GLINTS timeout "${EC_S:-330}" bash bench/embree_compare.sh ${EC:---rounds 3 --repeat 2} \
+GLINT=${EC_GLINTS:-$GLINTS} timeout "${EC_S:-330}" bash bench/embree_compare.sh ${EC:---rounds 3 --repeat 2} \
   > "$OUT/embree.txt" 2> "$OUT/embree.err"
 echo "embree_compare: rc $?"
 cat "$OUT/embree.txt"
