@@ -581,8 +581,13 @@ fn render_tiles<P: Copy + Default + Send>(
     };
 
     // Each tile renders into its own buffer; no lock and no shared write on the hot path.
+    // Every tile is a task of its own (`with_max_len(1)`): rayon otherwise splits the range
+    // into about twice as many runs as threads and renders each run on one thread unless it
+    // is stolen before it starts, so that the frame waited on the costliest band of tiles
+    // (the course's scenes are far from uniform); a thread still takes its tiles in order.
     let tiles: Vec<(Vec<P>, TileCounters)> = (0..tile_count)
         .into_par_iter()
+        .with_max_len(1)
         .map(|tile| {
             let mut counters = TileCounters::default();
             if cancelled.load(Ordering::Relaxed) {
@@ -741,5 +746,62 @@ mod tests {
         // Mapped fields come out in the same order.
         let xs = pool.install(|| tiles.gather(|&(x, _)| x));
         assert_eq!(xs, expected.iter().map(|&(x, _)| x).collect::<Vec<_>>());
+    }
+
+    /// No tile waits on a slow one: while the first tile of a frame is held (its first run
+    /// waits until every other tile is done, or five seconds), the other thread of a pool of
+    /// two renders all the rest. Rayon's default splitting would have left the first tile's
+    /// thread a run of neighbouring tiles to render after it, one at a time; the frame then
+    /// waited on the slowest such run (what cost a 16-thread frame its last per cent).
+    #[test]
+    fn a_slow_tile_holds_back_no_other_tile() {
+        let bounds = PixelBounds {
+            x0: 0,
+            x1: 8 * TILE_SIZE,
+            y0: 0,
+            y1: 8 * TILE_SIZE,
+        };
+        let tile_pixels = (TILE_SIZE * TILE_SIZE) as usize;
+        let others = (bounds.width() * bounds.height()) as usize - tile_pixels;
+        let rest_done = AtomicUsize::new(0);
+        // How many of the other pixels were done when the wait gave up, if it did.
+        let done_when_given_up = AtomicUsize::new(usize::MAX);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(2)
+            .build()
+            .unwrap();
+        pool.install(|| {
+            render_tiles(
+                bounds,
+                bounds.width(),
+                &|_: &Progress| true,
+                |_: &()| Color::ZERO,
+                |xs, y, _, out| {
+                    let first_tile = xs.start < TILE_SIZE && y < TILE_SIZE;
+                    if first_tile && xs.start == 0 && y == 0 {
+                        let start = std::time::Instant::now();
+                        while rest_done.load(Ordering::SeqCst) < others {
+                            if start.elapsed() > std::time::Duration::from_secs(5) {
+                                let done = rest_done.load(Ordering::SeqCst);
+                                done_when_given_up.store(done, Ordering::SeqCst);
+                                break;
+                            }
+                            std::thread::sleep(std::time::Duration::from_millis(1));
+                        }
+                    }
+                    if !first_tile {
+                        rest_done.fetch_add(xs.len(), Ordering::SeqCst);
+                    }
+                    out.extend(xs.map(|_| ()));
+                },
+            )
+        })
+        .unwrap();
+        let given_up = done_when_given_up.load(Ordering::SeqCst);
+        assert!(
+            given_up == usize::MAX,
+            "only {given_up} of the other {others} pixels were rendered in the five seconds \
+             the first tile was held"
+        );
     }
 }
