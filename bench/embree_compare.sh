@@ -31,7 +31,8 @@
 # GLINT=A,B,... runs several glints side by side: in each round every glint's single rays run
 # (in alternating order from round to round) next to the same Embree run; the main table is A's
 # (with A's packets), and a second table gives every glint's single rays, their ratio to Embree's
-# single rays and to A's.
+# single rays and to A's. A glint given as PATH@WALK runs `bench rays --walk WALK` (auto, avx2
+# or scalar): GLINT=G,G@avx2,G@scalar times one binary's walks side by side.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SHARED=${SHARED:-../shared}
@@ -50,6 +51,7 @@ if [ -z "${GLINT:-}" ]; then
   GLINT=target/release/glint
 fi
 FIRST_GLINT=${GLINT%%,*}
+FIRST_GLINT=${FIRST_GLINT%@*}
 EMBREE=${EMBREE:-target/embree_native}
 if [ ! -x "$EMBREE" ]; then
   if [ ! -f /usr/include/embree3/rtcore.h ] || ! command -v g++ >/dev/null; then
@@ -94,6 +96,11 @@ def run(cmd):
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     return json.loads(out.strip().splitlines()[-1])
 
+def glint_rays(spec):
+    """`bench rays` of a glint given as PATH or PATH@WALK (`--walk WALK`)."""
+    path, _, walk = spec.partition('@')
+    return [path, 'bench', 'rays'] + (['--walk', walk] if walk else [])
+
 rows, builds = [], {}
 for mesh in meshes:
     name = os.path.splitext(os.path.basename(mesh))[0]
@@ -108,7 +115,7 @@ for mesh in meshes:
         each = {g: [] for g in glints}
         for r in range(rounds):
             for g in (glints if r % 2 == 0 else glints[::-1]):
-                j = run([g, 'bench', 'rays'] + common +
+                j = run(glint_rays(g) + common +
                         (['--write-t', tfile] if r == 0 and g == glint else []))
                 each[g].append(j['mrays_per_s'])
                 if g == glint:
@@ -118,8 +125,8 @@ for mesh in meshes:
                           file=sys.stderr)
             f['single'].append(gj['mrays_per_s']); gb.append(gj['build_s'])
             if kind == 'primary':
-                f['pkt42'].append(run([glint, 'bench', 'rays'] + common + ['--packets'])['mrays_per_s'])
-                f['pkt81'].append(run([glint, 'bench', 'rays'] + common + ['--packets', '--consecutive'])['mrays_per_s'])
+                f['pkt42'].append(run(glint_rays(glint) + common + ['--packets'])['mrays_per_s'])
+                f['pkt81'].append(run(glint_rays(glint) + common + ['--packets', '--consecutive'])['mrays_per_s'])
             ej = run([embree, os.path.join(rays, f'{name}.bin'), rayfile, str(repeat)])
             f['e_single'].append(ej['single_mrays']); f['e_stream'].append(ej['stream_mrays'])
             f['e_pkt8'].append(ej['packet8_mrays']); eb.append(ej['build_s'])

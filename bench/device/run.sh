@@ -10,7 +10,8 @@
 # Options by environment: EC (embree_compare.sh's, default "--rounds 3 --repeat 2"), SC
 # (scaling.py's, default "--rounds 3"), CE (the ceiling's, default "--size 0.5 --rounds 2"),
 # and EC_S, SC_S, CE_S, their limits in seconds (330, 150, 60); EC_GLINTS, the glints
-# embree_compare.sh runs (default all of them, comma-separated paths under target/device/bin).
+# embree_compare.sh runs (default all of them, comma-separated paths under target/device/bin,
+# each perhaps with @WALK: `bench rays --walk WALK`).
 set -u
 cd "$(dirname "$0")/../.."
 D=target/device

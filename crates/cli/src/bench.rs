@@ -21,7 +21,7 @@ use clap::{Args, Subcommand, ValueEnum};
 use glint_render::accel::instances::AccelKind;
 use glint_render::accel::wide::WalkCounts;
 use glint_render::accel::workload::{self, Workload};
-use glint_render::accel::PACKET;
+use glint_render::accel::{Isa, PACKET};
 use glint_render::{Aabb, Camera, Light, Ray, Scene, SceneParts, Vec3};
 use rayon::prelude::*;
 
@@ -128,6 +128,44 @@ pub struct RaysArgs {
     /// the packets of `embree_native`'s `rtcIntersect8`).
     #[arg(long, requires = "packets", conflicts_with = "image_width")]
     pub consecutive: bool,
+    /// Which single-ray walk the wide bottom levels run: the best this CPU has (`auto`: the
+    /// AVX2 walks compiled with AVX-512 where the CPU has AVX-512F and VL, `evex` in the
+    /// output), the plain AVX2 walks (`avx2`), or the scalar ones (`scalar`: the browser's and
+    /// other targets'), to time them side by side on one tree. `--packets` runs the AVX2
+    /// packet walk for `auto` and `avx2` (it has no AVX-512 copy), the scalar one for
+    /// `scalar`. The JSON line's `walk` says which ran (`binary` for `--accel binary`).
+    #[arg(long, value_enum, default_value_t = WalkArg::Auto)]
+    pub walk: WalkArg,
+}
+
+/// `bench rays --walk`.
+#[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WalkArg {
+    Auto,
+    Avx2,
+    Scalar,
+}
+
+/// The kernel `--walk` names on this CPU; an error where it lacks the instructions.
+fn walk_isa(walk: WalkArg) -> Result<Isa, String> {
+    match walk {
+        WalkArg::Auto => Ok(Isa::detect()),
+        WalkArg::Scalar => Ok(Isa::Scalar),
+        WalkArg::Avx2 => match Isa::detect() {
+            Isa::Avx2(avx2) => Ok(Isa::Avx2(avx2.without_evex())),
+            Isa::Scalar => Err("--walk avx2: this CPU has no AVX2 and FMA".to_string()),
+        },
+    }
+}
+
+/// The name of a walk in `bench rays`' output.
+fn walk_name(isa: Option<Isa>) -> &'static str {
+    match isa {
+        None => "binary",
+        Some(Isa::Scalar) => "scalar",
+        Some(Isa::Avx2(avx2)) if avx2.evex() => "evex",
+        Some(Isa::Avx2(_)) => "avx2",
+    }
 }
 
 #[derive(Args, Debug)]
@@ -425,7 +463,9 @@ fn rays(args: &RaysArgs) -> Result<(), String> {
     let triangles = parts.geometries[0].shapes.len();
     let rays = glint_io::read_rays(&args.rays).map_err(|e| e.to_string())?;
     let threads = args.threads.max(1);
-    let (scene, build_s) = build(&parts, args.accel.into(), threads)?;
+    let (mut scene, build_s) = build(&parts, args.accel.into(), threads)?;
+    scene.instances_mut().set_isa(walk_isa(args.walk)?);
+    let walk = walk_name(scene.instances().isa());
     let packets = args.packets.then(|| {
         let width = if args.consecutive {
             None
@@ -470,13 +510,15 @@ fn rays(args: &RaysArgs) -> Result<(), String> {
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     println!(
-        "{{\"engine\": \"glint\", \"accel\": \"{}\", \"traversal\": \"{}\", \"mesh\": \"{}\", \
-         \"triangles\": {}, \"rays\": {}, \"threads\": {}, \"query\": \"{}\", \"build_s\": {:.4}, \
-         \"best_s\": {:.4}, \"median_s\": {:.4}, \"mrays_per_s\": {:.3}, \"hits\": {}{}}}",
+        "{{\"engine\": \"glint\", \"accel\": \"{}\", \"walk\": \"{}\", \"traversal\": \"{}\", \
+         \"mesh\": \"{}\", \"triangles\": {}, \"rays\": {}, \"threads\": {}, \"query\": \"{}\", \
+         \"build_s\": {:.4}, \"best_s\": {:.4}, \"median_s\": {:.4}, \"mrays_per_s\": {:.3}, \
+         \"hits\": {}{}}}",
         match args.accel {
             AccelArg::Wide => "wide",
             AccelArg::Binary => "binary",
         },
+        walk,
         match (args.packets, args.consecutive) {
             (false, _) => "single",
             (true, false) => "packets",

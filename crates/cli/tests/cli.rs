@@ -740,3 +740,110 @@ fn interrupt_cancels_without_writing() {
         .collect();
     assert_eq!(left.len(), 2, "only the scenes may be left: {left:?}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// `glint bench rays --walk`
+
+/// Each walk `bench rays --walk` names runs (its JSON line says which, read back from the
+/// tree, not from the flag) and finds the same hit distance for every ray: a bumpy 8x8 grid
+/// of 128 triangles and 2000 rays from above, some of them missing it.
+#[test]
+fn bench_rays_walks_report_which_ran_and_agree() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut obj = String::new();
+    for j in 0..9 {
+        for i in 0..9 {
+            let height = ((i * 7 + j * 3) % 5) as f32 * 0.1;
+            obj.push_str(&format!("v {i} {height} {j}\n"));
+        }
+    }
+    for j in 0..8 {
+        for i in 0..8 {
+            let v = 1 + i + 9 * j;
+            obj.push_str(&format!(
+                "f {v} {} {}\nf {} {} {}\n",
+                v + 1,
+                v + 10,
+                v,
+                v + 10,
+                v + 9
+            ));
+        }
+    }
+    std::fs::write(dir.path().join("grid.obj"), obj).unwrap();
+    let mut state = 0x2545_f491u32;
+    let mut next = || {
+        state ^= state << 13;
+        state ^= state >> 17;
+        state ^= state << 5;
+        state as f32 / u32::MAX as f32
+    };
+    let mut rays = Vec::new();
+    for _ in 0..2000 {
+        let origin = [next() * 10.0 - 1.0, 2.0 + next(), next() * 10.0 - 1.0];
+        let direction = [next() - 0.5, -1.0, next() - 0.5];
+        for value in origin.iter().chain(&direction) {
+            rays.extend_from_slice(&value.to_le_bytes());
+        }
+    }
+    std::fs::write(dir.path().join("grid.rays"), rays).unwrap();
+    #[cfg(target_arch = "x86_64")]
+    let (avx2, evex) = (
+        std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma"),
+        std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("avx512vl"),
+    );
+    #[cfg(not(target_arch = "x86_64"))]
+    let (avx2, evex) = (false, false);
+    let auto = match (avx2, evex) {
+        (true, true) => "evex",
+        (true, false) => "avx2",
+        _ => "scalar",
+    };
+    let mut distances = Vec::new();
+    for (walk, expected) in [("auto", auto), ("avx2", "avx2"), ("scalar", "scalar")] {
+        let t = format!("{walk}.t");
+        let args = [
+            "bench",
+            "rays",
+            "--mesh",
+            "grid.obj",
+            "--rays",
+            "grid.rays",
+            "--repeat",
+            "1",
+            "--walk",
+            walk,
+            "--write-t",
+            &t,
+        ];
+        let output = glint_in(dir.path(), &args);
+        if walk == "avx2" && !avx2 {
+            assert_exit(&output, 1);
+            assert!(stderr(&output).contains("no AVX2"), "{}", stderr(&output));
+            continue;
+        }
+        assert_exit(&output, 0);
+        let line = stdout(&output);
+        assert!(
+            line.contains(&format!("\"walk\": \"{expected}\"")),
+            "--walk {walk}: {line}"
+        );
+        distances.push(std::fs::read(dir.path().join(&t)).unwrap());
+    }
+    let t: Vec<f32> = distances[0]
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect();
+    let hits = t.iter().filter(|t| t.is_finite()).count();
+    assert!(
+        hits > 500 && hits < 2000,
+        "{hits} of 2000 rays hit the grid"
+    );
+    for other in &distances[1..] {
+        assert!(
+            other == &distances[0],
+            "the walks found different distances"
+        );
+    }
+}

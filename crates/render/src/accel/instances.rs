@@ -400,6 +400,28 @@ impl Instances {
         self.bounds
     }
 
+    /// Chooses the kernel of every wide bottom level (benchmarks time the walks on one tree;
+    /// the binary bottom levels and the top level have one walk each).
+    #[cfg(feature = "bench")]
+    pub fn set_isa(&mut self, isa: crate::accel::Isa) {
+        for geometry in &mut self.geometries {
+            if let Blas::Wide(bvh) = &mut geometry.blas {
+                bvh.set_isa(isa);
+            }
+        }
+    }
+
+    /// The kernel of the first wide bottom level, if there is one.
+    #[cfg(feature = "bench")]
+    pub fn isa(&self) -> Option<crate::accel::Isa> {
+        self.geometries
+            .iter()
+            .find_map(|geometry| match &geometry.blas {
+                Blas::Wide(bvh) => Some(bvh.isa()),
+                Blas::Binary { .. } => None,
+            })
+    }
+
     /// Number of primitives over all geometries (not multiplied by instancing).
     pub fn unique_primitive_count(&self) -> usize {
         self.geometries.iter().map(Geometry::primitive_count).sum()

@@ -204,6 +204,12 @@ impl Scene {
         &self.accel
     }
 
+    /// `instances` to change (benchmarks choose the walk with `Instances::set_isa`).
+    #[cfg(feature = "bench")]
+    pub fn instances_mut(&mut self) -> &mut Instances {
+        &mut self.accel
+    }
+
     /// The world-space bounds of everything in the scene.
     pub fn bounds(&self) -> Aabb {
         self.accel.bounds()
