@@ -778,15 +778,15 @@ fn bench_rays_walks_report_which_ran_and_agree() {
         state ^= state << 5;
         state as f32 / u32::MAX as f32
     };
-    let mut rays = Vec::new();
-    for _ in 0..2000 {
-        let origin = [next() * 10.0 - 1.0, 2.0 + next(), next() * 10.0 - 1.0];
-        let direction = [next() - 0.5, -1.0, next() - 0.5];
-        for value in origin.iter().chain(&direction) {
-            rays.extend_from_slice(&value.to_le_bytes());
-        }
-    }
-    std::fs::write(dir.path().join("grid.rays"), rays).unwrap();
+    let rays: Vec<glint_render::Ray> = (0..2000)
+        .map(|_| {
+            let origin =
+                glint_render::Vec3::new(next() * 10.0 - 1.0, 2.0 + next(), next() * 10.0 - 1.0);
+            let direction = glint_render::Vec3::new(next() - 0.5, -1.0, next() - 0.5);
+            glint_render::Ray::new(origin, direction)
+        })
+        .collect();
+    glint_io::write_rays(&dir.path().join("grid.rays"), &rays).unwrap();
     #[cfg(target_arch = "x86_64")]
     let (avx2, evex) = (
         std::arch::is_x86_feature_detected!("avx2") && std::arch::is_x86_feature_detected!("fma"),
