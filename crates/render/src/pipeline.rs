@@ -460,6 +460,49 @@ fn render_with<I: Integrator>(
     integrator: &I,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
 ) -> Result<(Film, RenderStats), RenderError> {
+    let bounds = settings.bounds();
+    let film = |pixels, features, sums| Film {
+        width: bounds.width(),
+        height: bounds.height(),
+        pixels,
+        origin: (bounds.x0, bounds.y0),
+        full_size: (settings.width, settings.height),
+        features,
+        sums,
+    };
+    // The tiles keep what the film takes: the beauty alone (12 bytes a pixel) unless the
+    // features or a sample range's sums are asked for (all of `PixelValue`, 56 bytes): the
+    // tiles of a 1024x1024 frame were 56 MB of fresh pages to fault in and gather from.
+    if !settings.features && settings.sample_range.is_none() {
+        let (values, stats) =
+            render_values(scene, settings, integrator, progress, |v| v.beauty, |c| *c)?;
+        return Ok((film(values.gather(|c| *c), None, None), stats));
+    }
+    let (values, stats) =
+        render_values(scene, settings, integrator, progress, |v| v, |v| v.beauty)?;
+    let features = settings.features.then(|| Features {
+        albedo: values.gather(|v| v.albedo),
+        normal: values.gather(|v| v.normal),
+        depth: values.gather(|v| v.depth),
+    });
+    // Kept only for a sample range, the one case where a farm adds pixels up.
+    let sums = settings.sample_range.is_some().then(|| SampleSums {
+        radiance: values.gather(|v| v.sum),
+        counts: values.gather(|v| v.count),
+    });
+    Ok((film(values.gather(|v| v.beauty), features, sums), stats))
+}
+
+/// The integrator's pixels of `settings.bounds()`, tile by tile, each kept as `keep` makes it
+/// (`beauty` reads its colour for the progress reports).
+fn render_values<I: Integrator, P: Copy + Default + Send>(
+    scene: &Scene,
+    settings: &RenderSettings,
+    integrator: &I,
+    progress: &(dyn Fn(&Progress) -> bool + Sync),
+    keep: impl Fn(PixelValue) -> P + Sync,
+    beauty: impl Fn(&P) -> Color + Sync,
+) -> Result<(TilePixels<P>, RenderStats), RenderError> {
     let (width, height) = (settings.width, settings.height);
     let samples = settings.samples();
     let context = |x: u32, y: u32| PixelContext {
@@ -473,11 +516,11 @@ fn render_with<I: Integrator>(
         max_depth: settings.max_depth(),
         features: settings.features,
     };
-    let (values, stats) = render_tiles(
+    render_tiles(
         settings.bounds(),
         width,
         progress,
-        |value: &PixelValue| value.beauty,
+        beauty,
         |xs, y, counters, out| {
             let mut pixels = [context(xs.start, y); RUN];
             let count = xs.len();
@@ -493,31 +536,14 @@ fn render_with<I: Integrator>(
                 &mut |i, sample| sums[i].add(sample),
             );
             for (pixel, sums) in pixels[..count].iter().zip(sums) {
-                out.push(sums.finish(settings.features, pixel.index(), counters));
+                out.push(keep(sums.finish(
+                    settings.features,
+                    pixel.index(),
+                    counters,
+                )));
             }
         },
-    )?;
-    let bounds = settings.bounds();
-    let features = settings.features.then(|| Features {
-        albedo: values.gather(|v| v.albedo),
-        normal: values.gather(|v| v.normal),
-        depth: values.gather(|v| v.depth),
-    });
-    // Kept only for a sample range, the one case where a farm adds pixels up.
-    let sums = settings.sample_range.is_some().then(|| SampleSums {
-        radiance: values.gather(|v| v.sum),
-        counts: values.gather(|v| v.count),
-    });
-    let film = Film {
-        width: bounds.width(),
-        height: bounds.height(),
-        pixels: values.gather(|v| v.beauty),
-        origin: (bounds.x0, bounds.y0),
-        full_size: (width, height),
-        features,
-        sums,
-    };
-    Ok((film, stats))
+    )
 }
 
 /// The pixels of `bounds` as `render_tiles` computed them: one row-major buffer per tile, the

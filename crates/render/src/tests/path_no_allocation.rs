@@ -1,8 +1,9 @@
 //! The path tracer's per-sample work allocates nothing (ARCHITECTURE.md invariant): every
 //! material (a textured one too), every kind of light and a cube-map environment, traced through
 //! a counting global allocator with the renderer's own Sobol' sampler, with the plain `Rng`, and
-//! through the render loop's call (`pixel_samples`, whose camera rays go in packets).
-//! Alone in its test binary so no other test allocates on the counted thread.
+//! through the render loop's call (`pixel_samples`, whose camera rays go in packets). And a
+//! whole render's working memory: the bytes live at once on its thread, at their peak.
+//! The counts are per thread, so other tests of the binary do not reach them.
 
 // The one unsafe item: a global allocator must implement the unsafe `GlobalAlloc` trait. It
 // forwards to `System` unchanged and only counts.
@@ -16,28 +17,48 @@ use crate::integrator::{FirstHit, Integrator, PixelContext};
 use crate::sampling::sobol::{PathSampler, SobolPixel};
 use crate::sampling::Rng;
 use crate::{
-    Background, Camera, Color, ColorSource, CubeMap, GeometryDesc, Image, Instance, Light,
-    Material, Projection, Scene, SceneParts, Shape, Vec3,
+    render, Background, Camera, Color, ColorSource, CubeMap, GeometryDesc, Image, Instance,
+    IntegratorKind, Light, Material, Projection, RenderSettings, Scene, SceneParts, Shape, Vec3,
 };
 
 struct CountingAllocator;
 
 thread_local! {
     static ALLOCATIONS: Cell<u64> = const { Cell::new(0) };
+    /// Whether this thread's bytes are weighed (`LIVE`, `PEAK`).
+    static WEIGHED: Cell<bool> = const { Cell::new(false) };
+    /// Bytes allocated on this thread while weighed, less those freed on it.
+    static LIVE: Cell<i64> = const { Cell::new(0) };
+    /// The most `LIVE` has been.
+    static PEAK: Cell<i64> = const { Cell::new(0) };
+}
+
+/// Adds `bytes` (negative: freed) to this thread's live bytes if it is weighed.
+fn weigh(bytes: i64) {
+    if WEIGHED.with(Cell::get) {
+        let live = LIVE.with(|live| {
+            live.set(live.get() + bytes);
+            live.get()
+        });
+        PEAK.with(|peak| peak.set(peak.get().max(live)));
+    }
 }
 
 unsafe impl GlobalAlloc for CountingAllocator {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
         ALLOCATIONS.with(|count| count.set(count.get() + 1));
+        weigh(layout.size() as i64);
         // SAFETY: forwarded unchanged to the system allocator.
         unsafe { System.alloc(layout) }
     }
     unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        weigh(-(layout.size() as i64));
         // SAFETY: `ptr` came from `System.alloc` with this layout.
         unsafe { System.dealloc(ptr, layout) }
     }
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
         ALLOCATIONS.with(|count| count.set(count.get() + 1));
+        weigh(new_size as i64 - layout.size() as i64);
         // SAFETY: as for `dealloc`; `new_size` is passed through.
         unsafe { System.realloc(ptr, layout, new_size) }
     }
@@ -255,4 +276,54 @@ fn tracing_paths_does_not_allocate() {
     let probe = ALLOCATIONS.with(Cell::get);
     drop(std::hint::black_box(Box::new(7u64)));
     assert_eq!(ALLOCATIONS.with(Cell::get), probe + 1);
+}
+
+/// The most bytes live at once on the one thread of a pool that renders `settings`.
+fn render_peak(scene: &Scene, settings: &RenderSettings) -> (i64, crate::Film) {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    pool.install(|| {
+        LIVE.with(|live| live.set(0));
+        PEAK.with(|peak| peak.set(0));
+        WEIGHED.with(|weighed| weighed.set(true));
+        let (film, _) = render(scene, settings, &|_| true).unwrap();
+        WEIGHED.with(|weighed| weighed.set(false));
+        (PEAK.with(Cell::get), film)
+    })
+}
+
+/// A frame's pixels are held twice at most while it renders (the tiles' and the film's): a
+/// beauty-only frame took 68 bytes a pixel when every tile kept the features and sums of
+/// each pixel too, whether asked for or not.
+#[test]
+fn a_render_holds_its_pixels_twice_at_most() {
+    let scene = every_feature_scene();
+    for integrator in [IntegratorKind::Course, IntegratorKind::Path] {
+        let settings = RenderSettings {
+            width: 256,
+            height: 192,
+            samples_per_pixel: 1,
+            integrator,
+            ..RenderSettings::default()
+        };
+        let (peak, film) = render_peak(&scene, &settings);
+        let pixels = (settings.width * settings.height) as i64;
+        let image = pixels * std::mem::size_of::<Color>() as i64;
+        assert!(film.pixels.iter().any(|c| c.max_component() > 0.0));
+        assert!(peak >= image, "{integrator:?}: peak {peak} bytes");
+        assert!(
+            peak <= 2 * image + (256 << 10),
+            "{integrator:?}: peak {peak} bytes, {} a pixel",
+            peak / pixels
+        );
+        // With the feature layers, more is kept, and weighed.
+        let features = RenderSettings {
+            features: true,
+            ..settings
+        };
+        let (with_features, _) = render_peak(&scene, &features);
+        assert!(with_features > peak + 2 * image, "{integrator:?}");
+    }
 }

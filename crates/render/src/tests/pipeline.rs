@@ -1,6 +1,7 @@
 //! The one pipeline: a crop window renders exactly the whole render's pixels, a sample range
-//! that covers every sample is the whole render, `-k` reaches the path tracer, every
-//! integrator makes feature layers, and non-finite samples never reach a pixel.
+//! that covers every sample is the whole render, a frame of the beauty alone is a full
+//! frame's, `-k` reaches the path tracer, every integrator makes feature layers, and
+//! non-finite samples never reach a pixel.
 
 use crate::{
     render, Background, Camera, Color, GeometryDesc, Instance, IntegratorKind, Light, Material,
@@ -197,6 +198,35 @@ fn every_integrator_makes_feature_layers() {
                 < 1e-6
         );
         assert_eq!(features.depth[3], 0.0);
+    }
+}
+
+/// A frame without feature layers or sample sums keeps only its beauty while it renders: the
+/// same pixels, bit for bit, as the frame with everything.
+#[test]
+fn a_beauty_only_frame_is_the_beauty_of_a_full_one() {
+    let scene = scene(red());
+    for integrator in IntegratorKind::ALL {
+        let full = settings(integrator);
+        let (everything, _) = render(&scene, &full, &|_| true).unwrap();
+        let beauty = RenderSettings {
+            features: false,
+            ..full.clone()
+        };
+        let (alone, _) = render(&scene, &beauty, &|_| true).unwrap();
+        assert!(alone.features.is_none() && alone.sums.is_none());
+        assert_eq!(
+            (alone.width, alone.height, alone.origin, alone.full_size),
+            (
+                everything.width,
+                everything.height,
+                everything.origin,
+                everything.full_size
+            )
+        );
+        let bits_of = |film: &crate::Film| film.pixels.iter().map(|&c| bits(c)).collect::<Vec<_>>();
+        assert_eq!(bits_of(&alone), bits_of(&everything), "{integrator:?}");
+        assert!(alone.pixels.iter().any(|c| c.max_component() > 0.0));
     }
 }
 
