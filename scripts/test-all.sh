@@ -5,7 +5,8 @@
 #   scripts/test-all.sh --no-install test with what is installed (a suite missing something fails
 #                                    under CI=1 and says SKIPPED otherwise)
 # Suites: the Rust workspace (`cargo test --workspace`: unit, reference-image, corpus, Mitsuba,
-# software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh), every
+# software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh), the
+# release binary's SIMD intrinsics inlined (scripts/inlined-intrinsics.sh), every
 # README command in a fresh clone (scripts/readme-examples.sh), and each
 # front end's own script (`ci.sh install|test`, listed in SUITES below).
 set -euo pipefail
@@ -72,6 +73,12 @@ scripts/same-images.sh 2>&1 | tee "$logs/same-images.log" || status=$?
 result[same-images]=$(tail -n 1 "$logs/same-images.log")
 [ "$status" = 0 ] || failed=1
 
+echo "== SIMD intrinsics inlined in the release glint (scripts/inlined-intrinsics.sh)"
+status=0
+scripts/inlined-intrinsics.sh 2>&1 | tee "$logs/intrinsics.log" || status=$?
+result[intrinsics]=$(tail -n 1 "$logs/intrinsics.log")
+[ "$status" = 0 ] || failed=1
+
 echo "== README examples in a fresh clone (scripts/readme-examples.sh)"
 status=0
 CARGO_TARGET_DIR="$root/target" scripts/readme-examples.sh 2>&1 | tee "$logs/readme.log" || status=$?
@@ -88,7 +95,7 @@ done
 
 echo
 echo "== summary"
-for name in cargo same-images readme "${SUITES[@]}"; do
+for name in cargo same-images intrinsics readme "${SUITES[@]}"; do
   printf '%-26s %s\n' "$name" "${result[$name]}"
 done
 if [ "$failed" != 0 ]; then
