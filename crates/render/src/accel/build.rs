@@ -874,22 +874,33 @@ impl Builder {
                     Subtree { nodes: sub, root }
                 })
                 .collect();
-            for (slot, (sub, c)) in subtrees.into_iter().zip(children.iter()).enumerate() {
-                let offset = nodes.len() as u32;
-                let relocate = |r: ChildRef| {
-                    if r.is_leaf() {
-                        r
-                    } else {
-                        ChildRef::node(r.index() as u32 + offset)
-                    }
-                };
-                for mut node in sub.nodes {
-                    for child in node.children.iter_mut() {
-                        *child = relocate(ChildRef(*child)).0;
-                    }
-                    nodes.push(node);
+            // The subtrees' nodes appended in order, each moved by where its subtree starts:
+            // in parallel, straight into `nodes` (serial, this copy was 1.2 ms of the
+            // instanced dragon's build on two threads).
+            let mut starts = Vec::with_capacity(subtrees.len());
+            let mut total = 0;
+            for sub in &subtrees {
+                starts.push(total);
+                total += sub.nodes.len();
+            }
+            let first = nodes.len();
+            let relocate = |r: ChildRef, k: usize| {
+                if r.is_leaf() {
+                    r
+                } else {
+                    ChildRef::node((r.index() + first + starts[k]) as u32)
                 }
-                let root = relocate(sub.root);
+            };
+            nodes.par_extend((0..total).into_par_iter().with_min_len(256).map(|i| {
+                let k = starts.partition_point(|&s| s <= i) - 1;
+                let mut node = subtrees[k].nodes[i - starts[k]];
+                for child in node.children.iter_mut() {
+                    *child = relocate(ChildRef(*child), k).0;
+                }
+                node
+            }));
+            for (slot, (sub, c)) in subtrees.iter().zip(children.iter()).enumerate() {
+                let root = relocate(sub.root, slot);
                 nodes[node_index].set_child(slot, root, &c.bounds.aabb());
             }
         } else {
