@@ -8,7 +8,7 @@
 # Exits 1 and lists the functions that call `core::core_arch` functions.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --release --quiet -p glint
+cargo build --release --quiet --locked -p glint
 binary=${CARGO_TARGET_DIR:-target}/release/glint
 listing=$(mktemp)
 trap 'rm -f "$listing"' EXIT
