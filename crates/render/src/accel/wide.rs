@@ -219,10 +219,6 @@ impl WideBvh {
     pub fn set_isa(&mut self, isa: Isa) {
         self.isa = isa;
     }
-    /// Number of primitive slots (block lanes, padding included, then shapes).
-    pub fn primitive_slots(&self) -> usize {
-        self.blocks.len() * BLOCK + self.shapes.len()
-    }
     /// The index in the geometry as given of primitive `primitive`.
     #[cfg(any(test, feature = "bench"))]
     pub fn source_index(&self, primitive: u32) -> u32 {
