@@ -3,8 +3,9 @@
 
 use std::ops::{Add, AddAssign, Div, Index, Mul, MulAssign, Neg, Sub, SubAssign};
 
-/// A 3-vector of f32: a point, a direction or a linear RGB colour.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+/// A 3-vector of f32: a point, a direction or a linear RGB colour. Plain data (`Pod`): three
+/// floats in order x, y, z, no padding, any bits.
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
 #[repr(C)]
 pub struct Vec3 {
     pub x: f32,
