@@ -32,28 +32,18 @@ pub(crate) fn load_triangles(
                 }
                 None => AssetError::Failed(error.to_string()),
             })?;
-    let refuse = |triangles: u64| {
-        AssetError::Refused(format!(
+    // Counted first, so that a face of millions of corners is refused before any of it is
+    // parsed (the parser's corner list alone takes up to four times the file's size).
+    let triangles = count_triangles(&bytes);
+    if triangles > limits.max_triangles {
+        return Err(AssetError::Refused(format!(
             "its faces make {triangles} triangles, more than the limit of {} \
              (--max-triangles raises it)",
             limits.max_triangles
-        ))
-    };
-    // The fast path counts the triangles as it parses, before making any (the chunks it
-    // holds until then take a few times the file's size at most); what it declines goes to
-    // tobj, and tobj is given only files whose faces were counted first.
-    if let Some(parsed) = crate::obj_fast::parse(&bytes) {
-        let triangles = parsed.triangle_count();
-        if triangles > limits.max_triangles {
-            return Err(refuse(triangles));
-        }
-        if let Some(triangles) = parsed.triangles() {
-            return Ok(triangles);
-        }
+        )));
     }
-    let triangles = count_triangles(&bytes);
-    if triangles > limits.max_triangles {
-        return Err(refuse(triangles));
+    if let Some(triangles) = crate::obj_fast::parse(&bytes).and_then(|parsed| parsed.triangles()) {
+        return Ok(triangles);
     }
     let mesh = read_with_tobj(&mut &bytes[..]).map_err(AssetError::Failed)?;
     // In parallel like the parse.
