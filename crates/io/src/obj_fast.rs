@@ -126,12 +126,24 @@ impl Parsed {
         let positions = &self.positions;
         let bases: Vec<(&Chunk, usize)> = self.chunks.iter().zip(self.bases).collect();
         stitch(&bases, total, |&(chunk, base), out| {
+            // The chunk's part has as many slots as its faces make triangles (`Chunk::triangles`,
+            // counted with the faces).
             let mut slots = out.iter_mut();
             triangulate(chunk, base, positions, |corners| {
-                if let Some(slot) = slots.next() {
+                let slot = slots.next();
+                debug_assert!(
+                    slot.is_some(),
+                    "a chunk made more triangles than it counted"
+                );
+                if let Some(slot) = slot {
                     *slot = corners.map(|corner| positions[corner as usize]);
                 }
-            })
+            })?;
+            debug_assert!(
+                slots.next().is_none(),
+                "a chunk made fewer triangles than it counted"
+            );
+            Some(())
         })
     }
 }
