@@ -80,10 +80,14 @@ pub(crate) fn parse(bytes: &[u8]) -> Option<Parsed> {
     if total > u32::MAX as usize {
         return None;
     }
-    let positions = stitch(&chunks, total, |chunk, out| {
-        out.copy_from_slice(&chunk.vertices);
-        Some(())
-    })?;
+    let positions = stitch(
+        &chunks,
+        |chunk| chunk.vertices.len(),
+        |chunk, out| {
+            out.copy_from_slice(&chunk.vertices);
+            Some(())
+        },
+    )?;
     Some(Parsed {
         chunks,
         bases,
@@ -93,8 +97,9 @@ pub(crate) fn parse(bytes: &[u8]) -> Option<Parsed> {
 
 impl Parsed {
     /// How many triangles the faces make, fan-triangulated: what `obj::count_triangles`
-    /// counts, known here before any is made.
-    pub(crate) fn triangle_count(&self) -> u64 {
+    /// counts (the tests hold the two together).
+    #[cfg(test)]
+    fn triangle_count(&self) -> u64 {
         self.chunks.iter().map(|chunk| chunk.triangles as u64).sum()
     }
 
@@ -122,68 +127,54 @@ impl Parsed {
     /// mesh's index array (made, then concatenated serially, then read again, that was a
     /// fifth of the instanced dragon's load on 2 threads).
     pub(crate) fn triangles(self) -> Option<Vec<[Vec3; 3]>> {
-        let total = usize::try_from(self.triangle_count()).ok()?;
         let positions = &self.positions;
         let bases: Vec<(&Chunk, usize)> = self.chunks.iter().zip(self.bases).collect();
-        stitch(&bases, total, |&(chunk, base), out| {
-            // The chunk's part has as many slots as its faces make triangles (`Chunk::triangles`,
-            // counted with the faces).
-            let mut slots = out.iter_mut();
-            triangulate(chunk, base, positions, |corners| {
-                let slot = slots.next();
+        stitch(
+            &bases,
+            |(chunk, _)| chunk.triangles,
+            |&(chunk, base), out| {
+                // The chunk's part has as many slots as its faces make triangles (`Chunk::triangles`,
+                // counted with the faces).
+                let mut slots = out.iter_mut();
+                triangulate(chunk, base, positions, |corners| {
+                    let slot = slots.next();
+                    debug_assert!(
+                        slot.is_some(),
+                        "a chunk made more triangles than it counted"
+                    );
+                    if let Some(slot) = slot {
+                        *slot = corners.map(|corner| positions[corner as usize]);
+                    }
+                })?;
                 debug_assert!(
-                    slot.is_some(),
-                    "a chunk made more triangles than it counted"
+                    slots.next().is_none(),
+                    "a chunk made fewer triangles than it counted"
                 );
-                if let Some(slot) = slot {
-                    *slot = corners.map(|corner| positions[corner as usize]);
-                }
-            })?;
-            debug_assert!(
-                slots.next().is_none(),
-                "a chunk made fewer triangles than it counted"
-            );
-            Some(())
-        })
+                Some(())
+            },
+        )
     }
 }
 
-/// One array of the parts' items in order, each part filling its own slice of it (`fill`),
-/// in parallel: the array first made with `T::default()` in parallel (its pages are first
-/// touched, and faulted in, by every thread at once), then filled. `None` when a part's
-/// `fill` is. The parts' lengths are `Stitched::len`, summing to `total`.
-fn stitch<P: Stitched + Sync, T: Copy + Default + Send + Sync>(
+/// One array of the parts' items in order, each part filling its own slice of it, `len(part)`
+/// long (`fill`), in parallel: the array first made with `T::default()` in parallel (its pages
+/// are first touched, and faulted in, by every thread at once), then filled. `None` when a
+/// part's `fill` is.
+fn stitch<P: Sync, T: Copy + Default + Send + Sync>(
     parts: &[P],
-    total: usize,
+    len: impl Fn(&P) -> usize,
     fill: impl Fn(&P, &mut [T]) -> Option<()> + Sync + Send,
 ) -> Option<Vec<T>> {
-    let mut out: Vec<T> = filled(total);
+    let mut out: Vec<T> = filled(parts.iter().map(&len).sum());
     let mut slices = Vec::with_capacity(parts.len());
     let mut rest = out.as_mut_slice();
     for part in parts {
-        let (mine, tail) = std::mem::take(&mut rest).split_at_mut(part.len());
+        let (mine, tail) = std::mem::take(&mut rest).split_at_mut(len(part));
         slices.push((part, mine));
         rest = tail;
     }
     for_each_mut(slices, |(part, slice)| fill(part, slice))?;
     Some(out)
-}
-
-/// What `stitch` needs to know of a part: how many items it makes.
-trait Stitched {
-    fn len(&self) -> usize;
-}
-
-impl Stitched for Chunk {
-    fn len(&self) -> usize {
-        self.vertices.len()
-    }
-}
-
-impl Stitched for (&Chunk, usize) {
-    fn len(&self) -> usize {
-        self.0.triangles
-    }
 }
 
 /// Byte ranges covering `bytes`, each ending after a `\n` but the last, about `CHUNK_BYTES`
