@@ -6,8 +6,13 @@
 # bench/embree_compare.sh and bench/scaling.py, and the helpers they call. About 30 MB, under
 # the 64 MiB a `run` call may carry.
 #
-# usage: bash bench/device/pack.sh [NAME=]GLINT ...   (NAME: the binary's name there, so that
-#        two builds can be compared side by side; default the file's name)
+# With PERF=1, also this machine's `perf` (Debian's linux-perf) and the libraries it links but
+# glibc's own (about 7 MB more, xz-compressed), for run.sh's profiles: the lent machine has
+# no perf of its own. Keep the unstripped glints: `perf report` here reads the samples
+# brought back against them (by build id, `perf buildid-cache -a GLINT`).
+#
+# usage: [PERF=1] bash bench/device/pack.sh [NAME=]GLINT ...   (NAME: the binary's name there,
+#        so that two builds can be compared side by side; default the file's name)
 # then:  run(command="bash bench/device/run.sh", carry=["target/device"], timeout_s=600)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -43,4 +48,14 @@ for f in models/stanford-bunny.obj models/igea-sub4.ply \
   cp "$SHARED/$f" "$D/shared/$f"
 done
 xz -T0 "$D/shared/models/igea-sub4.ply"
+if [ "${PERF:-0}" = 1 ]; then
+  perf=$(command -v perf) || { echo "PERF=1 needs perf (apt-get install linux-perf)" >&2; exit 2; }
+  mkdir -p "$D/perf/lib"
+  cp "$(readlink -f "$perf")" "$D/perf/perf"
+  ldd "$perf" | awk '$3 ~ /^\// { print $3 }' | while read -r lib; do
+    case $(basename "$lib") in libc.so.*|libm.so.*|ld-linux*) continue ;; esac
+    cp -L "$lib" "$D/perf/lib/"
+  done
+  xz -T0 "$D/perf/perf" "$D"/perf/lib/*
+fi
 du -sh "$D"

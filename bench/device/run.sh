@@ -12,6 +12,14 @@
 # and EC_S, SC_S, CE_S, their limits in seconds (330, 150, 60); EC_GLINTS, the glints
 # embree_compare.sh runs (default all of them, comma-separated paths under target/device/bin,
 # each perhaps with @WALK: `bench rays --walk WALK`).
+#
+# Where pack.sh packed perf (PERF=1), a last part (limit PF_S, default 70 s; EC_S then
+# defaults to 260) profiles the first glint and embree_native, one thread, on the rays
+# embree_compare.sh made (PF_SETS, default "dragon.bounce stanford-bunny.primary"): `perf
+# stat` of each process (task-clock, and cycles, instructions, branch and cache misses where
+# the machine's PMU counts them: clock rate and IPC on that core) and `perf record` samples of
+# each (cpu-clock), all in $OUT/prof.tar. Read here: `perf buildid-cache -a GLINT` (the
+# unstripped binary packed), then `perf report -i FILE.data` or `perf annotate -i FILE.data`.
 set -u
 cd "$(dirname "$0")/../.."
 D=target/device
@@ -20,12 +28,18 @@ mkdir -p "$OUT"
 T0=$(date +%s)
 el() { echo "== $1 at $(($(date +%s) - T0)) s"; }
 [ -d "$D/bin" ] || { echo "no $D: run bench/device/pack.sh here first, then carry it" >&2; exit 2; }
-for f in "$D"/bin/*.xz "$D"/lib/*.xz "$D"/shared/models/*.xz; do
+for f in "$D"/bin/*.xz "$D"/lib/*.xz "$D"/shared/models/*.xz "$D"/perf/*.xz "$D"/perf/lib/*.xz; do
   [ -e "$f" ] && xz -d -f -T0 "$f"
 done
 chmod +x "$D"/bin/*
 export LD_LIBRARY_PATH=$PWD/$D/lib
 THREADS=$(nproc)
+PERF_BIN=
+if [ -e "$D/perf/perf" ]; then
+  PERF_BIN=$PWD/$D/perf/perf
+  chmod +x "$PERF_BIN"
+  : "${EC_S:=260}"
+fi
 { lscpu; free -g; } > "$OUT/machine.txt" 2>&1
 grep -E "Model name|^CPU\(s\)|Thread" "$OUT/machine.txt"
 echo "AVX-512: $(grep -o 'avx512[a-z]*' "$OUT/machine.txt" | sort -u | tr '\n' ' ')"
@@ -58,3 +72,31 @@ for s in scenes_A/spheres_1K.xml:9 scenes_B/StanfordDragon_Instanced.json:16; do
     | tr -s ' ' | paste -sd';' -)"
 done | tee "$OUT/stages.txt"
 el stages
+if [ -n "$PERF_BIN" ]; then
+  P=/tmp/device-prof
+  rm -rf "$P"; mkdir -p "$P"
+  perf_run() { LD_LIBRARY_PATH=$PWD/$D/perf/lib:$LD_LIBRARY_PATH timeout 30 "$PERF_BIN" "$@"; }
+  EVENTS=task-clock,cycles,instructions,branches,branch-misses,L1-dcache-load-misses,LLC-load-misses
+  profile() {
+    for set in ${PF_SETS:-dragon.bounce stanford-bunny.primary}; do
+      mesh=$(find "$SHARED/models" "$SHARED/scenes" -name "${set%%.*}.*" \( -name '*.obj' -o -name '*.ply' \) | head -1)
+      rays=$RAYS/$set.rays
+      [ -n "$mesh" ] && [ -f "$rays" ] || { echo "profile: no mesh or rays for $set"; continue; }
+      glint=("$FIRST" bench rays --mesh "$mesh" --rays "$rays" --threads 1 --repeat 5)
+      embree=("$EMBREE" "$RAYS/${set%%.*}.bin" "$rays" 5)
+      perf_run stat -x, -e "$EVENTS" -o "$P/glint-$set.stat" -- "${glint[@]}" > "$P/glint-$set.json"
+      perf_run stat -x, -e "$EVENTS" -o "$P/embree-$set.stat" -- "${embree[@]}" > "$P/embree-$set.json"
+      perf_run record -q -e cpu-clock -F 4000 -o "$P/glint-$set.data" -- "${glint[@]}" > /dev/null
+      perf_run record -q -e cpu-clock -F 4000 -o "$P/embree-$set.data" -- "${embree[@]}" > /dev/null
+      for f in "$P/glint-$set.stat" "$P/embree-$set.stat"; do
+        echo "$(basename "$f"): $(grep -v '^#' "$f" | grep . | awk -F, '{ printf "%s %s; ", $3, $1 }')"
+      done
+    done
+  }
+  export -f perf_run profile
+  export PERF_BIN D P EVENTS FIRST EMBREE RAYS SHARED
+  timeout "${PF_S:-70}" bash -c profile | tee "$OUT/profile.txt"
+  tar cf "$OUT/prof.tar" -C "$P" .
+  el profile
+fi
+
