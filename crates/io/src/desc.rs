@@ -167,6 +167,31 @@ pub enum ShaderKindDesc {
     },
 }
 
+impl ShaderKindDesc {
+    /// The colour parameters: the diffuse colour, then the specular one, where the type has
+    /// them. The scene builder resolves them (and reads their textures) in this order.
+    pub fn colors(&self) -> impl Iterator<Item = &ColorDesc> {
+        use ShaderKindDesc::*;
+        let (first, second) = match self {
+            Lambertian { diffuse }
+            | Glaze { diffuse, .. }
+            | CoolToWarm { diffuse }
+            | Diffuse { diffuse } => (Some(diffuse), None),
+            BlinnPhong {
+                diffuse, specular, ..
+            }
+            | Phong {
+                diffuse, specular, ..
+            }
+            | BlinnPhongMirrored {
+                diffuse, specular, ..
+            } => (Some(diffuse), Some(specular)),
+            Mirror { .. } | Dielectric { .. } | Unknown { .. } => (None, None),
+        };
+        first.into_iter().chain(second)
+    }
+}
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct ShapeDesc {
     pub span: Span,

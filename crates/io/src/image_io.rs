@@ -43,7 +43,7 @@ pub(crate) fn load_image(
 
 /// `load_image`'s first half: the file read, and the dimensions its header declares checked
 /// against the limits and charged to `budget`; `Checked::decode` is the rest.
-fn read_image(
+pub(crate) fn read_image(
     path: &Path,
     assets: &dyn Assets,
     budget: &mut TextureBudget,
@@ -68,7 +68,7 @@ pub(crate) fn decode_image(bytes: &[u8], budget: &mut TextureBudget) -> Result<I
 
 /// An image file whose header passed the limits and whose memory is charged: what is left is
 /// to decode it (which may still fail), on any thread.
-struct Checked {
+pub(crate) struct Checked {
     bytes: Vec<u8>,
     limits: image::Limits,
 }
@@ -109,7 +109,12 @@ fn check_image(bytes: Vec<u8>, budget: &mut TextureBudget) -> Result<Checked, As
 }
 
 impl Checked {
-    fn decode(self) -> Result<Image, AssetError> {
+    /// The file's size.
+    pub(crate) fn file_bytes(&self) -> u64 {
+        self.bytes.len() as u64
+    }
+
+    pub(crate) fn decode(self) -> Result<Image, AssetError> {
         let mut reader = reader(&self.bytes)?;
         reader.limits(self.limits);
         let decoded = reader
@@ -121,29 +126,10 @@ impl Checked {
         ) {
             return float_image(decoded.into_rgb32f()).map_err(AssetError::Failed);
         }
-        // `into_rgb8` takes an 8-bit RGB image as it is (`to_rgb8` copied it); the texels are
-        // made from it in parallel, runs of texels a task, each writing (and faulting in) its own
-        // part of the 12-byte texels: serial, that was as long as decoding the PNG (8 ms for
-        // a 1000 x 1000 texture).
+        // `into_rgb8` takes an 8-bit RGB image as it is (`to_rgb8` copied it).
         let rgb = decoded.into_rgb8();
         let (width, height) = rgb.dimensions();
-        let texels = rgb
-            .as_raw()
-            .par_chunks_exact(3)
-            .with_min_len(1 << 14)
-            .map(|pixel| {
-                Color::new(
-                    f32::from(pixel[0]) / 255.0,
-                    f32::from(pixel[1]) / 255.0,
-                    f32::from(pixel[2]) / 255.0,
-                )
-            })
-            .collect();
-        Ok(Image {
-            width,
-            height,
-            texels,
-        })
+        Ok(Image::from_rgb8(width, height, rgb.as_raw()))
     }
 }
 
@@ -208,32 +194,21 @@ pub(crate) fn cut_vertical_cross(cross: &Image) -> Result<[Image; 6], String> {
             cross.width, cross.height
         ));
     }
-    let region = |column: u32, row: u32, rotated: bool| -> Image {
-        let mut texels = Vec::with_capacity((face_size * face_size) as usize);
-        for y in 0..face_size {
-            for x in 0..face_size {
-                let (source_x, source_y) = if rotated {
-                    (face_size - 1 - x, face_size - 1 - y)
-                } else {
-                    (x, y)
-                };
-                texels.push(cross.texel(column * face_size + source_x, row * face_size + source_y));
-            }
-        }
-        Image {
-            width: face_size,
-            height: face_size,
-            texels,
-        }
-    };
-    Ok([
-        region(2, 1, false), // +X
-        region(0, 1, false), // -X
-        region(1, 0, false), // +Y
-        region(1, 2, false), // -Y
-        region(1, 1, false), // +Z
-        region(1, 3, true),  // -Z
-    ])
+    // The faces in parallel (each a copy of a sixth of the cross).
+    let faces: Vec<Image> = [
+        (2, 1, false), // +X
+        (0, 1, false), // -X
+        (1, 0, false), // +Y
+        (1, 2, false), // -Y
+        (1, 1, false), // +Z
+        (1, 3, true),  // -Z
+    ]
+    .into_par_iter()
+    .map(|(column, row, turned)| {
+        cross.square(column * face_size, row * face_size, face_size, turned)
+    })
+    .collect();
+    Ok(faces.try_into().expect("six faces"))
 }
 
 /// Loads the six faces named by `envMapPrefix`, resolved against `directory` (PNG, or EXR or

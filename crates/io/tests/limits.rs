@@ -3,6 +3,8 @@
 
 use std::path::Path;
 
+use glint_render::Material;
+
 use glint_io::{
     load_scene_limited, load_scene_with_assets_limited, Limits, LoadedScene, MemoryAssets,
     SceneError, TooLarge, BYTES_PER_TEXEL,
@@ -216,4 +218,132 @@ fn warnings_share_the_scene_text() {
     for warning in &loaded.warnings {
         assert!(std::ptr::eq(warning.source_line().unwrap(), first));
     }
+}
+
+/// `png(width, height)` with its image data spoilt after the header: the header (all the
+/// limits look at) reads, the decode fails.
+fn spoilt_png(width: u32, height: u32) -> Vec<u8> {
+    let mut bytes = png(width, height);
+    let idat = bytes.windows(4).position(|w| w == b"IDAT").unwrap();
+    for byte in &mut bytes[idat + 4..idat + 12] {
+        *byte ^= 0x5a;
+    }
+    bytes
+}
+
+/// The texture images are read ahead and decoded in parallel; what the load reports is what
+/// reading and decoding each one when a shader first names it gives: the warnings in that
+/// order (a failed decode's before those of the shaders after it), the images numbered in that
+/// order without the failed ones, each colour with its own texture.
+#[test]
+fn textures_are_reported_and_numbered_in_the_order_shaders_name_them() {
+    let mut assets = MemoryAssets::new();
+    assets.insert("dir/a.png", png(4, 2));
+    assets.insert("dir/b.png", spoilt_png(8, 8));
+    assets.insert("dir/d.png", png(2, 6));
+    let scene = format!(
+        "<scene>\n{CAMERA}\
+         <texture name=\"td\" type=\"image\"><sourcefile>d.png</sourcefile></texture>\n\
+         <texture name=\"tc\" type=\"image\"><sourcefile>c.png</sourcefile></texture>\n\
+         <texture name=\"tb\" type=\"image\"><sourcefile>b.png</sourcefile></texture>\n\
+         <texture name=\"ta\" type=\"image\"><sourcefile>a.png</sourcefile></texture>\n\
+         <shader name=\"s0\" type=\"BlinnPhong\"><diffuse tex=\"ta\">1 1 1</diffuse>\
+         <specular tex=\"tb\">1 1 1</specular></shader>\n\
+         <shader name=\"s1\" type=\"Lambertian\"><diffuse tex=\"tx\">1 1 1</diffuse></shader>\n\
+         <shader name=\"s2\" type=\"Lambertian\"><diffuse tex=\"tc\">1 1 1</diffuse></shader>\n\
+         <shader name=\"s3\" type=\"Phong\"><diffuse>1 1 1</diffuse>\
+         <specular tex=\"td\">1 1 1</specular></shader>\n\
+         <shape type=\"sphere\"><shader ref=\"s0\"/></shape>\n</scene>\n"
+    );
+    let loaded = load(&scene, &assets, &Limits::default()).unwrap();
+    let warnings: Vec<(u32, &str)> = loaded
+        .warnings
+        .iter()
+        .map(|w| (w.line, w.message.as_str()))
+        .collect();
+    assert_eq!(warnings.len(), 3, "{warnings:?}");
+    assert_eq!(warnings[0].0, 5, "{warnings:?}");
+    assert!(warnings[0].1.contains("b.png"), "{warnings:?}");
+    assert!(
+        warnings[1].1.contains("`tx` is not defined"),
+        "{warnings:?}"
+    );
+    assert_eq!(warnings[2].0, 4, "{warnings:?}");
+    assert!(warnings[2].1.contains("c.png"), "{warnings:?}");
+    let sizes: Vec<(u32, u32)> = loaded
+        .parts
+        .textures
+        .iter()
+        .map(|t| (t.width, t.height))
+        .collect();
+    assert_eq!(sizes, [(4, 2), (2, 6)]);
+    let textures: Vec<[Option<u32>; 2]> = loaded
+        .parts
+        .materials
+        .iter()
+        .map(|material| match material {
+            Material::BlinnPhong {
+                diffuse, specular, ..
+            }
+            | Material::Phong {
+                diffuse, specular, ..
+            } => [diffuse.texture, specular.texture],
+            Material::Lambertian { diffuse } => [diffuse.texture, None],
+            other => panic!("{other:?}"),
+        })
+        .collect();
+    assert_eq!(
+        textures,
+        [[Some(0), None], [None, None], [None, None], [None, Some(1)]]
+    );
+}
+
+/// The texture budget is charged in the order the shaders name the images, not the order
+/// they are declared in: the image named last is the one refused, where the first two fit.
+#[test]
+fn the_texture_budget_is_charged_in_the_order_shaders_name_the_images() {
+    let mut assets = MemoryAssets::new();
+    let mut scene = format!("<scene>\n{CAMERA}");
+    for index in 0..3 {
+        assets.insert(format!("dir/t{index}.png"), png(10 + index, 10));
+        scene.push_str(&format!(
+            "<texture name=\"t{index}\" type=\"image\"><sourcefile>t{index}.png</sourcefile></texture>\n"
+        ));
+    }
+    for index in (0..3).rev() {
+        scene.push_str(&format!(
+            "<shader name=\"s{index}\" type=\"Lambertian\"><diffuse tex=\"t{index}\">1 1 1</diffuse></shader>\n"
+        ));
+    }
+    scene.push_str("<shape type=\"sphere\"><shader ref=\"s0\"/></shape>\n</scene>\n");
+    // Room for t2 and t1 (12 x 10 and 11 x 10 texels), not for t0 after them.
+    let limits = Limits {
+        max_texture_bytes: (120 + 110 + 50) * BYTES_PER_TEXEL,
+        ..Limits::default()
+    };
+    let (line, _, message) = error_at(load(&scene, &assets, &limits));
+    assert_eq!(line, 3, "{message}");
+    assert!(message.contains("t0.png"), "{message}");
+    // Files held ahead of their decode are decoded in batches of at most one file's limit:
+    // the same images when every file is its own batch.
+    let one_file = Limits {
+        max_file_bytes: (0..3)
+            .map(|index| assets_size(&assets, &format!("dir/t{index}.png")))
+            .max()
+            .unwrap(),
+        ..Limits::default()
+    };
+    let batched = load(&scene, &assets, &one_file).unwrap();
+    let whole = load(&scene, &assets, &Limits::default()).unwrap();
+    assert_eq!(batched.parts.textures, whole.parts.textures);
+    assert_eq!(whole.parts.textures.len(), 3);
+    assert_eq!(whole.parts.textures[0].width, 12);
+}
+
+fn assets_size(assets: &MemoryAssets, path: &str) -> u64 {
+    use glint_io::Assets;
+    assets
+        .read_at_most(Path::new(path), u64::MAX)
+        .unwrap()
+        .len() as u64
 }

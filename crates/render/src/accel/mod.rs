@@ -16,7 +16,7 @@ mod dispatch;
 pub mod instances;
 pub mod isa;
 pub mod packet;
-mod pages;
+pub(crate) mod pages;
 pub mod simd;
 pub mod triangle;
 pub mod wide;
