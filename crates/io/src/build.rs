@@ -12,7 +12,7 @@
 //!   the file is named again); every OBJ file is read once;
 //! * each visible area light adds a two-triangle emissive rectangle that casts no shadow.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 use std::rc::Rc;
 
@@ -182,6 +182,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
     /// decoded before more are read.
     fn prefetch_textures(&mut self) {
         let mut read: Vec<(PathBuf, Checked)> = Vec::new();
+        let mut seen: HashSet<PathBuf> = HashSet::new();
         let mut held = 0u64;
         let decode =
             |read: &mut Vec<(PathBuf, Checked)>,
@@ -204,7 +205,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 continue;
             };
             let path = self.resolve_path(&declaration.source_file.value);
-            if self.prefetched.contains_key(&path) || read.iter().any(|(p, _)| *p == path) {
+            if !seen.insert(path.clone()) {
                 continue;
             }
             match read_image(&path, self.assets, &mut self.texture_budget) {
