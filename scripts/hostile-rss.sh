@@ -4,6 +4,8 @@
 #   2a. /dev/zero as the scene; 2b. an OBJ mesh that is a link to /dev/zero
 #   3. -w 65535 -h 65535
 #   4. three texture entries naming one 420 KB PNG that declares 12000 x 12000
+#   5. 64 textures on 64 files of 8 MB each, a 1 x 1 PNG padded by an ancillary chunk (the
+#      files waiting for their decode are held to 64 MiB together)
 # Usage: scripts/hostile-rss.sh GLINT [CAP_KB]. Each run is capped at CAP_KB of virtual
 # memory (default 6000000, ~5.7 GiB) and 120 s, so that an old binary cannot take the machine.
 set -eu
@@ -38,6 +40,17 @@ textures = ''.join('<texture name="t%d" type="image"><sourcefile>big.png</source
 spheres = ''.join('<shape type="sphere"><shader ref="s%d"/><center>%d 0 -5</center>'
                   '<radius>0.5</radius></shape>\n' % (i, i - 1) for i in range(3))
 open('tex.xml', 'w').write('<scene>\n' + camera + textures + spheres + '</scene>\n')
+pixel = chunk(b'IDAT', zlib.compress(b'\x00\x80\x80\x80'))
+padding = chunk(b'peGz', b'\x00' * (8 << 20))
+many = ''
+for i in range(64):
+    open('pad%d.png' % i, 'wb').write(b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', 1, 1, 8, 2, 0, 0, 0))
+                                    + padding + pixel + chunk(b'IEND', b''))
+    many += ('<texture name="t%d" type="image"><sourcefile>pad%d.png</sourcefile></texture>'
+             '<shader name="s%d" type="Lambertian"><diffuse tex="t%d">1 1 1</diffuse></shader>\n'
+             % (i, i, i, i))
+open('many.xml', 'w').write('<scene>\n' + camera + many + spheres.replace('s1', 's0').replace('s2', 's0')
+                            + '</scene>\n')
 shader = '<shader name="b" type="Lambertian"><diffuse>1 1 1</diffuse></shader>'
 open('mesh.xml', 'w').write('<scene>\n' + camera + shader + '<shape type="mesh"><file>endless.obj'
                             '</file><shader ref="b"/></shape>\n</scene>\n')
@@ -62,3 +75,4 @@ measure "2a /dev/zero" render /dev/zero
 measure "2b OBJ zero" render mesh.xml -w 8 -h 8
 measure "3 65535^2" render small.xml -w 65535 -h 65535
 measure "4 12000^2 x3" render tex.xml -w 8 -h 8
+measure "5 64 x 8 MB" render many.xml -w 8 -h 8

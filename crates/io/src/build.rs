@@ -58,6 +58,10 @@ pub(crate) fn build(
     Ok(builder.finish(camera, background))
 }
 
+/// Texture files held at once, read and waiting for their decode (`prefetch_textures`): 64 MiB,
+/// some twenty of the course's largest.
+const PREFETCH_BYTES: u64 = 64 << 20;
+
 /// The mesh cache: every OBJ file is read once; `None` records a failure already reported.
 type MeshCache = HashMap<PathBuf, Option<Rc<Vec<[Vec3; 3]>>>>;
 
@@ -178,8 +182,11 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
     /// the decodes were most of a textured scene's load (ten 2048 x 1024 images, 190 ms of
     /// the solar system's 240). What `texture` then reports, and in which order, is what
     /// reading and decoding each image as it was first asked for gave. The files read and not
-    /// yet decoded are held to the limit on one file's size together: past it they are
-    /// decoded before more are read.
+    /// yet decoded are held to `PREFETCH_BYTES` together (or the limit on one file's size,
+    /// when lower): past it they are decoded before more are read, so that a load holds at
+    /// most that much more file data than one file at a time did. (Their decoded images are
+    /// charged to the texture budget before they are decoded, `BYTES_PER_TEXEL` covering
+    /// the decoder's own buffers, so decoding them together takes no more than the budget.)
     fn prefetch_textures(&mut self) {
         let mut read: Vec<(PathBuf, Checked)> = Vec::new();
         let mut seen: HashSet<PathBuf> = HashSet::new();
@@ -212,7 +219,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 Ok(image) => {
                     held += image.file_bytes();
                     read.push((path, image));
-                    if held > self.limits.max_file_bytes {
+                    if held > PREFETCH_BYTES.min(self.limits.max_file_bytes) {
                         decode(&mut read, &mut self.prefetched);
                         held = 0;
                     }
