@@ -29,9 +29,7 @@ use crate::desc::{
     TextureDesc, TransformOperation, TransformStep,
 };
 use crate::diagnostic::{did_you_mean, Diagnostics, SceneError};
-use crate::image_io::{
-    cut_vertical_cross, load_cube_map, load_image, read_image, Checked, TextureBudget,
-};
+use crate::image_io::{load_cube_map, load_image, read_image, Checked, TextureBudget};
 use crate::limits::Limits;
 use crate::obj::load_triangles;
 
@@ -920,7 +918,9 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
         }
         if let Some(cross) = &background.env_map_vertical_cross {
             let path = self.resolve_path(&cross.value);
-            let faces = match load_image(&path, self.assets, &mut self.texture_budget) {
+            let faces = match read_image(&path, self.assets, &mut self.texture_budget)
+                .and_then(Checked::decode_cross)
+            {
                 Err(AssetError::Refused(why)) => {
                     return Err(self.diagnostics.error(
                         cross.span,
@@ -934,7 +934,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 Err(AssetError::Failed(error)) => {
                     Err(format!("cannot read ({}): {error}", path.display()))
                 }
-                Ok(image) => cut_vertical_cross(&image),
+                Ok(faces) => faces,
             };
             match faces {
                 Ok(faces) => return Ok(Background::CubeMap(Box::new(CubeMap { faces }))),

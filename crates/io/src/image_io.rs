@@ -115,6 +115,40 @@ impl Checked {
     }
 
     pub(crate) fn decode(self) -> Result<Image, AssetError> {
+        match self.decode_levels()? {
+            Decoded::Levels(rgb) => {
+                let (width, height) = rgb.dimensions();
+                Ok(Image::from_rgb8(width, height, rgb.as_raw()))
+            }
+            Decoded::Float(image) => Ok(image),
+        }
+    }
+
+    /// A vertical-cross environment map's six faces (`cut_vertical_cross`); an 8-bit cross's
+    /// faces are made straight from its levels, the six cells outside the cross never made
+    /// into texels (half the cross's texels, and as many more copied into the faces). The
+    /// outer error is the decode's, the inner one the cross's shape.
+    pub(crate) fn decode_cross(self) -> Result<Result<[Image; 6], String>, AssetError> {
+        Ok(match self.decode_levels()? {
+            Decoded::Float(image) => cut_vertical_cross(&image),
+            Decoded::Levels(rgb) => {
+                let (width, height) = rgb.dimensions();
+                cross_face_size(width, height).map(|size| {
+                    cross_faces(|column, row, turned| {
+                        Image::square_from_rgb8(
+                            rgb.as_raw(),
+                            width,
+                            (column * size, row * size),
+                            size,
+                            turned,
+                        )
+                    })
+                })
+            }
+        })
+    }
+
+    fn decode_levels(self) -> Result<Decoded, AssetError> {
         let mut reader = reader(&self.bytes)?;
         reader.limits(self.limits);
         let decoded = reader
@@ -124,13 +158,19 @@ impl Checked {
             decoded,
             image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
         ) {
-            return float_image(decoded.into_rgb32f()).map_err(AssetError::Failed);
+            return float_image(decoded.into_rgb32f())
+                .map(Decoded::Float)
+                .map_err(AssetError::Failed);
         }
         // `into_rgb8` takes an 8-bit RGB image as it is (`to_rgb8` copied it).
-        let rgb = decoded.into_rgb8();
-        let (width, height) = rgb.dimensions();
-        Ok(Image::from_rgb8(width, height, rgb.as_raw()))
+        Ok(Decoded::Levels(decoded.into_rgb8()))
     }
+}
+
+/// A decoded image: 8-bit levels, or float texels kept as they are.
+enum Decoded {
+    Levels(image::RgbImage),
+    Float(Image),
 }
 
 /// A floating-point image as it is, refusing non-finite and negative texels.
@@ -187,14 +227,26 @@ fn cube_face_extension(directory: &Path, prefix: &str, assets: &dyn Assets) -> &
 /// OpenGL -Z face has y = +1 at the top and x growing to the left. The region is therefore the
 /// face turned by 180°, and we turn it back.
 pub(crate) fn cut_vertical_cross(cross: &Image) -> Result<[Image; 6], String> {
-    let face_size = cross.width / 3;
-    if face_size == 0 || cross.width != face_size * 3 || cross.height != face_size * 4 {
+    let size = cross_face_size(cross.width, cross.height)?;
+    Ok(cross_faces(|column, row, turned| {
+        cross.square(column * size, row * size, size, turned)
+    }))
+}
+
+/// The side of a vertical cross's square faces: a third of its width, a quarter of its height.
+fn cross_face_size(width: u32, height: u32) -> Result<u32, String> {
+    let size = width / 3;
+    if size == 0 || width != size * 3 || height != size * 4 {
         return Err(format!(
-            "a vertical cross is 3 x 4 square faces, but the image is {} x {} pixels",
-            cross.width, cross.height
+            "a vertical cross is 3 x 4 square faces, but the image is {width} x {height} pixels"
         ));
     }
-    // The faces in parallel (each a copy of a sixth of the cross).
+    Ok(size)
+}
+
+/// The six faces in `CubeMap` order, each `face(column, row, turned)` of its cell in the
+/// cross, made in parallel.
+fn cross_faces(face: impl Fn(u32, u32, bool) -> Image + Sync) -> [Image; 6] {
     let faces: Vec<Image> = [
         (2, 1, false), // +X
         (0, 1, false), // -X
@@ -204,11 +256,9 @@ pub(crate) fn cut_vertical_cross(cross: &Image) -> Result<[Image; 6], String> {
         (1, 3, true),  // -Z
     ]
     .into_par_iter()
-    .map(|(column, row, turned)| {
-        cross.square(column * face_size, row * face_size, face_size, turned)
-    })
+    .map(|(column, row, turned)| face(column, row, turned))
     .collect();
-    Ok(faces.try_into().expect("six faces"))
+    faces.try_into().expect("six faces")
 }
 
 /// Loads the six faces named by `envMapPrefix`, resolved against `directory` (PNG, or EXR or
@@ -856,6 +906,39 @@ mod tests {
         // -Z is turned by 180°: its stored top-left corner ends up bottom-right.
         assert_eq!(faces[5].texel(0, 0).z, 0.0);
         assert_eq!(faces[5].texel(size - 1, size - 1).z, 1.0);
+    }
+
+    /// An 8-bit cross's faces made from its levels are those cut from its texels; a cross of
+    /// the wrong shape gives the same message either way.
+    #[test]
+    fn an_eight_bit_cross_is_cut_from_its_levels_as_from_its_texels() {
+        let encode = |width: u32, height: u32| {
+            let levels: Vec<u8> = (0..3 * width * height)
+                .map(|i| (i * 29 % 251) as u8)
+                .collect();
+            let mut bytes = Vec::new();
+            image::RgbImage::from_raw(width, height, levels)
+                .unwrap()
+                .write_to(
+                    &mut std::io::Cursor::new(&mut bytes),
+                    image::ImageFormat::Png,
+                )
+                .unwrap();
+            bytes
+        };
+        let checked = |bytes: &[u8]| {
+            check_image(bytes.to_vec(), &mut TextureBudget::new(Limits::default())).unwrap()
+        };
+        let cross = encode(9, 12);
+        let from_levels = checked(&cross).decode_cross().unwrap().unwrap();
+        let from_texels = cut_vertical_cross(&checked(&cross).decode().unwrap()).unwrap();
+        assert_eq!(from_levels, from_texels);
+        assert_eq!(from_levels[5].width, 3);
+        let wrong = encode(9, 11);
+        assert_eq!(
+            checked(&wrong).decode_cross().unwrap().unwrap_err(),
+            cut_vertical_cross(&checked(&wrong).decode().unwrap()).unwrap_err()
+        );
     }
 
     #[test]

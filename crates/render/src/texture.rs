@@ -44,6 +44,51 @@ impl Image {
         }
     }
 
+    /// `from_rgb8` of the `size` x `size` square whose top-left corner is at column `x0`, row
+    /// `y0` of the 8-bit RGB image `levels`, `width` texels a row, turned by 180° when
+    /// `turned` (its last texel first): a cube face cut from a cross, where the cells
+    /// outside the cross are never made into texels.
+    ///
+    /// # Panics
+    /// If the square does not lie inside the image.
+    pub fn square_from_rgb8(
+        levels: &[u8],
+        width: u32,
+        (x0, y0): (u32, u32),
+        size: u32,
+        turned: bool,
+    ) -> Image {
+        let (row_levels, side) = (3 * width as usize, size as usize);
+        let height = levels.len() / row_levels.max(1);
+        assert!(
+            x0 as usize + side <= width as usize && y0 as usize + side <= height,
+            "a {size} x {size} square at ({x0}, {y0}) of a {width} x {height} image"
+        );
+        let mut texels = crate::accel::pages::vec_with_capacity(side * side);
+        let texel = |level: &[u8]| {
+            Color::new(
+                f32::from(level[0]) / 255.0,
+                f32::from(level[1]) / 255.0,
+                f32::from(level[2]) / 255.0,
+            )
+        };
+        for y in 0..side {
+            let source = if turned { side - 1 - y } else { y };
+            let start = (y0 as usize + source) * row_levels + 3 * x0 as usize;
+            let row = levels[start..start + 3 * side].chunks_exact(3);
+            if turned {
+                texels.extend(row.rev().map(texel));
+            } else {
+                texels.extend(row.map(texel));
+            }
+        }
+        Image {
+            width: size,
+            height: size,
+            texels,
+        }
+    }
+
     /// The `size` x `size` square of texels whose top-left corner is at column `x0`, row `y0`,
     /// turned by 180° when `turned` (its last texel first). In memory advised for huge pages,
     /// as `from_rgb8`.
@@ -247,6 +292,32 @@ mod tests {
                 assert_eq!(at(&turned, x, y), (4 - x, 3 - y));
             }
         }
+    }
+
+    /// A square cut from 8-bit levels is the same square cut from their texels, upright and
+    /// turned.
+    #[test]
+    fn squares_from_levels_are_squares_of_their_texels() {
+        let (width, height) = (7u32, 5u32);
+        let levels: Vec<u8> = (0..3 * width * height)
+            .map(|i| (i * 37 % 256) as u8)
+            .collect();
+        let image = Image::from_rgb8(width, height, &levels);
+        for turned in [false, true] {
+            for (x0, y0, size) in [(0, 0, 5), (2, 1, 4), (6, 4, 1), (3, 0, 3)] {
+                assert_eq!(
+                    Image::square_from_rgb8(&levels, width, (x0, y0), size, turned),
+                    image.square(x0, y0, size, turned),
+                    "({x0}, {y0}) size {size} turned {turned}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "square")]
+    fn squares_of_levels_must_lie_inside_the_image() {
+        Image::square_from_rgb8(&[0; 3 * 16], 4, (1, 2), 3, false);
     }
 
     #[test]
