@@ -29,13 +29,7 @@ impl Image {
         levels
             .par_chunks_exact(3)
             .with_min_len(1 << 14)
-            .map(|level| {
-                Color::new(
-                    f32::from(level[0]) / 255.0,
-                    f32::from(level[1]) / 255.0,
-                    f32::from(level[2]) / 255.0,
-                )
-            })
+            .map(level_texel)
             .collect_into_vec(&mut texels);
         Image {
             width,
@@ -54,39 +48,11 @@ impl Image {
     pub fn square_from_rgb8(
         levels: &[u8],
         width: u32,
-        (x0, y0): (u32, u32),
+        corner: (u32, u32),
         size: u32,
         turned: bool,
     ) -> Image {
-        let (row_levels, side) = (3 * width as usize, size as usize);
-        let height = levels.len() / row_levels.max(1);
-        assert!(
-            x0 as usize + side <= width as usize && y0 as usize + side <= height,
-            "a {size} x {size} square at ({x0}, {y0}) of a {width} x {height} image"
-        );
-        let mut texels = crate::accel::pages::vec_with_capacity(side * side);
-        let texel = |level: &[u8]| {
-            Color::new(
-                f32::from(level[0]) / 255.0,
-                f32::from(level[1]) / 255.0,
-                f32::from(level[2]) / 255.0,
-            )
-        };
-        for y in 0..side {
-            let source = if turned { side - 1 - y } else { y };
-            let start = (y0 as usize + source) * row_levels + 3 * x0 as usize;
-            let row = levels[start..start + 3 * side].chunks_exact(3);
-            if turned {
-                texels.extend(row.rev().map(texel));
-            } else {
-                texels.extend(row.map(texel));
-            }
-        }
-        Image {
-            width: size,
-            height: size,
-            texels,
-        }
+        cut_square(levels, 3, width, corner, size, turned, level_texel)
     }
 
     /// The `size` x `size` square of texels whose top-left corner is at column `x0`, row `y0`,
@@ -96,31 +62,9 @@ impl Image {
     /// # Panics
     /// If the square does not lie inside the image.
     pub fn square(&self, x0: u32, y0: u32, size: u32, turned: bool) -> Image {
-        assert!(
-            u64::from(x0) + u64::from(size) <= u64::from(self.width)
-                && u64::from(y0) + u64::from(size) <= u64::from(self.height),
-            "a {size} x {size} square at ({x0}, {y0}) of a {} x {} image",
-            self.width,
-            self.height
-        );
-        let side = size as usize;
-        let mut texels = crate::accel::pages::vec_with_capacity(side * side);
-        let row = |y: usize| {
-            let start = (y0 as usize + y) * self.width as usize + x0 as usize;
-            &self.texels[start..start + side]
-        };
-        for y in 0..side {
-            if turned {
-                texels.extend(row(side - 1 - y).iter().rev());
-            } else {
-                texels.extend_from_slice(row(y));
-            }
-        }
-        Image {
-            width: size,
-            height: size,
-            texels,
-        }
+        cut_square(&self.texels, 1, self.width, (x0, y0), size, turned, |t| {
+            t[0]
+        })
     }
 
     /// Nearest-texel lookup at (u, v) in \[0,1\]², v = 0 at the bottom of the image. Wraps in u,
@@ -230,6 +174,54 @@ impl CubeMap {
         let x = (s * img.width as f32) as u32;
         let y = (t * img.height as f32) as u32;
         img.texel(x, y)
+    }
+}
+
+/// The texel of three 8-bit levels: each level `l` the value `l / 255`.
+fn level_texel(levels: &[u8]) -> Color {
+    Color::new(
+        f32::from(levels[0]) / 255.0,
+        f32::from(levels[1]) / 255.0,
+        f32::from(levels[2]) / 255.0,
+    )
+}
+
+/// The `size` x `size` square at `(x0, y0)` of an image stored as rows of `width` texels,
+/// `per_texel` values of `source` a texel, each texel made by `texel`; turned by 180° when
+/// `turned`. In memory advised for huge pages.
+///
+/// # Panics
+/// If the square does not lie inside the image.
+fn cut_square<T>(
+    source: &[T],
+    per_texel: usize,
+    width: u32,
+    (x0, y0): (u32, u32),
+    size: u32,
+    turned: bool,
+    texel: impl Fn(&[T]) -> Color,
+) -> Image {
+    let (row_values, side) = (per_texel * width as usize, size as usize);
+    let height = source.len() / row_values.max(1);
+    assert!(
+        x0 as usize + side <= width as usize && y0 as usize + side <= height,
+        "a {size} x {size} square at ({x0}, {y0}) of a {width} x {height} image"
+    );
+    let mut texels = crate::accel::pages::vec_with_capacity(side * side);
+    for y in 0..side {
+        let source_row = if turned { side - 1 - y } else { y };
+        let start = (y0 as usize + source_row) * row_values + per_texel * x0 as usize;
+        let row = source[start..start + per_texel * side].chunks_exact(per_texel);
+        if turned {
+            texels.extend(row.rev().map(&texel));
+        } else {
+            texels.extend(row.map(&texel));
+        }
+    }
+    Image {
+        width: size,
+        height: size,
+        texels,
     }
 }
 
