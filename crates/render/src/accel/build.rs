@@ -17,6 +17,8 @@
 //! split breadth first (the record of lowest binary level, then of most primitives), which
 //! collapses the top three levels of their binary tree into one wide node.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use rayon::prelude::*;
 
 use crate::accel::isa::Isa;
@@ -36,6 +38,15 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// Primitives a task bins when a split's range is binned in parallel (`find_split`): ranges
 /// of at least two chunks are.
 const BINNING_CHUNK: usize = 16384;
+
+/// The two sides of a range at least this long are measured by chunks on the pool after its
+/// partition (`measure_chunked`), on any number of threads, so that the boxes do not depend
+/// on it: the top of the tree, where every split measures the whole range before any subtree
+/// can run apart.
+const CHUNKED_MEASURE: usize = 2 * MEASURE_CHUNK;
+
+/// Primitives a task measures in `measure_chunked`.
+const MEASURE_CHUNK: usize = 16384;
 
 /// How the builder splits a range of primitives in two (`-s`, FORMAT.md 1.4).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -470,6 +481,34 @@ fn measure_in_order<'a>(order: impl Iterator<Item = &'a PrimRef>) -> (Box4, Box4
     }
 }
 
+/// `measure` of `prims` (`reversed`: `measure_in_order` of them backwards), by chunks of
+/// `MEASURE_CHUNK` on the current pool, the chunks' boxes then united one after the other in
+/// the same order. Every minimum and maximum, `measure_rows`' and `Box4::union`'s alike,
+/// keeps the later of two equal operands, so without NaN among the coordinates the boxes are
+/// `measure`'s bit for bit, signed zeros included (of equal extremes, the last in the order
+/// is kept either way). With NaN they may differ from it, but not with the number of threads:
+/// the chunks and the order of their union are fixed.
+fn measure_chunked(prims: &[PrimRef], reversed: bool) -> (Box4, Box4) {
+    let one = |chunk: &[PrimRef]| {
+        if reversed {
+            measure_in_order(chunk.iter().rev())
+        } else {
+            measure(chunk)
+        }
+    };
+    if prims.len() <= MEASURE_CHUNK {
+        return one(prims);
+    }
+    let parts: Vec<(Box4, Box4)> = prims.par_chunks(MEASURE_CHUNK).map(one).collect();
+    let unite = |a: (Box4, Box4), b: &(Box4, Box4)| (a.0.union(b.0), a.1.union(b.1));
+    let empty = (Box4::EMPTY, Box4::EMPTY);
+    if reversed {
+        parts.iter().rev().fold(empty, unite)
+    } else {
+        parts.iter().fold(empty, unite)
+    }
+}
+
 /// Splits a record in two by `method`. With the SAH: by its split, else at the median by count
 /// on the widest centroid axis. Both halves are non-empty.
 fn split_record(
@@ -568,9 +607,16 @@ fn partition(
         debug_assert!(done);
         mid
     };
-    let left = measure(&prims[..mid]);
-    let right = measure_in_order(prims[mid..].iter().rev());
-    (left, right, mid)
+    let (left, right) = prims.split_at(mid);
+    if prims.len() >= CHUNKED_MEASURE {
+        (
+            measure_chunked(left, false),
+            measure_chunked(right, true),
+            mid,
+        )
+    } else {
+        (measure(left), measure_in_order(right.iter().rev()), mid)
+    }
 }
 
 /// Whether a primitive goes to the right side of `split`: `binner.bin(c, axis) > split.bin`
@@ -922,29 +968,27 @@ pub fn build(shapes: &[Shape]) -> WideBvh {
 /// Builds the wide BVH of `shapes` with the binary splits of `method`, on the current rayon
 /// pool. Any method finds the same closest hits (ties in t go to the lowest index as given).
 pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
-    let all_triangles = shapes.iter().all(|s| matches!(s, Shape::Triangle { .. }));
-    let config = Config::for_shapes(all_triangles);
+    // Whether every shape is a triangle, noted while the shapes are read for their boxes: a
+    // pass of its own, serial, was 2-4 ms of igea-sub4's build (1.07M triangles).
+    let other_shapes = AtomicBool::new(false);
     let mut prims: Vec<PrimRef> = shapes
         .par_iter()
         .with_min_len(4096)
         .enumerate()
         .map(|(i, s)| {
             let b = s.bounds();
+            let triangle = matches!(s, Shape::Triangle { .. });
+            if !triangle {
+                other_shapes.store(true, Ordering::Relaxed);
+            }
             PrimRef {
                 lo: [b.min.x, b.min.y, b.min.z, f32::from_bits(i as u32)],
-                hi: [
-                    b.max.x,
-                    b.max.y,
-                    b.max.z,
-                    f32::from_bits(matches!(s, Shape::Triangle { .. }) as u32),
-                ],
+                hi: [b.max.x, b.max.y, b.max.z, f32::from_bits(triangle as u32)],
             }
         })
         .collect();
-    let (bounds, centroids) = prims.par_chunks(16384).map(measure).reduce(
-        || (Box4::EMPTY, Box4::EMPTY),
-        |a, b| (a.0.union(b.0), a.1.union(b.1)),
-    );
+    let config = Config::for_shapes(!other_shapes.into_inner());
+    let (bounds, centroids) = measure_chunked(&prims, false);
     let mut nodes = pages::vec_with_capacity(node_capacity(prims.len()));
     let root = if prims.is_empty() {
         ChildRef::EMPTY
@@ -1208,14 +1252,16 @@ mod tests {
                 },
             );
         }
-        let mut two_block_leaves = 0;
-        for shapes in [triangles, mixed] {
+        // Leaves of up to eight triangles where all shapes are triangles (`Config::for_shapes`),
+        // of up to four primitives where some are not.
+        for (shapes, two_blocks) in [(triangles, true), (mixed, false)] {
+            let mut two_block_leaves = 0;
             check_pack(&shapes, &mut two_block_leaves);
+            assert!(
+                (two_block_leaves > 100) == two_blocks,
+                "{two_block_leaves} leaves of two blocks"
+            );
         }
-        assert!(
-            two_block_leaves > 100,
-            "{two_block_leaves} leaves of two blocks"
-        );
     }
 
     fn check_pack(shapes: &[Shape], two_block_leaves: &mut usize) {
@@ -1429,6 +1475,153 @@ mod tests {
             result.get_or_insert((prims, l, r, mid));
         }
         result.expect("one partition")
+    }
+
+    fn pool(threads: usize) -> rayon::ThreadPool {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool")
+    }
+
+    /// Long ranges (a few `CHUNKED_MEASURE`s): random boxes, points on a grid (centroids on
+    /// bin boundaries) and boxes of signed zeros.
+    fn long_sets() -> Vec<Vec<PrimRef>> {
+        let mut r = Rng(0x51_7cc1_b727_220a);
+        let n = 3 * CHUNKED_MEASURE + 1234;
+        let random = (0..n)
+            .map(|i| {
+                let a: [f32; 3] = std::array::from_fn(|_| r.f32() * 10.0 - 5.0);
+                let d: [f32; 3] = std::array::from_fn(|_| r.f32() * 0.1);
+                prim(i, a, std::array::from_fn(|k| a[k] + d[k]))
+            })
+            .collect();
+        let grid = (0..n)
+            .map(|i| {
+                let p = [(i % 33) as f32, (i % 7) as f32 * 0.25, ((i / 7) % 5) as f32];
+                prim(i, p, p)
+            })
+            .collect();
+        let zeros = (0..n)
+            .map(|i| {
+                let zero = |r: &mut Rng| if r.next() & 1 == 0 { 0.0 } else { -0.0 };
+                let lo: [f32; 3] = std::array::from_fn(|_| zero(&mut r));
+                let hi: [f32; 3] = std::array::from_fn(|k| match r.next() % 3 {
+                    0 => lo[k] + 1.0,
+                    _ => zero(&mut r),
+                });
+                prim(i, lo, hi)
+            })
+            .collect();
+        vec![random, grid, zeros]
+    }
+
+    /// The sides of long ranges are measured by chunks (`measure_chunked`, here on a pool of
+    /// three), and still give `partition_reference`'s boxes bit for bit, signed zeros
+    /// included, also when the left count given is off.
+    #[test]
+    fn long_ranges_are_measured_by_chunks_as_in_one_pass() {
+        pool(3).install(|| {
+            for set in long_sets() {
+                let record = Record::root(set.len(), measure(&set));
+                let binner = Binner::new(&record.centroids, set.len());
+                for axis in 0..3 {
+                    for bin in [0, 3, binner.count / 2, binner.count - 2] {
+                        partition_checked(&set, &binner, axis, bin);
+                    }
+                }
+            }
+        });
+    }
+
+    /// With NaN among the centroids (boxes infinite both ways), the chunked measure may keep
+    /// other extremes than one pass does, but the same on any number of threads; the
+    /// arrangement is Hoare's.
+    #[test]
+    fn long_ranges_with_nan_are_measured_alike_on_any_number_of_threads() {
+        let mut set = long_sets().swap_remove(0);
+        for i in (0..set.len()).step_by(997) {
+            set[i] = prim(i, [f32::NEG_INFINITY; 3], [f32::INFINITY; 3]);
+        }
+        let record = Record::root(set.len(), measure_chunked(&set, false));
+        let binner = Binner::new(&record.centroids, set.len());
+        let split = |left| Split {
+            axis: 1,
+            bin: binner.count / 2,
+            left,
+            cost: 0.0,
+        };
+        let mut expected = set.clone();
+        let left = set
+            .iter()
+            .filter(|p| binner.bin(p.centroid(), 1) <= binner.count / 2)
+            .count();
+        partition_reference(&mut expected, &binner, split(left));
+        let runs: Vec<_> = [1, 2, 3]
+            .into_iter()
+            .map(|threads| {
+                let mut prims = set.clone();
+                let (l, r, mid) =
+                    pool(threads).install(|| partition(&mut prims, &binner, split(left)));
+                assert_eq!(mid, left);
+                let order: Vec<usize> = prims.iter().map(PrimRef::index).collect();
+                let boxes = [l.0, l.1, r.0, r.1].map(|b| bits(&b));
+                (order, boxes)
+            })
+            .collect();
+        let hoare: Vec<usize> = expected.iter().map(PrimRef::index).collect();
+        for run in &runs {
+            assert!(run.0 == hoare);
+            assert_eq!(run.1, runs[0].1);
+        }
+    }
+
+    /// The tree of a mesh whose top splits bin and measure long ranges by chunks, built on
+    /// one, two and three threads: the same nodes, blocks and sources, bit for bit; also with
+    /// boxes infinite both ways among the triangles (NaN centroids, where the order of the
+    /// chunks' union decides which extremes are kept).
+    #[test]
+    fn the_tree_does_not_depend_on_the_number_of_threads() {
+        let mut r = Rng(0x7a3d_5c1b_9e0f_2468);
+        let triangles: Vec<Shape> = (0..6 * CHUNKED_MEASURE)
+            .map(|_| {
+                let a = Vec3::new(r.f32() * 8.0, r.f32() * 2.0, r.f32() * 4.0);
+                let mut corner = || a + Vec3::new(r.f32(), r.f32(), r.f32()) * 0.05;
+                Shape::Triangle {
+                    vertices: [a, corner(), corner()],
+                }
+            })
+            .collect();
+        let mut with_infinite = triangles.clone();
+        // Some at the end of a chunk, where that chunk's centroid box is NaN.
+        let ends = [1, 4, 5, 8].map(|chunk| (chunk + 1) * MEASURE_CHUNK - 1);
+        for i in (0..with_infinite.len()).step_by(4999).chain(ends) {
+            with_infinite[i] = Shape::Box {
+                min: Vec3::splat(f32::NEG_INFINITY),
+                max: Vec3::splat(f32::INFINITY),
+            };
+        }
+        for shapes in [triangles, with_infinite] {
+            let tree = |threads: usize| {
+                let bvh = pool(threads).install(|| build_with(&shapes, SplitMethod::Sah));
+                let nodes: Vec<_> = bvh
+                    .nodes
+                    .iter()
+                    .map(|n| (n.bounds.map(|row| row.map(f32::to_bits)), n.children))
+                    .collect();
+                let blocks: Vec<_> = bvh
+                    .blocks
+                    .iter()
+                    .map(|b| b.v.map(|corner| corner.map(|axis| axis.map(f32::to_bits))))
+                    .collect();
+                (bvh.root, nodes, blocks, bvh.source)
+            };
+            let one = tree(1);
+            assert!(one.1.len() > 1000);
+            for threads in [2, 3] {
+                assert!(tree(threads) == one, "{threads} threads");
+            }
+        }
     }
 
     #[test]
