@@ -5,16 +5,17 @@
 # all threads (bench/scaling.py), the machine's own ceiling (16 single-thread copies at once)
 # and the stage times of two 16-thread frames. Each part has a time limit, so that the call
 # ends within the 600 s a command may run; what ran is in $OUT (machine.txt, embree.txt,
-# scaling.txt, ceiling.txt, stages.txt), and printed.
+# scaling.txt, ceiling.txt, stages.txt, align.txt: single rays by the stack's alignment, see
+# align_sweep), and printed.
 #
 # Options by environment: EC (embree_compare.sh's, default "--rounds 3 --repeat 2"), SC
 # (scaling.py's, default "--rounds 3"), CE (the ceiling's, default "--size 0.5 --rounds 2"),
-# and EC_S, SC_S, CE_S, their limits in seconds (330, 150, 60); EC_GLINTS, the glints
+# and EC_S, SC_S, CE_S, their limits in seconds (290, 150, 60); EC_GLINTS, the glints
 # embree_compare.sh runs (default all of them, comma-separated paths under target/device/bin,
 # each perhaps with @WALK: `bench rays --walk WALK`).
 #
 # Where pack.sh packed perf (PERF=1), a last part (limit PF_S, default 70 s; EC_S then
-# defaults to 260) profiles the first glint and embree_native, one thread, on the rays
+# defaults to 220) profiles the first glint and embree_native, one thread, on the rays
 # embree_compare.sh made (PF_SETS, default "dragon.bounce stanford-bunny.primary"): `perf
 # stat` of each process (task-clock, and cycles, instructions, branch and cache misses where
 # the machine's PMU counts them: clock rate and IPC on that core) and `perf record` samples of
@@ -38,7 +39,7 @@ PERF_BIN=
 if [ -e "$D/perf/perf" ]; then
   PERF_BIN=$PWD/$D/perf/perf
   chmod +x "$PERF_BIN"
-  : "${EC_S:=260}"
+  : "${EC_S:=220}"
 fi
 { lscpu; free -g; } > "$OUT/machine.txt" 2>&1
 grep -E "Model name|^CPU\(s\)|Thread" "$OUT/machine.txt"
@@ -48,7 +49,7 @@ FIRST=${GLINTS%%,*}
 export SHARED=$PWD/$D/shared RAYS=/tmp/device-rays EMBREE=$PWD/$D/bin/embree_native
 el setup
 # shellcheck disable=SC2086
-GLINT=${EC_GLINTS:-$GLINTS} timeout "${EC_S:-330}" bash bench/embree_compare.sh ${EC:---rounds 3 --repeat 2} \
+GLINT=${EC_GLINTS:-$GLINTS} timeout "${EC_S:-290}" bash bench/embree_compare.sh ${EC:---rounds 3 --repeat 2} \
   > "$OUT/embree.txt" 2> "$OUT/embree.err"
 echo "embree_compare: rc $?"
 cat "$OUT/embree.txt"
@@ -72,6 +73,33 @@ for s in scenes_A/spheres_1K.xml:9 scenes_B/StanfordDragon_Instanced.json:16; do
     | tr -s ' ' | paste -sd';' -)"
 done | tee "$OUT/stages.txt"
 el stages
+# The stack's alignment: the single-ray walks run on the main thread (`--threads 1`), whose
+# stack starts below the environment, so the environment's size moves every frame, among them
+# the closest-hit walk's buffer of entry distances, which the box test writes as one 32-byte
+# vector and the walk reads back 4 bytes at a time (store forwarding; 16-byte aligned only).
+# The same run with an environment 0, 16, 32 and 48 bytes longer, alternating, AL_ROUNDS times
+# (limit AL_S, default 40 s): Mrays/s by padding. On the Zen 4 here: no pattern (5.1-5.5
+# Mrays/s on the dragon's bounce rays at every padding, three rounds).
+align_sweep() {
+  for set in dragon.bounce stanford-bunny.primary; do
+    mesh=$(find "$SHARED/models" "$SHARED/scenes" -name "${set%%.*}.*" \( -name '*.obj' -o -name '*.ply' \) | head -1)
+    [ -n "$mesh" ] && [ -f "$RAYS/$set.rays" ] || continue
+    for round in $(seq "${AL_ROUNDS:-3}"); do
+      line="$set round $round:"
+      for pad in 0 16 32 48; do
+        rate=$(env GLINT_PAD="$(head -c "$pad" /dev/zero | tr '\0' a)" "$FIRST" bench rays \
+          --mesh "$mesh" --rays "$RAYS/$set.rays" --threads 1 --repeat 3 | tail -1 \
+          | python3 -c 'import json, sys; print(json.load(sys.stdin)["mrays_per_s"])')
+        line="$line pad $pad $rate"
+      done
+      echo "$line"
+    done
+  done
+}
+export -f align_sweep
+export FIRST RAYS SHARED
+timeout "${AL_S:-40}" bash -c align_sweep | tee "$OUT/align.txt"
+el align
 if [ -n "$PERF_BIN" ]; then
   P=/tmp/device-prof
   rm -rf "$P"; mkdir -p "$P"
