@@ -1168,6 +1168,22 @@ mod tests {
         }
     }
 
+    /// `n` boxes of signed zeros everywhere (some a unit long on an axis): which zero a box
+    /// keeps depends on the order it grows in.
+    fn signed_zeros(n: usize, r: &mut Rng) -> Vec<PrimRef> {
+        let zero = |r: &mut Rng| if r.next() & 1 == 0 { 0.0 } else { -0.0 };
+        (0..n)
+            .map(|i| {
+                let lo: [f32; 3] = std::array::from_fn(|_| zero(r));
+                let hi: [f32; 3] = std::array::from_fn(|k| match r.next() % 3 {
+                    0 => lo[k] + 1.0,
+                    _ => zero(r),
+                });
+                prim(i, lo, hi)
+            })
+            .collect()
+    }
+
     /// Boxes of every kind the builder meets: random, flat, points, coinciding, on a grid
     /// (centroids landing exactly on bin boundaries), far outliers.
     fn prim_sets() -> Vec<Vec<PrimRef>> {
@@ -1205,19 +1221,7 @@ mod tests {
             outlier[n / 2] = prim(n / 2, [1e30, -1e30, 3e5], [1e30, -1e30, 3e5]);
             sets.push(outlier);
             sets.push((0..n).map(|i| prim(i, [1.0; 3], [2.0; 3])).collect());
-            // Signed zeros everywhere: which one a box keeps depends on the order it grows in.
-            let signed_zeros = (0..n)
-                .map(|i| {
-                    let zero = |r: &mut Rng| if r.next() & 1 == 0 { 0.0 } else { -0.0 };
-                    let lo: [f32; 3] = std::array::from_fn(|_| zero(&mut r));
-                    let hi: [f32; 3] = std::array::from_fn(|k| match r.next() % 3 {
-                        0 => lo[k] + 1.0,
-                        _ => zero(&mut r),
-                    });
-                    prim(i, lo, hi)
-                })
-                .collect();
-            sets.push(signed_zeros);
+            sets.push(signed_zeros(n, &mut r));
         }
         sets
     }
@@ -1502,18 +1506,7 @@ mod tests {
                 prim(i, p, p)
             })
             .collect();
-        let zeros = (0..n)
-            .map(|i| {
-                let zero = |r: &mut Rng| if r.next() & 1 == 0 { 0.0 } else { -0.0 };
-                let lo: [f32; 3] = std::array::from_fn(|_| zero(&mut r));
-                let hi: [f32; 3] = std::array::from_fn(|k| match r.next() % 3 {
-                    0 => lo[k] + 1.0,
-                    _ => zero(&mut r),
-                });
-                prim(i, lo, hi)
-            })
-            .collect();
-        vec![random, grid, zeros]
+        vec![random, grid, signed_zeros(n, &mut r)]
     }
 
     /// The sides of long ranges are measured by chunks (`measure_chunked`, here on a pool of
