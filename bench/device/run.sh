@@ -77,8 +77,9 @@ el stages
 # stack starts below the environment, so the environment's size moves every frame, among them
 # the closest-hit walk's buffer of entry distances, which the box test writes as one 32-byte
 # vector and the walk reads back 4 bytes at a time (store forwarding; 16-byte aligned only).
-# The same run with an environment 0, 16, 32 and 48 bytes longer, alternating, AL_ROUNDS times
-# (limit AL_S, default 40 s): Mrays/s by padding. On the Zen 4 here: no pattern (5.1-5.5
+# The same run with an environment 0, 16, 32 and 48 bytes longer (the buffer at each of the
+# four 16-byte places in a 64-byte line, one of them split across two lines), alternating,
+# AL_ROUNDS times (limit AL_S, default 40 s): Mrays/s by padding. On the Zen 4 here: no pattern (5.1-5.5
 # Mrays/s on the dragon's bounce rays at every padding, three rounds).
 align_sweep() {
   for set in dragon.bounce stanford-bunny.primary; do
