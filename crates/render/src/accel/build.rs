@@ -39,13 +39,9 @@ const PARALLEL_THRESHOLD: usize = 4096;
 /// of at least two chunks are.
 const BINNING_CHUNK: usize = 16384;
 
-/// The two sides of a range at least this long are measured by chunks on the pool after its
-/// partition (`measure_chunked`), on any number of threads, so that the boxes do not depend
-/// on it: the top of the tree, where every split measures the whole range before any subtree
-/// can run apart.
-const CHUNKED_MEASURE: usize = 2 * MEASURE_CHUNK;
-
-/// Primitives a task measures in `measure_chunked`.
+/// Primitives a task measures in `measure_chunked`: longer ranges (the top of the tree, where
+/// every split measures the whole range before any subtree can run apart) are measured by
+/// chunks on the pool, on any number of threads, so that the boxes do not depend on it.
 const MEASURE_CHUNK: usize = 16384;
 
 /// How the builder splits a range of primitives in two (`-s`, FORMAT.md 1.4).
@@ -608,15 +604,11 @@ fn partition(
         mid
     };
     let (left, right) = prims.split_at(mid);
-    if prims.len() >= CHUNKED_MEASURE {
-        (
-            measure_chunked(left, false),
-            measure_chunked(right, true),
-            mid,
-        )
-    } else {
-        (measure(left), measure_in_order(right.iter().rev()), mid)
-    }
+    (
+        measure_chunked(left, false),
+        measure_chunked(right, true),
+        mid,
+    )
 }
 
 /// Whether a primitive goes to the right side of `split`: `binner.bin(c, axis) > split.bin`
@@ -1269,13 +1261,7 @@ mod tests {
     }
 
     fn check_pack(shapes: &[Shape], two_block_leaves: &mut usize) {
-        let on = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("thread pool")
-                .install(|| build_with(shapes, SplitMethod::Sah))
-        };
+        let on = |threads: usize| pool(threads).install(|| build_with(shapes, SplitMethod::Sah));
         for bvh in [on(1), on(2)] {
             let mut leaves: Vec<ChildRef> = bvh
                 .nodes
@@ -1488,11 +1474,11 @@ mod tests {
             .expect("thread pool")
     }
 
-    /// Long ranges (a few `CHUNKED_MEASURE`s): random boxes, points on a grid (centroids on
+    /// Long ranges (several `MEASURE_CHUNK`s): random boxes, points on a grid (centroids on
     /// bin boundaries) and boxes of signed zeros.
     fn long_sets() -> Vec<Vec<PrimRef>> {
         let mut r = Rng(0x51_7cc1_b727_220a);
-        let n = 3 * CHUNKED_MEASURE + 1234;
+        let n = 6 * MEASURE_CHUNK + 1234;
         let random = (0..n)
             .map(|i| {
                 let a: [f32; 3] = std::array::from_fn(|_| r.f32() * 10.0 - 5.0);
@@ -1576,7 +1562,7 @@ mod tests {
     #[test]
     fn the_tree_does_not_depend_on_the_number_of_threads() {
         let mut r = Rng(0x7a3d_5c1b_9e0f_2468);
-        let triangles: Vec<Shape> = (0..6 * CHUNKED_MEASURE)
+        let triangles: Vec<Shape> = (0..12 * MEASURE_CHUNK)
             .map(|_| {
                 let a = Vec3::new(r.f32() * 8.0, r.f32() * 2.0, r.f32() * 4.0);
                 let mut corner = || a + Vec3::new(r.f32(), r.f32(), r.f32()) * 0.05;
