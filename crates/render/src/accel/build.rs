@@ -1006,12 +1006,116 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
     )
 }
 
+/// A block to make: its leaf's first primitive, the leaf's count, which block of the leaf.
+type BlockJob = (u32, u8, u8);
+
+/// A leaf's primitives in the order given (so the lowest lane of a tie is also the lowest
+/// index).
+fn sorted(prims: &[PrimRef], start: usize, count: usize) -> [PrimRef; 8] {
+    let mut sorted = [prims[start]; 8];
+    sorted[..count].copy_from_slice(&prims[start..start + count]);
+    sorted[..count].sort_unstable_by_key(PrimRef::index);
+    sorted
+}
+
+/// The first pass of `pack`: every leaf of `nodes` (in node order, each node's slots in
+/// order, then the root when it is one) turned from a primitive range into its run of
+/// blocks or of other shapes, numbered in that order. Returns the root so turned, the blocks
+/// to make (the leaf's first primitive, its count, which block of the leaf) and the other
+/// shapes' indices, in order.
+fn leaf_runs(
+    prims: &[PrimRef],
+    nodes: &mut [WideNode],
+    root: ChildRef,
+) -> (ChildRef, Vec<BlockJob>, Vec<u32>) {
+    // In two passes over the nodes, `LEAF_RUN_NODES` a task: how many blocks and shapes each
+    // run of nodes holds; then, each run starting where those before it end (their running
+    // sums), its leaves turned and their blocks and shapes written in place. Serial, this
+    // pass was 4.5-7 ms of igea-sub4's build on any number of threads.
+    const LEAF_RUN_NODES: usize = 256;
+    let leaf = |r: ChildRef| r.is_leaf() && r != ChildRef::EMPTY;
+    // The blocks and the shapes of one child.
+    let sizes = |r: ChildRef| -> (usize, usize) {
+        let (_, count) = r.range();
+        match (leaf(r), r.is_shapes()) {
+            (false, _) => (0, 0),
+            (true, false) => (count.div_ceil(BLOCK), 0),
+            (true, true) => (0, count),
+        }
+    };
+    let add = |(a, b): (usize, usize), (c, d): (usize, usize)| (a + c, b + d);
+    let counts: Vec<(usize, usize)> = nodes
+        .par_chunks(LEAF_RUN_NODES)
+        .map(|run| {
+            run.iter()
+                .flat_map(|node| node.children)
+                .map(|c| sizes(ChildRef(c)))
+                .fold((0, 0), add)
+        })
+        .collect();
+    let (blocks, shapes) = counts.iter().copied().fold(sizes(root), add);
+    let mut jobs: Vec<BlockJob> = vec![(0, 0, 0); blocks];
+    let mut others: Vec<u32> = vec![0; shapes];
+    // Each run's part of the outputs, and where its numbering starts; the root's after all.
+    let mut parts = Vec::with_capacity(counts.len());
+    let (mut jobs_left, mut others_left) = (&mut jobs[..], &mut others[..]);
+    let mut first = (0, 0);
+    for &(b, s) in &counts {
+        let (run_jobs, rest_jobs) = jobs_left.split_at_mut(b);
+        let (run_others, rest_others) = others_left.split_at_mut(s);
+        parts.push((first, run_jobs, run_others));
+        (jobs_left, others_left) = (rest_jobs, rest_others);
+        first = add(first, (b, s));
+    }
+    // A leaf turned into its run, numbered from `next`, its blocks and shapes written at the
+    // front of `jobs` and `others`; `next` and the two moved past them.
+    let turn = |r: ChildRef,
+                next: &mut (usize, usize),
+                jobs: &mut &mut [BlockJob],
+                others: &mut &mut [u32]|
+     -> ChildRef {
+        if !leaf(r) {
+            return r;
+        }
+        let (start, count) = r.range();
+        let (b, s) = sizes(r);
+        let turned = if r.is_shapes() {
+            let (mine, rest) = std::mem::take(others).split_at_mut(s);
+            for (out, p) in mine.iter_mut().zip(&sorted(prims, start, count)[..count]) {
+                *out = p.index() as u32;
+            }
+            *others = rest;
+            ChildRef::shapes(next.1 as u32, s as u32)
+        } else {
+            let (mine, rest) = std::mem::take(jobs).split_at_mut(b);
+            for (block, out) in mine.iter_mut().enumerate() {
+                *out = (start as u32, count as u8, block as u8);
+            }
+            *jobs = rest;
+            ChildRef::triangles(next.0 as u32, b as u32)
+        };
+        *next = add(*next, (b, s));
+        turned
+    };
+    nodes.par_chunks_mut(LEAF_RUN_NODES).zip(parts).for_each(
+        |(run, (mut next, mut jobs, mut others))| {
+            for node in run {
+                for child in node.children.iter_mut() {
+                    *child = turn(ChildRef(*child), &mut next, &mut jobs, &mut others).0;
+                }
+            }
+        },
+    );
+    let root = turn(root, &mut first, &mut jobs_left, &mut others_left);
+    (root, jobs, others)
+}
+
 /// Turns leaves over primitive ranges into leaves over triangle blocks and shape runs.
 ///
 /// The blocks follow the leaves in node order (each node's slots in order, the root last when
 /// it is a leaf), a leaf's triangles in the order given, four to a block. A first pass over
-/// the leaves, serial but light, gives each leaf its first block (or shape) and lists the
-/// blocks to make; the blocks, which read every triangle's vertices at random in `shapes` (a
+/// the leaves (`leaf_runs`) gives each leaf its first block (or shape) and lists the blocks
+/// to make; the blocks, which read every triangle's vertices at random in `shapes` (a
 /// cache miss each on big meshes: most of the time), are then made in parallel on the
 /// current pool. Serial, this took 50-100 ms of igea-sub4's 1-thread build (1.07M
 /// triangles) and 6-9 ms of the instanced dragon's, more than the root node's splits, on one
@@ -1024,56 +1128,8 @@ fn pack(
     root: ChildRef,
     bounds: Aabb,
 ) -> WideBvh {
-    /// A leaf's primitives in the order given (so the lowest lane of a tie is also the
-    /// lowest index).
-    fn sorted(prims: &[PrimRef], start: usize, count: usize) -> [PrimRef; 8] {
-        let mut sorted = [prims[start]; 8];
-        sorted[..count].copy_from_slice(&prims[start..start + count]);
-        sorted[..count].sort_unstable_by_key(PrimRef::index);
-        sorted
-    }
-    let leaves: Vec<(u32, u8)> = nodes
-        .iter()
-        .enumerate()
-        .flat_map(|(n, node)| {
-            node.children
-                .iter()
-                .enumerate()
-                .filter_map(move |(slot, &c)| {
-                    let c = ChildRef(c);
-                    (c.is_leaf() && c != ChildRef::EMPTY).then_some((n as u32, slot as u8))
-                })
-        })
-        .collect();
-    // The blocks to make, in order: (the leaf's first primitive, its count, which block of
-    // the leaf).
-    let mut jobs: Vec<(u32, u8, u8)> = Vec::with_capacity(prims.len() / 3 + 1);
-    let mut others: Vec<Shape> = Vec::new();
-    let mut other_source: Vec<u32> = Vec::new();
-    let mut convert = |r: ChildRef| -> ChildRef {
-        if !r.is_leaf() || r == ChildRef::EMPTY {
-            return r;
-        }
-        let (start, count) = r.range();
-        if r.is_shapes() {
-            let first = others.len() as u32;
-            for p in &sorted(prims, start, count)[..count] {
-                others.push(shapes[p.index()]);
-                other_source.push(p.index() as u32);
-            }
-            ChildRef::shapes(first, count as u32)
-        } else {
-            let first = jobs.len() as u32;
-            let blocks = count.div_ceil(BLOCK);
-            jobs.extend((0..blocks).map(|b| (start as u32, count as u8, b as u8)));
-            ChildRef::triangles(first, blocks as u32)
-        }
-    };
-    for (n, slot) in leaves {
-        let child = &mut nodes[n as usize].children[slot as usize];
-        *child = convert(ChildRef(*child)).0;
-    }
-    let root = convert(root);
+    let (root, jobs, other_source) = leaf_runs(prims, &mut nodes, root);
+    let others: Vec<Shape> = other_source.iter().map(|&i| shapes[i as usize]).collect();
     // The blocks, each from its leaf's triangles; the shapes of the block a few jobs ahead
     // are fetched meanwhile, so that a task's misses overlap.
     const AHEAD: usize = 8;
@@ -1117,22 +1173,30 @@ fn pack(
 }
 
 /// `WideBvh::magnitude`: the largest |plane| of the children's boxes (empty slots left out), ∞
-/// where one is infinite or NaN.
+/// where one is infinite or NaN. On the pool, 1024 nodes a task (serial, this was 2.5 ms of igea-sub4's build on any number
+/// of threads); the maximum does not depend on the order the nodes are taken in.
 pub(crate) fn plane_magnitude(nodes: &[WideNode]) -> f32 {
-    let mut largest = 0.0f32;
-    for node in nodes {
-        for slot in (0..WIDTH).filter(|&slot| node.children[slot] != ChildRef::EMPTY.0) {
-            for row in &node.bounds {
-                let m = row[slot].abs();
-                largest = if m.is_nan() {
-                    f32::INFINITY
-                } else {
-                    largest.max(m)
-                };
-            }
+    nodes
+        .par_iter()
+        .with_min_len(1024)
+        .map(node_magnitude)
+        .reduce(|| 0.0, f32::max)
+}
+
+/// `plane_magnitude` of one node, without a branch per plane: the largest |plane| of its used
+/// slots, with NaN as ∞.
+fn node_magnitude(node: &WideNode) -> f32 {
+    let mut largest = [0.0f32; WIDTH];
+    for row in &node.bounds {
+        for (slot, largest) in largest.iter_mut().enumerate() {
+            let used = node.children[slot] != ChildRef::EMPTY.0;
+            let m = row[slot].abs();
+            let m = if m.is_nan() { f32::INFINITY } else { m };
+            let m = if used { m } else { 0.0 };
+            *largest = if m > *largest { m } else { *largest };
         }
     }
-    largest
+    largest.into_iter().fold(0.0, f32::max)
 }
 
 #[cfg(test)]
@@ -1599,6 +1663,172 @@ mod tests {
             assert!(one.1.len() > 1000);
             for threads in [2, 3] {
                 assert!(tree(threads) == one, "{threads} threads");
+            }
+        }
+    }
+
+    /// `plane_magnitude` is the largest |plane| over the used slots, ∞ with a NaN or an
+    /// infinite plane among them, whatever the unused slots hold; the same on any number of
+    /// threads as one loop over the planes in order.
+    #[test]
+    fn the_plane_magnitude_is_the_largest_used_plane() {
+        fn one_loop(nodes: &[WideNode]) -> f32 {
+            let mut largest = 0.0f32;
+            for node in nodes {
+                for slot in (0..WIDTH).filter(|&slot| node.children[slot] != ChildRef::EMPTY.0) {
+                    for row in &node.bounds {
+                        let m = row[slot].abs();
+                        largest = if m.is_nan() {
+                            f32::INFINITY
+                        } else {
+                            largest.max(m)
+                        };
+                    }
+                }
+            }
+            largest
+        }
+        let mut r = Rng(0x6d1f_0b93_c2a4_5e87);
+        let node = |r: &mut Rng, scale: f32| {
+            let mut node = WideNode::EMPTY;
+            for slot in 0..WIDTH {
+                if r.next().is_multiple_of(4) {
+                    continue;
+                }
+                for row in node.bounds.iter_mut() {
+                    row[slot] = (r.f32() - 0.5) * scale;
+                }
+                node.children[slot] = ChildRef::node(slot as u32).0;
+            }
+            node
+        };
+        let mut nodes: Vec<WideNode> = (0..5000).map(|i| node(&mut r, 1.0 + i as f32)).collect();
+        // Slot `slot` of node `n` used (or not), its planes small but one.
+        let set = |nodes: &mut [WideNode], n: usize, slot: usize, plane: usize, v: f32, used| {
+            for row in nodes[n].bounds.iter_mut() {
+                row[slot] = 1.0;
+            }
+            nodes[n].bounds[plane][slot] = v;
+            nodes[n].children[slot] = if used {
+                ChildRef::node(slot as u32).0
+            } else {
+                ChildRef::EMPTY.0
+            };
+        };
+        // The largest plane deep inside, in an unused slot something larger still.
+        set(&mut nodes, 3217, 2, 4, -9.0e6, true);
+        set(&mut nodes, 4001, 5, 1, 3.0e7, false);
+        let mut with_nan = nodes.clone();
+        set(&mut with_nan, 2500, 1, 0, f32::NAN, true);
+        let mut with_infinite = nodes.clone();
+        set(&mut with_infinite, 77, 0, 5, f32::NEG_INFINITY, true);
+        let mut nan_unused = nodes.clone();
+        set(&mut nan_unused, 10, 7, 3, f32::NAN, false);
+        let cases = [
+            (nodes, 9.0e6),
+            (with_nan, f32::INFINITY),
+            (with_infinite, f32::INFINITY),
+            (nan_unused, 9.0e6),
+            (vec![], 0.0),
+            (vec![WideNode::EMPTY], 0.0),
+        ];
+        for (k, (nodes, expected)) in cases.iter().enumerate() {
+            assert_eq!(one_loop(nodes), *expected, "case {k}");
+            for threads in [1, 2, 3] {
+                let got = pool(threads).install(|| plane_magnitude(nodes));
+                assert_eq!(
+                    got.to_bits(),
+                    expected.to_bits(),
+                    "case {k}, {threads} threads"
+                );
+            }
+        }
+    }
+
+    /// `leaf_runs` numbers the leaves' blocks and shapes as one loop over the leaves in order
+    /// does (each node's slots in order, the root last), on any number of threads: nodes
+    /// mixing empty slots, inner nodes, triangle leaves and shape leaves, over a root that is
+    /// a node or a leaf of either kind.
+    #[test]
+    fn leaves_are_numbered_as_one_loop_numbers_them() {
+        fn one_loop(
+            prims: &[PrimRef],
+            nodes: &mut [WideNode],
+            root: ChildRef,
+        ) -> (ChildRef, Vec<BlockJob>, Vec<u32>) {
+            let mut jobs = Vec::new();
+            let mut others = Vec::new();
+            let mut convert = |r: ChildRef| -> ChildRef {
+                if !r.is_leaf() || r == ChildRef::EMPTY {
+                    return r;
+                }
+                let (start, count) = r.range();
+                if r.is_shapes() {
+                    let first = others.len() as u32;
+                    for p in &sorted(prims, start, count)[..count] {
+                        others.push(p.index() as u32);
+                    }
+                    ChildRef::shapes(first, count as u32)
+                } else {
+                    let first = jobs.len() as u32;
+                    let blocks = count.div_ceil(BLOCK);
+                    jobs.extend((0..blocks).map(|b| (start as u32, count as u8, b as u8)));
+                    ChildRef::triangles(first, blocks as u32)
+                }
+            };
+            for node in nodes.iter_mut() {
+                for child in node.children.iter_mut() {
+                    *child = convert(ChildRef(*child)).0;
+                }
+            }
+            (convert(root), jobs, others)
+        }
+        let mut r = Rng(0x1e5a_93c7_4b20_d6f1);
+        let prims: Vec<PrimRef> = (0..4000)
+            .map(|i| {
+                let p = [r.f32(), r.f32(), r.f32()];
+                prim((i * 7919) % 4000, p, p)
+            })
+            .collect();
+        let child = |r: &mut Rng| {
+            let start = (r.next() % 3990) as u32;
+            let count = 1 + (r.next() % 8) as u32;
+            match r.next() % 4 {
+                0 => ChildRef::EMPTY,
+                1 => ChildRef::node((r.next() % 3000) as u32),
+                2 => ChildRef::triangles(start, count),
+                _ => ChildRef::shapes(start, count),
+            }
+        };
+        let nodes: Vec<WideNode> = (0..3000)
+            .map(|_| {
+                let mut node = WideNode::EMPTY;
+                for slot in 0..WIDTH {
+                    node.children[slot] = child(&mut r).0;
+                }
+                node
+            })
+            .collect();
+        let roots = [
+            ChildRef::node(0),
+            ChildRef::triangles(17, 7),
+            ChildRef::shapes(3000, 5),
+        ];
+        for root in roots {
+            let mut expected_nodes = nodes.clone();
+            let expected = one_loop(&prims, &mut expected_nodes, root);
+            assert!(expected.1.len() > 3000 && expected.2.len() > 3000);
+            for threads in [1, 2, 3] {
+                let mut got_nodes = nodes.clone();
+                let got = pool(threads).install(|| leaf_runs(&prims, &mut got_nodes, root));
+                assert!(got == expected, "root {root:?}, {threads} threads");
+                assert!(
+                    got_nodes
+                        .iter()
+                        .map(|n| n.children)
+                        .eq(expected_nodes.iter().map(|n| n.children)),
+                    "root {root:?}, {threads} threads"
+                );
             }
         }
     }
