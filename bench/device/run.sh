@@ -5,7 +5,7 @@
 # all threads (bench/scaling.py), the machine's own ceiling (16 single-thread copies at once)
 # and the stage times of two 16-thread frames. Each part has a time limit, so that the call
 # ends within the 600 s a command may run; what ran is in $OUT (machine.txt, embree.txt,
-# scaling.txt, ceiling.txt, stages.txt, align.txt: single rays by the stack's alignment, see
+# scaling.txt, ceiling.txt, stages.txt (with the largest tree's build phases), align.txt: single rays by the stack's alignment, see
 # align_sweep), and printed.
 #
 # Options by environment: EC (embree_compare.sh's, default "--rounds 3 --repeat 2"), SC
@@ -69,7 +69,7 @@ el ceiling
 C=$SHARED/scenes/course/willemsen
 for s in scenes_A/spheres_1K.xml:9 scenes_B/StanfordDragon_Instanced.json:16; do
   echo "${s%%:*}, $THREADS threads: $("$FIRST" render "$C/${s%%:*}" -w 1024 -h 1024 -r "${s##*:}" \
-    -n "$THREADS" --stats -o /tmp/device-stages.png 2>&1 | grep -E "^ +(load|hash|build|render|write) " \
+    -n "$THREADS" --stats -o /tmp/device-stages.png 2>&1 | grep -E "^ +(load|hash|build|render|write) |^BVH build phases" \
     | tr -s ' ' | paste -sd';' -)"
 done | tee "$OUT/stages.txt"
 el stages

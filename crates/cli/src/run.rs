@@ -474,12 +474,26 @@ pub fn run(
 pub fn bvh_stats(scene: &Scene, settings: &RenderSettings) -> String {
     let bvh = scene.bvh_stats();
     let walk = glint_render::measure_traversal(scene, settings);
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
+    // Where the largest tree's build spent its time: the root node's splits run before any
+    // subtree can run apart, so they are what more threads shorten least.
+    let phases = bvh.largest.map_or_else(String::new, |(primitives, p)| {
+        format!(
+            "BVH build phases, largest tree ({primitives} primitives): boxes {:.1} ms, root \
+             splits {:.1} ms, subtrees {:.1} ms, blocks {:.1} ms\n",
+            ms(p.boxes),
+            ms(p.top_splits),
+            ms(p.subtrees),
+            ms(p.pack),
+        )
+    });
     format!(
         "BVH ({}): built in {:.1} ms; {} tree{}, {} nodes, {} leaves, depth {}, SAH cost {:.2}\n\
+         {phases}\
          BVH traversal: {:.2} nodes and {:.2} triangle blocks per camera ray ({} rays through \
          pixel centres, {:.0}% hit)\n",
         bvh.split.name(),
-        bvh.build_time.as_secs_f64() * 1e3,
+        ms(bvh.build_time),
         bvh.trees,
         plural(bvh.trees as u64),
         bvh.nodes,

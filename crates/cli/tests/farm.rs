@@ -653,6 +653,7 @@ fn logs_get_progress_lines_and_stats() {
         "total",
         "  memory",
         "peak resident",
+        "BVH build phases, largest tree (4 primitives): boxes ",
     ] {
         assert!(stderr.contains(expected), "no '{expected}' in {stderr}");
     }

@@ -90,6 +90,7 @@ mod tests;
 
 // The scene a loader builds, in plain data.
 pub use accel::build::SplitMethod;
+pub use accel::wide::BuildPhases;
 pub use camera::{Camera, Projection, ThinLens};
 pub use geometry::{Aabb, Shape};
 pub use light::sampler::CubeDistribution;

@@ -18,11 +18,15 @@
 //! collapses the top three levels of their binary tree into one wide node.
 
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::OnceLock;
 
 use rayon::prelude::*;
+use web_time::{Duration, Instant};
 
 use crate::accel::isa::Isa;
-use crate::accel::wide::{ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH};
+use crate::accel::wide::{
+    BuildPhases, ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH,
+};
 use crate::accel::{pages, simd};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
@@ -777,6 +781,8 @@ struct Subtree {
 struct Builder {
     config: Config,
     method: SplitMethod,
+    /// How long the root node's splits took, set once by the root's `subtree`.
+    top_splits: OnceLock<Duration>,
 }
 
 impl Builder {
@@ -855,6 +861,8 @@ impl Builder {
                 (0.0, c.bounds.half_area())
             }
         };
+        // Timed at the root only (a clock read at every node would cost more than it tells).
+        let splits_start = (depth == 0).then(Instant::now);
         let mut slots = [record; WIDTH];
         let mut len = 1;
         while len < WIDTH {
@@ -879,6 +887,9 @@ impl Builder {
         }
         let children = &mut slots[..len];
         children.sort_unstable_by_key(|c| c.start);
+        if let Some(splits_start) = splits_start {
+            let _ = self.top_splits.set(splits_start.elapsed());
+        }
 
         let node_index = nodes.len();
         nodes.push(WideNode::EMPTY);
@@ -960,6 +971,7 @@ pub fn build(shapes: &[Shape]) -> WideBvh {
 /// Builds the wide BVH of `shapes` with the binary splits of `method`, on the current rayon
 /// pool. Any method finds the same closest hits (ties in t go to the lowest index as given).
 pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
+    let start = Instant::now();
     // Whether every shape is a triangle, noted while the shapes are read for their boxes: a
     // pass of its own, serial, was 2-4 ms of igea-sub4's build (1.07M triangles).
     let other_shapes = AtomicBool::new(false);
@@ -981,19 +993,27 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         .collect();
     let config = Config::for_shapes(!other_shapes.into_inner());
     let (bounds, centroids) = measure_chunked(&prims, false);
+    let boxes = start.elapsed();
+    let builder = Builder {
+        config,
+        method,
+        top_splits: OnceLock::new(),
+    };
+    let mut root_binning = Duration::ZERO;
     let mut nodes = pages::vec_with_capacity(node_capacity(prims.len()));
     let root = if prims.is_empty() {
         ChildRef::EMPTY
     } else {
         let mut record = Record::root(prims.len(), (bounds, centroids));
         let mut bins = Bins::new();
-        if method == SplitMethod::Sah && record.len() > config.min_leaf {
-            record.split = find_split(&prims, &record, &config, &mut bins);
+        if method == SplitMethod::Sah && record.len() > builder.config.min_leaf {
+            record.split = find_split(&prims, &record, &builder.config, &mut bins);
         }
-        let builder = Builder { config, method };
+        root_binning = start.elapsed() - boxes;
         builder.subtree(&mut prims, 0, record, 0, &mut nodes, &mut bins)
     };
-    pack(
+    let built = start.elapsed();
+    let mut bvh = pack(
         shapes,
         &prims,
         nodes,
@@ -1003,7 +1023,16 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         } else {
             bounds.aabb()
         },
-    )
+    );
+    // The root's own binning counts among its splits.
+    let top_splits = root_binning + builder.top_splits.get().copied().unwrap_or_default();
+    bvh.phases = BuildPhases {
+        boxes,
+        top_splits,
+        subtrees: (built - boxes).saturating_sub(top_splits),
+        pack: start.elapsed() - built,
+    };
+    bvh
 }
 
 /// A block to make: its leaf's first primitive, the leaf's count, which block of the leaf.
@@ -1169,6 +1198,7 @@ fn pack(
         shapes: others,
         source: lane_source,
         isa: Isa::detect(),
+        phases: BuildPhases::default(),
     }
 }
 
@@ -1664,6 +1694,40 @@ mod tests {
             for threads in [2, 3] {
                 assert!(tree(threads) == one, "{threads} threads");
             }
+        }
+    }
+
+    /// The phases of a build (`BuildPhases`, which `--stats` prints) are each measured and
+    /// together no longer than the build, on one thread and on two (where the root's
+    /// children are built apart).
+    #[test]
+    fn the_build_phases_divide_the_build_time() {
+        let mut r = Rng(0x2c9b_41d7_06e3_f5a8);
+        let shapes: Vec<Shape> = (0..3 * MEASURE_CHUNK)
+            .map(|_| {
+                let a = Vec3::new(r.f32() * 4.0, r.f32() * 4.0, r.f32());
+                let mut corner = || a + Vec3::new(r.f32(), r.f32(), r.f32()) * 0.05;
+                Shape::Triangle {
+                    vertices: [a, corner(), corner()],
+                }
+            })
+            .collect();
+        for threads in [1, 2] {
+            let pool = pool(threads);
+            let start = Instant::now();
+            let bvh = pool.install(|| build_with(&shapes, SplitMethod::Sah));
+            let whole = start.elapsed();
+            let p = bvh.phases;
+            for (name, phase) in [
+                ("boxes", p.boxes),
+                ("root splits", p.top_splits),
+                ("subtrees", p.subtrees),
+                ("blocks", p.pack),
+            ] {
+                assert!(phase > Duration::ZERO, "{name}, {threads} threads: {p:?}");
+            }
+            let sum = p.boxes + p.top_splits + p.subtrees + p.pack;
+            assert!(sum <= whole, "{threads} threads: {p:?} in {whole:?}");
         }
     }
 

@@ -6,7 +6,7 @@
 use rayon::prelude::*;
 
 use crate::accel::build::SplitMethod;
-use crate::accel::wide::{TreeStats, WalkCounts, BLOCK};
+use crate::accel::wide::{BuildPhases, TreeStats, WalkCounts, BLOCK};
 use crate::accel::{LocalHit, WideBvh, PACKET};
 use crate::bvh::Bvh;
 use crate::geometry::{Aabb, Shape};
@@ -354,6 +354,8 @@ pub struct BottomLevelStats {
     /// Their SAH costs averaged with each tree weighted by its primitives (for one geometry,
     /// its tree's cost).
     pub sah_cost: f64,
+    /// The primitives of the tree with the most, and how long each phase of its build took.
+    pub largest: Option<(usize, BuildPhases)>,
 }
 
 /// Which structure the bottom level (one per geometry) is built as.
@@ -467,6 +469,11 @@ impl Instances {
                 let primitives = g.primitive_count();
                 weighted += t.sah_cost * primitives as f64;
                 weights += primitives;
+                if let Blas::Wide(bvh) = &g.blas {
+                    if out.largest.is_none_or(|(most, _)| primitives > most) {
+                        out.largest = Some((primitives, bvh.phases));
+                    }
+                }
             }
         }
         out.sah_cost = if weights > 0 {

@@ -7,7 +7,7 @@ use web_time::{Duration, Instant};
 
 use crate::accel::build::SplitMethod;
 use crate::accel::instances::{AccelKind, AccelStats, Geometry, Hit, Instances, PreliminaryHit};
-use crate::accel::wide::WalkCounts;
+use crate::accel::wide::{BuildPhases, WalkCounts};
 use crate::accel::PACKET;
 use crate::camera::Camera;
 use crate::geometry::{Aabb, PrimitiveHit};
@@ -65,6 +65,9 @@ pub struct BvhStats {
     /// Expected node visits plus block (or shape) tests for a ray meeting a tree's root box,
     /// by the surface area heuristic; averaged over the trees weighted by their primitives.
     pub sah_cost: f64,
+    /// The primitives of the wide tree with the most, and how long each phase of its build
+    /// took; `None` without wide trees.
+    pub largest: Option<(usize, BuildPhases)>,
 }
 
 /// A scene ready to trace. Built once from `SceneParts`; immutable and shared by all threads.
@@ -189,6 +192,7 @@ impl Scene {
             leaves: trees.leaves,
             depth: trees.depth,
             sah_cost: trees.sah_cost,
+            largest: trees.largest,
         }
     }
 

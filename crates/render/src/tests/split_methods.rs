@@ -181,3 +181,52 @@ fn spatial_median_depth_stays_bounded_on_geometric_clusters() {
         );
     }
 }
+
+/// `--stats` prints the build phases of the tree with the most primitives: here the second
+/// of three geometries, each instanced once.
+#[test]
+fn the_build_phases_shown_are_the_largest_trees() {
+    use crate::sampling::Rng;
+    use crate::{
+        Background, Camera, ColorSource, GeometryDesc, Instance, Material, Projection, Scene,
+        SceneParts,
+    };
+    let mut r = rng(21);
+    let geometry = |count: usize, r: &mut Rng| {
+        let shapes = shapes_of(&random_soup(r, count));
+        GeometryDesc {
+            materials: vec![0; shapes.len()],
+            shapes,
+        }
+    };
+    let scene = Scene::new(SceneParts {
+        camera: Camera::new(Projection::Perspective, Vec3::Z, -Vec3::Z, 1.0, 1.0),
+        materials: vec![Material::Lambertian {
+            diffuse: ColorSource::constant(Vec3::splat(0.5)),
+        }],
+        textures: vec![],
+        lights: vec![],
+        background: Background::Color(Vec3::ZERO),
+        geometries: vec![
+            geometry(40, &mut r),
+            geometry(700, &mut r),
+            geometry(300, &mut r),
+        ],
+        instances: (0..3)
+            .map(|geometry| Instance {
+                geometry,
+                transform: None,
+                material: None,
+                casts_shadow: true,
+            })
+            .collect(),
+    });
+    let stats = scene.bvh_stats();
+    assert_eq!(stats.trees, 3);
+    let (primitives, phases) = stats.largest.expect("wide trees");
+    assert_eq!(primitives, 700);
+    assert!(
+        phases.subtrees + phases.pack > std::time::Duration::ZERO,
+        "{phases:?}"
+    );
+}
