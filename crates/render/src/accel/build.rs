@@ -970,7 +970,14 @@ pub fn build(shapes: &[Shape]) -> WideBvh {
 
 /// Builds the wide BVH of `shapes` with the binary splits of `method`, on the current rayon
 /// pool. Any method finds the same closest hits (ties in t go to the lowest index as given).
+#[cfg(any(test, feature = "bench"))]
 pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
+    build_timed(shapes, method).0
+}
+
+/// `build_with`, and how long each phase of the build took (what `--stats` prints; kept out
+/// of the tree, which is the same whatever the timings).
+pub(crate) fn build_timed(shapes: &[Shape], method: SplitMethod) -> (WideBvh, BuildPhases) {
     let start = Instant::now();
     // Whether every shape is a triangle, noted while the shapes are read for their boxes: a
     // pass of its own, serial, was 2-4 ms of igea-sub4's build (1.07M triangles).
@@ -1013,7 +1020,7 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
         builder.subtree(&mut prims, 0, record, 0, &mut nodes, &mut bins)
     };
     let built = start.elapsed();
-    let mut bvh = pack(
+    let bvh = pack(
         shapes,
         &prims,
         nodes,
@@ -1026,13 +1033,13 @@ pub fn build_with(shapes: &[Shape], method: SplitMethod) -> WideBvh {
     );
     // The root's own binning counts among its splits.
     let top_splits = root_binning + builder.top_splits.get().copied().unwrap_or_default();
-    bvh.phases = BuildPhases {
+    let phases = BuildPhases {
         boxes,
         top_splits,
         subtrees: (built - boxes).saturating_sub(top_splits),
         pack: start.elapsed() - built,
     };
-    bvh
+    (bvh, phases)
 }
 
 /// A block to make: its leaf's first primitive, the leaf's count, which block of the leaf.
@@ -1198,7 +1205,6 @@ fn pack(
         shapes: others,
         source: lane_source,
         isa: Isa::detect(),
-        phases: BuildPhases::default(),
     }
 }
 
@@ -1715,9 +1721,8 @@ mod tests {
         for threads in [1, 2] {
             let pool = pool(threads);
             let start = Instant::now();
-            let bvh = pool.install(|| build_with(&shapes, SplitMethod::Sah));
+            let (_, p) = pool.install(|| build_timed(&shapes, SplitMethod::Sah));
             let whole = start.elapsed();
-            let p = bvh.phases;
             for (name, phase) in [
                 ("boxes", p.boxes),
                 ("root splits", p.top_splits),

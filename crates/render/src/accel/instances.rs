@@ -44,6 +44,8 @@ pub(crate) struct Geometry {
     /// The unit geometric normal of each triangle by primitive index (`Shape::normal`,
     /// computed once at build rather than at every hit); zero for other primitives.
     pub normals: Vec<Vec3>,
+    /// How long each phase of the wide BVH's build took; `None` for the binary reference.
+    pub phases: Option<BuildPhases>,
 }
 
 /// A bottom-level structure: the wide BVH, or the reference binary BVH over the shapes.
@@ -97,7 +99,7 @@ impl Geometry {
     fn build(desc: GeometryDesc, accel: AccelKind, split: SplitMethod) -> Geometry {
         match accel {
             AccelKind::Wide => {
-                let bvh = crate::accel::build::build_with(&desc.shapes, split);
+                let (bvh, phases) = crate::accel::build::build_timed(&desc.shapes, split);
                 let materials = Materials::new(&desc.materials, &bvh.source);
                 // Each primitive slot's `triangle_normal(&bvh.shape(p))`, read from the blocks
                 // directly rather than through a `Shape` per slot, a block a task (serial, this
@@ -119,6 +121,7 @@ impl Geometry {
                     blas: Blas::Wide(bvh),
                     materials,
                     normals,
+                    phases: Some(phases),
                 }
             }
             AccelKind::Binary => {
@@ -135,6 +138,7 @@ impl Geometry {
                     },
                     materials,
                     normals,
+                    phases: None,
                 }
             }
         }
@@ -469,9 +473,9 @@ impl Instances {
                 let primitives = g.primitive_count();
                 weighted += t.sah_cost * primitives as f64;
                 weights += primitives;
-                if let Blas::Wide(bvh) = &g.blas {
+                if let Some(phases) = g.phases {
                     if out.largest.is_none_or(|(most, _)| primitives > most) {
-                        out.largest = Some((primitives, bvh.phases));
+                        out.largest = Some((primitives, phases));
                     }
                 }
             }

@@ -189,8 +189,6 @@ pub struct WideBvh {
     /// (`simd.rs`, `SlabMargin`; read only where that walk exists).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub(crate) magnitude: f32,
-    /// How long each phase of the build took.
-    pub(crate) phases: BuildPhases,
 }
 
 /// Wall time of each phase of one tree's build (`--stats`): reading the shapes' boxes and
