@@ -5,8 +5,8 @@
 # all threads (bench/scaling.py), the machine's own ceiling (16 single-thread copies at once)
 # and the stage times of two 16-thread frames. Each part has a time limit, so that the call
 # ends within the 600 s a command may run; what ran is in $OUT (machine.txt, embree.txt,
-# scaling.txt, ceiling.txt, stages.txt (with the largest tree's build phases), align.txt: single rays by the stack's alignment, see
-# align_sweep), and printed.
+# scaling.txt, ceiling.txt, stages.txt (with the largest tree's build phases), align.txt:
+# single rays by the stack's alignment, see align_sweep), and printed.
 #
 # Options by environment: EC (embree_compare.sh's, default "--rounds 3 --repeat 2"), SC
 # (scaling.py's, default "--rounds 3"), CE (the ceiling's, default "--size 0.5 --rounds 2"),
@@ -79,8 +79,8 @@ el stages
 # vector and the walk reads back 4 bytes at a time (store forwarding; 16-byte aligned only).
 # The same run with an environment 0, 16, 32 and 48 bytes longer (the buffer at each of the
 # four 16-byte places in a 64-byte line, one of them split across two lines), alternating,
-# AL_ROUNDS times (limit AL_S, default 40 s): Mrays/s by padding. On the Zen 4 here: no pattern (5.1-5.5
-# Mrays/s on the dragon's bounce rays at every padding, three rounds).
+# AL_ROUNDS times (limit AL_S, default 40 s): Mrays/s by padding. On the Zen 4 here: no
+# pattern (5.1-5.5 Mrays/s on the dragon's bounce rays at every padding, three rounds).
 align_sweep() {
   for set in dragon.bounce stanford-bunny.primary; do
     mesh=$(find "$SHARED/models" "$SHARED/scenes" -name "${set%%.*}.*" \( -name '*.obj' -o -name '*.ply' \) | head -1)

@@ -89,8 +89,7 @@ mod pipeline;
 mod tests;
 
 // The scene a loader builds, in plain data.
-pub use accel::build::SplitMethod;
-pub use accel::wide::BuildPhases;
+pub use accel::build::{BuildPhases, SplitMethod};
 pub use camera::{Camera, Projection, ThinLens};
 pub use geometry::{Aabb, Shape};
 pub use light::sampler::CubeDistribution;

@@ -24,9 +24,7 @@ use rayon::prelude::*;
 use web_time::{Duration, Instant};
 
 use crate::accel::isa::Isa;
-use crate::accel::wide::{
-    BuildPhases, ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH,
-};
+use crate::accel::wide::{ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH};
 use crate::accel::{pages, simd};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
@@ -785,6 +783,18 @@ struct Builder {
     top_splits: OnceLock<Duration>,
 }
 
+/// Wall time of each phase of one tree's build (`--stats`): reading the shapes' boxes and
+/// measuring them; the root node's splits (its binary splits bin and partition the whole set
+/// before any subtree can run apart, the part of the build that gains least from threads);
+/// the subtrees below the root; packing the leaves' triangles into blocks.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BuildPhases {
+    pub boxes: Duration,
+    pub top_splits: Duration,
+    pub subtrees: Duration,
+    pub pack: Duration,
+}
+
 impl Builder {
     fn leaf(
         &self,
@@ -1067,7 +1077,7 @@ fn leaf_runs(
     // In two passes over the nodes, `LEAF_RUN_NODES` a task: how many blocks and shapes each
     // run of nodes holds; then, each run starting where those before it end (their running
     // sums), its leaves turned and their blocks and shapes written in place. Serial, this
-    // pass was 4.5-7 ms of igea-sub4's build on any number of threads.
+    // pass was 4.5-10 ms of igea-sub4's build on any number of threads.
     const LEAF_RUN_NODES: usize = 256;
     let leaf = |r: ChildRef| r.is_leaf() && r != ChildRef::EMPTY;
     // The blocks and the shapes of one child.
@@ -1209,8 +1219,9 @@ fn pack(
 }
 
 /// `WideBvh::magnitude`: the largest |plane| of the children's boxes (empty slots left out), ∞
-/// where one is infinite or NaN. On the pool, 1024 nodes a task (serial, this was 2.5 ms of igea-sub4's build on any number
-/// of threads); the maximum does not depend on the order the nodes are taken in.
+/// where one is infinite or NaN. On the pool, 1024 nodes a task (serial, with a branch per
+/// plane, this was 3.6-3.8 ms of igea-sub4's build on any number of threads); the maximum
+/// does not depend on the order the nodes are taken in.
 pub(crate) fn plane_magnitude(nodes: &[WideNode]) -> f32 {
     nodes
         .par_iter()

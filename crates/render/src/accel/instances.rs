@@ -5,8 +5,8 @@
 
 use rayon::prelude::*;
 
-use crate::accel::build::SplitMethod;
-use crate::accel::wide::{BuildPhases, TreeStats, WalkCounts, BLOCK};
+use crate::accel::build::{BuildPhases, SplitMethod};
+use crate::accel::wide::{TreeStats, WalkCounts, BLOCK};
 use crate::accel::{LocalHit, WideBvh, PACKET};
 use crate::bvh::Bvh;
 use crate::geometry::{Aabb, Shape};

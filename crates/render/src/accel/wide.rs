@@ -24,8 +24,6 @@
 //! `simd::node_test`), which changes no hit. A block hit carries its barycentrics, so a
 //! closest hit needs no second triangle test (`finish` serves the preliminary hits).
 
-use web_time::Duration;
-
 use crate::accel::isa::Isa;
 use crate::accel::triangle::{self, WoopRay};
 use crate::geometry::{Aabb, Shape};
@@ -189,18 +187,6 @@ pub struct WideBvh {
     /// (`simd.rs`, `SlabMargin`; read only where that walk exists).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub(crate) magnitude: f32,
-}
-
-/// Wall time of each phase of one tree's build (`--stats`): reading the shapes' boxes and
-/// measuring them; the root node's splits (its binary splits bin and partition the whole set
-/// before any subtree can run apart, the part of the build that gains least from threads);
-/// the subtrees below the root; packing the leaves' triangles into blocks.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct BuildPhases {
-    pub boxes: Duration,
-    pub top_splits: Duration,
-    pub subtrees: Duration,
-    pub pack: Duration,
 }
 
 /// The closest hit inside one bottom-level structure.

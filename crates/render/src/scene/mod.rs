@@ -5,9 +5,9 @@
 // std's clock natively; in the browser std has none (`web_time` is std's re-export elsewhere).
 use web_time::{Duration, Instant};
 
-use crate::accel::build::SplitMethod;
+use crate::accel::build::{BuildPhases, SplitMethod};
 use crate::accel::instances::{AccelKind, AccelStats, Geometry, Hit, Instances, PreliminaryHit};
-use crate::accel::wide::{BuildPhases, WalkCounts};
+use crate::accel::wide::WalkCounts;
 use crate::accel::PACKET;
 use crate::camera::Camera;
 use crate::geometry::{Aabb, PrimitiveHit};
