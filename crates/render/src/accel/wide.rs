@@ -743,6 +743,22 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
     closest_prepared(kernel, bvh, ray, box_ray, stack)
 }
 
+/// The box test's entry distances, which the AVX2 kernels store as one 32-byte vector and the
+/// walks read back one lane at a time: 32-byte aligned. Intel cores forward a 32-byte store to
+/// narrower loads inside it only when the store is aligned (Agner Fog's microarchitecture
+/// manual, Skylake on); else each load waits for the store to reach the cache. On the stack's
+/// 16-byte alignment, which the kernel moves by a random multiple of 16 bytes for every
+/// process, half the processes got an unaligned buffer, and the lent Xeon's single rays ran at
+/// two speeds from one run of the same binary to the next (the bunny's primary rays 8.4 or
+/// 10.6 Mrays/s, 5 runs of 12 slow; `bench/README.md`, twenty-eighth pass). The Zen 4 forwards
+/// either way.
+#[repr(C, align(32))]
+struct EntryDistances([f32; WIDTH]);
+
+const _: () = assert!(
+    std::mem::size_of::<EntryDistances>() == 32 && std::mem::align_of::<EntryDistances>() == 32
+);
+
 /// `closest` for a valid ray whose box-test constants the caller made (`Kernel::prepare_box`).
 #[inline(always)]
 pub(crate) fn closest_prepared<K: Kernel, S: Stack>(
@@ -752,7 +768,8 @@ pub(crate) fn closest_prepared<K: Kernel, S: Stack>(
     box_ray: K::BoxRay,
     stack: &mut S,
 ) -> Option<LocalHit> {
-    let mut entry = [0.0f32; WIDTH];
+    let mut entry = EntryDistances([0.0; WIDTH]);
+    let entry = &mut entry.0;
     let mut current = bvh.root;
     // Entries below `sp` are waiting; those beyond the closest hit so far are dropped.
     let mut sp = 0usize;
@@ -765,7 +782,7 @@ pub(crate) fn closest_prepared<K: Kernel, S: Stack>(
         &mut current,
         &mut sp,
         stack,
-        &mut entry,
+        entry,
     ) {
         return None;
     }
@@ -807,7 +824,7 @@ pub(crate) fn closest_prepared<K: Kernel, S: Stack>(
             &mut current,
             &mut sp,
             stack,
-            &mut entry,
+            entry,
         );
         if !more {
             return (best.primitive != u32::MAX).then_some(best);
@@ -839,7 +856,8 @@ pub(crate) fn any_prepared<K: Kernel, S: Stack>(
     box_ray: K::BoxRay,
     stack: &mut S,
 ) -> bool {
-    let mut entry = [0.0f32; WIDTH];
+    let mut entry = EntryDistances([0.0; WIDTH]);
+    let entry = &mut entry.0;
     let mut current = bvh.root;
     let mut sp = 0usize;
     let t_max = ray.t_max;
@@ -854,7 +872,7 @@ pub(crate) fn any_prepared<K: Kernel, S: Stack>(
         &mut current,
         &mut sp,
         stack,
-        &mut entry,
+        entry,
     ) {
         return false;
     }
@@ -883,7 +901,7 @@ pub(crate) fn any_prepared<K: Kernel, S: Stack>(
             &mut current,
             &mut sp,
             stack,
-            &mut entry,
+            entry,
         );
         if !more {
             return false;
