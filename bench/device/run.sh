@@ -6,11 +6,12 @@
 # and the stage times of two 16-thread frames. Each part has a time limit, so that the call
 # ends within the 600 s a command may run; what ran is in $OUT (machine.txt, embree.txt,
 # scaling.txt, ceiling.txt, stages.txt (with the largest tree's build phases), align.txt:
-# single rays by the stack's alignment, see align_sweep), and printed.
+# each glint's single rays by the stack's place in a cache line, see align_sweep), and printed.
 #
 # Options by environment: EC (embree_compare.sh's, default "--rounds 3 --repeat 2"), SC
 # (scaling.py's, default "--rounds 3"), CE (the ceiling's, default "--size 0.5 --rounds 2"),
-# and EC_S, SC_S, CE_S, their limits in seconds (290, 150, 60); EC_GLINTS, the glints
+# and EC_S, SC_S, CE_S, their limits in seconds (290, 150, 60; CE_S=0 skips the ceiling, which
+# `SC="--copies ..."` measures in the frames' own rounds); EC_GLINTS, the glints
 # embree_compare.sh runs (default all of them, comma-separated paths under target/device/bin,
 # each perhaps with @WALK: `bench rays --walk WALK`).
 #
@@ -19,7 +20,8 @@
 # embree_compare.sh made (PF_SETS, default "dragon.bounce stanford-bunny.primary"): `perf
 # stat` of each process (task-clock, and cycles, instructions, branch and cache misses where
 # the machine's PMU counts them: clock rate and IPC on that core) and `perf record` samples of
-# each (cpu-clock), all in $OUT/prof.tar. Read here: `perf buildid-cache -a GLINT` (the
+# each (cpu-clock), all in $OUT/prof.tar with their summary (profile.txt; a call brings back
+# eight files at most). Read here: `perf buildid-cache -a GLINT` (the
 # unstripped binary packed), then `perf report -i FILE.data` or `perf annotate -i FILE.data`.
 set -u
 cd "$(dirname "$0")/../.."
@@ -60,12 +62,14 @@ PYTHONUNBUFFERED=1 timeout "${SC_S:-150}" python3 bench/scaling.py --glint "$GLI
   --shared "$SHARED" --threads "1,$THREADS" ${SC:---rounds 3} > "$OUT/scaling.txt" 2>&1
 cat "$OUT/scaling.txt"
 el scaling
-# shellcheck disable=SC2086
-PYTHONUNBUFFERED=1 timeout "${CE_S:-60}" python3 bench/scaling.py --glint "$FIRST" \
-  --shared "$SHARED" --ceiling --threads "1,$THREADS" ${CE:---size 0.5 --rounds 2} \
-  > "$OUT/ceiling.txt" 2>&1
-cat "$OUT/ceiling.txt"
-el ceiling
+if [ "${CE_S:-60}" != 0 ]; then
+  # shellcheck disable=SC2086
+  PYTHONUNBUFFERED=1 timeout "${CE_S:-60}" python3 bench/scaling.py --glint "$FIRST" \
+    --shared "$SHARED" --ceiling --threads "1,$THREADS" ${CE:---size 0.5 --rounds 2} \
+    > "$OUT/ceiling.txt" 2>&1
+  cat "$OUT/ceiling.txt"
+  el ceiling
+fi
 C=$SHARED/scenes/course/willemsen
 for s in scenes_A/spheres_1K.xml:9 scenes_B/StanfordDragon_Instanced.json:16; do
   echo "${s%%:*}, $THREADS threads: $("$FIRST" render "$C/${s%%:*}" -w 1024 -h 1024 -r "${s##*:}" \
@@ -74,31 +78,43 @@ for s in scenes_A/spheres_1K.xml:9 scenes_B/StanfordDragon_Instanced.json:16; do
 done | tee "$OUT/stages.txt"
 el stages
 # The stack's alignment: the single-ray walks run on the main thread (`--threads 1`), whose
-# stack starts below the environment, so the environment's size moves every frame, among them
-# the closest-hit walk's buffer of entry distances, which the box test writes as one 32-byte
-# vector and the walk reads back 4 bytes at a time (store forwarding; 16-byte aligned only).
-# The same run with an environment 0, 16, 32 and 48 bytes longer (the buffer at each of the
-# four 16-byte places in a 64-byte line, one of them split across two lines), alternating,
-# AL_ROUNDS times (limit AL_S, default 40 s): Mrays/s by padding. On the Zen 4 here: no
-# pattern (5.1-5.5 Mrays/s on the dragon's bounce rays at every padding, three rounds).
+# stack starts below the environment, so the environment's size moves every frame. Before the
+# twenty-eighth pass the closest-hit walk's buffer of entry distances (written as one 32-byte
+# vector, read back 4 bytes at a time) had the stack's 16-byte alignment only, and Intel cores
+# forward a 32-byte store to narrower loads only when it is 32-byte aligned (the buffer is now,
+# whatever the stack). The kernel also moves the stack by a random multiple of 16 bytes for
+# every process (ASLR), which padding the environment alone does not undo (the sweeps of the
+# twenty-sixth and twenty-seventh passes measured random places; gdb, used to check them, turns
+# ASLR off). So each run goes under `setarch -R` (ASLR off for that process) where the machine
+# allows it: an environment 0, 16, 32 and 48 bytes longer then puts the stack at each of the
+# four 16-byte places in a 64-byte line: a build before the twenty-eighth pass, packed beside
+# HEAD, should run slow at two of them and HEAD at none. Every glint packed, the paddings
+# alternating, AL_ROUNDS times (limit AL_S, default 40 s): Mrays/s by padding.
 align_sweep() {
+  norand=(setarch "$(uname -m)" -R)
+  "${norand[@]}" true 2> /dev/null || {
+    echo "setarch -R refused here: ASLR stays on, so the paddings are random places"
+    norand=()
+  }
   for set in dragon.bounce stanford-bunny.primary; do
     mesh=$(find "$SHARED/models" "$SHARED/scenes" -name "${set%%.*}.*" \( -name '*.obj' -o -name '*.ply' \) | head -1)
     [ -n "$mesh" ] && [ -f "$RAYS/$set.rays" ] || continue
     for round in $(seq "${AL_ROUNDS:-3}"); do
-      line="$set round $round:"
-      for pad in 0 16 32 48; do
-        rate=$(env GLINT_PAD="$(head -c "$pad" /dev/zero | tr '\0' a)" "$FIRST" bench rays \
-          --mesh "$mesh" --rays "$RAYS/$set.rays" --threads 1 --repeat 3 | tail -1 \
-          | python3 -c 'import json, sys; print(json.load(sys.stdin)["mrays_per_s"])')
-        line="$line pad $pad $rate"
+      for glint in ${GLINTS//,/ }; do
+        line="$set $(basename "$glint") round $round:"
+        for pad in 0 16 32 48; do
+          rate=$(env GLINT_PAD="$(head -c "$pad" /dev/zero | tr '\0' a)" "${norand[@]}" "$glint" \
+            bench rays --mesh "$mesh" --rays "$RAYS/$set.rays" --threads 1 --repeat 3 | tail -1 \
+            | python3 -c 'import json, sys; print(json.load(sys.stdin)["mrays_per_s"])')
+          line="$line pad $pad $rate"
+        done
+        echo "$line"
       done
-      echo "$line"
     done
   done
 }
 export -f align_sweep
-export FIRST RAYS SHARED
+export GLINTS RAYS SHARED
 timeout "${AL_S:-40}" bash -c align_sweep | tee "$OUT/align.txt"
 el align
 if [ -n "$PERF_BIN" ]; then
@@ -124,7 +140,7 @@ if [ -n "$PERF_BIN" ]; then
   }
   export -f perf_run profile
   export PERF_BIN D P EVENTS FIRST EMBREE RAYS SHARED
-  timeout "${PF_S:-70}" bash -c profile | tee "$OUT/profile.txt"
+  timeout "${PF_S:-70}" bash -c profile | tee "$P/profile.txt"
   tar cf "$OUT/prof.tar" -C "$P" .
   el profile
 fi
