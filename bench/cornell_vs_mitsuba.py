@@ -18,7 +18,10 @@ For the Cornell box of ../shared/refs/cornell at 256x256, in one run on this mac
      it runs under a wrapper that reads the same two time.time() calls in full) and, as a
      second ratio, with the best wall time of Mitsuba's whole
      process (Python start and import included, so that one favours Glint).
-Prints both times and their ratio (below 1: Glint reaches Mitsuba's quality in less time).
+Prints both times and their ratio (below 1: Glint reaches Mitsuba's quality in less time), and
+the median of the rounds' own ratios (each Glint run against the Mitsuba run just before it),
+which a change in the machine's load between rounds moves less than two best times taken from
+different rounds.
 
 Glint runs as `glint render SCENE --integrator path --spp N --seed S -w 256 -h 256 -o OUT.exr`.
 
@@ -31,6 +34,7 @@ import math
 import os
 import re
 import shutil
+import statistics
 import subprocess
 import sys
 import tempfile
@@ -199,13 +203,14 @@ def main():
         # which Mitsuba's kernel cache makes comparable, enters.
         mitsuba_seconds, glint_seconds = first_seconds, math.inf
         mitsuba_process_seconds = math.inf
+        round_ratios = []
         for _ in range(args.repeats):
             seconds, process_seconds, _ = run_mitsuba(work)
             mitsuba_seconds = min(mitsuba_seconds, seconds)
             mitsuba_process_seconds = min(mitsuba_process_seconds, process_seconds)
-            glint_seconds = min(
-                glint_seconds, glint.render(spp, 1, os.path.join(work, "timed.exr"))
-            )
+            glint_round = glint.render(spp, 1, os.path.join(work, "timed.exr"))
+            glint_seconds = min(glint_seconds, glint_round)
+            round_ratios.append(glint_round / seconds)
     finally:
         shutil.rmtree(work, ignore_errors=True)
 
@@ -234,6 +239,11 @@ def main():
     print(
         f"  whole process against whole process: "
         f"{glint_seconds / mitsuba_process_seconds:.3f}"
+    )
+    print(
+        f"  round by round (Glint's run / the Mitsuba run before it): median "
+        f"{statistics.median(round_ratios):.3f}, from {min(round_ratios):.3f} to "
+        f"{max(round_ratios):.3f}"
     )
 
 
