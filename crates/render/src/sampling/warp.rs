@@ -30,13 +30,17 @@ pub fn sample_uniform_disk_concentric(u1: f32, u2: f32) -> (f32, f32) {
         return (0.0, 0.0);
     }
     // r·(cos θ, sin θ) with θ = π/4 · oy/ox, or θ = π/2 − a with a = π/4 · ox/oy, where
-    // cos θ = sin a and sin θ = cos a: either way the angle that enters is within ±π/4.
-    if ox.abs() > oy.abs() {
-        let (sin, cos) = sin_cos_quarter_pi(std::f32::consts::FRAC_PI_4 * (oy / ox));
-        (ox * cos, ox * sin)
+    // cos θ = sin a and sin θ = cos a: either way the angle that enters is within ±π/4. The
+    // two cases are one computation on swapped inputs and outputs, chosen by selects: which
+    // case a sample falls in is a coin toss that a branch would mispredict half the time.
+    let swap = ox.abs() <= oy.abs();
+    let (r, other) = if swap { (oy, ox) } else { (ox, oy) };
+    let (sin, cos) = sin_cos_quarter_pi(std::f32::consts::FRAC_PI_4 * (other / r));
+    let (x, y) = (r * cos, r * sin);
+    if swap {
+        (y, x)
     } else {
-        let (sin, cos) = sin_cos_quarter_pi(std::f32::consts::FRAC_PI_4 * (ox / oy));
-        (oy * sin, oy * cos)
+        (x, y)
     }
 }
 
