@@ -13,7 +13,7 @@
 //! samples or more, and each path goes on from its given first hit: the same hits, so the same
 //! image as ray by ray (`crates/io/tests/packet_frames.rs`).
 //!
-//! Every random number is a function of (seed, pixel, sample, dimension) (`path_sampler.rs`:
+//! Every random number is a function of (seed, pixel, sample, dimension) (`sampling/sobol.rs`:
 //! scrambled Sobol' points stratified over the pixel's samples, then the sample's own PCG
 //! stream, keyed as the course renderer keys it), so the image is bit-identical for any thread
 //! count, and nothing on the per-sample path allocates: the BSDF lives on the stack and the
@@ -177,7 +177,7 @@ impl PathIntegrator {
     ) -> Color {
         let ray = unit_ray(camera_ray);
         let dimension = first_path_dimension(scene);
-        sampler.prepare([dimension, dimension + 3]);
+        sampler.prepare(dimension);
         self.trace_unit(scene, ray, None, sampler, rays, first_hit)
     }
 
@@ -210,10 +210,10 @@ impl PathIntegrator {
             // Each vertex draws its numbers from its own block of dimensions, so a pixel's
             // samples are stratified against each other vertex by vertex.
             let dimension = first_dimension + DIMENSIONS_PER_VERTEX * depth;
-            // The light's and the direction's numbers do not depend on the hit: their work
+            // The direction's and the light's numbers do not depend on the hit: their work
             // can run beside the traversal (the first vertex's is the caller's).
             if depth > 0 {
-                sampler.prepare([dimension, dimension + 3]);
+                sampler.prepare(dimension);
             }
             *rays += 1;
             let found = match given.take() {
@@ -316,22 +316,19 @@ impl PathIntegrator {
             // does not depend on the light sample: all of it ahead of the shadow ray, so that
             // its arithmetic overlaps the light sample's instead of waiting for the shadow
             // ray's traversal.
-            let nee = bsdf.has_non_specular();
-            let u_light = if nee {
-                sampler.sample_2d(dimension)
-            } else {
-                (0.5, 0.5)
-            };
+            // The direction and the light sample are one four-dimensional point (stratified
+            // together, and one index shuffle for both), drawn whether or not the light
+            // sample is used.
+            let [u_direction, u_light] = sampler.sample_4d(dimension);
             let u_lobe = if bsdf.uses_lobe_sample() {
-                sampler.sample_1d(dimension + 2)
+                sampler.sample_1d(dimension + 4)
             } else {
                 0.5
             };
-            let u_direction = sampler.sample_2d(dimension + 3);
             let continuation = bsdf.sample(wo, u_lobe, u_direction);
 
             // Next-event estimation: one light, chosen by power, one point on it.
-            if nee {
+            if bsdf.has_non_specular() {
                 if let Some(sample) = self.lights.sample(scene, si.point, u_light) {
                     let wi = frame.to_local(sample.direction);
                     let (f, scattering_pdf) = bsdf.eval_and_pdf(wo, wi);
@@ -403,7 +400,7 @@ impl Integrator for PathIntegrator {
                 None => (0.5, 0.5),
             };
             let ray = unit_ray(&pixel.camera_ray(scene, ox, oy, lens));
-            sampler.prepare([dimension, dimension + 3]);
+            sampler.prepare(dimension);
             (ray, sampler)
         };
         let mut emit = |radiance: Color, first_hit: FirstHit| {
@@ -468,5 +465,6 @@ pub fn first_path_dimension(scene: &Scene) -> u32 {
         None => FIRST_PATH_DIMENSION,
     }
 }
-/// Per path vertex: light and point on it (2), lobe, direction (2), roulette.
+/// Per path vertex: direction (2), light and point on it (2), as one four-dimensional sample
+/// (`PathSampler::sample_4d`); lobe; roulette.
 const DIMENSIONS_PER_VERTEX: u32 = 6;

@@ -1,11 +1,15 @@
 //! The sample values the path tracer consumes, by dimension: the pixel position, then per path
-//! vertex the light choice, the point on the light, the BSDF lobe, the direction and Russian
-//! roulette.
+//! vertex the direction, the light choice and the point on the light, the BSDF lobe and
+//! Russian roulette.
 //!
 //! `SobolSampler` stratifies them across a pixel's samples: each dimension pair is an
 //! Owen-scrambled two-dimensional Sobol' sequence, with the sample index shuffled by a
 //! per-pixel, per-dimension permutation so pairs do not correlate (pbrt-v4's
 //! `PaddedSobolSampler` with `FastOwenScrambler`, after Laine and Karras 2011 and Burley 2020).
+//! A path vertex's direction and light sample are padded together as one four-dimensional
+//! Sobol' point (`PathSampler::sample_4d`): one index shuffle for both, whose cost (Kensler's
+//! hash, cycle-walking) was the larger part of the sampler's, and the two pairs stratified
+//! against each other instead of paired at random.
 //! Stratification pays most where the first bounces' light and BSDF samples decide the noise
 //! (soft shadows, the first diffuse bounce); beyond `QMC_DIMENSIONS` the sampler falls back to
 //! the sample's own PCG stream. Every value is a pure function of (seed, pixel, sample index,
@@ -23,12 +27,20 @@ pub trait PathSampler {
     fn sample_1d(&mut self, dimension: u32) -> f32;
     /// Two values in [0, 1)² for dimensions `dimension` and `dimension + 1`.
     fn sample_2d(&mut self, dimension: u32) -> (f32, f32);
-    /// A hint that `dimensions` are likely drawn soon: a sampler may start their work now, so
-    /// that it overlaps whatever runs in between (the path tracer gives a vertex's dimensions
-    /// before tracing the ray that finds the vertex). No value changes.
+    /// Four values for dimensions `dimension` to `dimension + 3`, as two pairs: one point of
+    /// [0, 1)⁴, stratified as a whole where the sampler stratifies (a path vertex's direction
+    /// and light sample). Not the same values as two `sample_2d` calls.
+    #[inline]
+    fn sample_4d(&mut self, dimension: u32) -> [(f32, f32); 2] {
+        [self.sample_2d(dimension), self.sample_2d(dimension + 2)]
+    }
+    /// A hint that `dimension` (of `sample_2d` or `sample_4d`) is likely drawn soon: a sampler
+    /// may start its work now, so that it overlaps whatever runs in between (the path tracer
+    /// gives a vertex's dimension before tracing the ray that finds the vertex). No value
+    /// changes.
     #[inline(always)]
-    fn prepare(&mut self, dimensions: [u32; 2]) {
-        let _ = dimensions;
+    fn prepare(&mut self, dimension: u32) {
+        let _ = dimension;
     }
 }
 
@@ -215,7 +227,7 @@ impl SobolPixel {
             rng: None,
             pixel: self,
             sample_index,
-            prepared: [(u32::MAX, 0); 2],
+            prepared: (u32::MAX, 0),
         }
     }
 }
@@ -229,7 +241,7 @@ pub struct SobolSampler<'a> {
     pixel: &'a SobolPixel,
     sample_index: u32,
     /// (dimension, shuffled index) computed ahead by `prepare`; `u32::MAX`: none.
-    prepared: [(u32, u32); 2],
+    prepared: (u32, u32),
 }
 
 impl SobolSampler<'_> {
@@ -239,7 +251,7 @@ impl SobolSampler<'_> {
     fn index_and_seeds(&self, dimension: u32) -> (u32, &DimensionSeeds) {
         let seeds = &self.pixel.dimensions[dimension as usize];
         let index = match self.prepared {
-            [(d, index), _] | [_, (d, index)] if d == dimension => index,
+            (d, index) if d == dimension => index,
             _ => seeds.permutation.apply(self.sample_index),
         };
         (index, seeds)
@@ -263,12 +275,10 @@ fn permute_mask(n: u32) -> u32 {
 
 impl PathSampler for SobolSampler<'_> {
     #[inline(always)]
-    fn prepare(&mut self, dimensions: [u32; 2]) {
-        for (slot, dimension) in self.prepared.iter_mut().zip(dimensions) {
-            if dimension < QMC_DIMENSIONS {
-                let seeds = &self.pixel.dimensions[dimension as usize];
-                *slot = (dimension, seeds.permutation.apply_ahead(self.sample_index));
-            }
+    fn prepare(&mut self, dimension: u32) {
+        if dimension < QMC_DIMENSIONS {
+            let seeds = &self.pixel.dimensions[dimension as usize];
+            self.prepared = (dimension, seeds.permutation.apply_ahead(self.sample_index));
         }
     }
 
@@ -288,18 +298,51 @@ impl PathSampler for SobolSampler<'_> {
             return (rng.next_f32(), rng.next_f32());
         }
         let (index, seeds) = self.index_and_seeds(dimension);
-        let first = owen_hash(index, seeds.scramble_first);
-        let second = owen_hash(
-            sobol_second_dimension_reversed(index),
-            seeds.permutation.seed,
-        );
-        // Both reversed at once: reversing the 64 bits (first, second) gives (second', first').
-        let reversed = ((first as u64) << 32 | second as u64).reverse_bits();
-        (
-            unit_float(reversed as u32),
-            unit_float((reversed >> 32) as u32),
+        scrambled_pair(
+            index,
+            sobol_dimension_reversed(&SOBOL_SECOND_DIMENSION, index),
+            seeds,
         )
     }
+
+    /// Sobol' dimensions 0 to 3 at one shuffled index (the shuffle and the first pair's
+    /// scrambling those of `dimension`, the second pair's scrambling that of `dimension + 2`):
+    /// each pair is still a (0, 2)-sequence or close to one, and the four values together are
+    /// one point of a four-dimensional Sobol' sequence, so the pairs are stratified against
+    /// each other as well. One shuffle instead of two.
+    #[inline(always)]
+    fn sample_4d(&mut self, dimension: u32) -> [(f32, f32); 2] {
+        if dimension + 3 >= QMC_DIMENSIONS {
+            return [self.sample_2d(dimension), self.sample_2d(dimension + 2)];
+        }
+        let (index, seeds) = self.index_and_seeds(dimension);
+        let second_seeds = &self.pixel.dimensions[dimension as usize + 2];
+        [
+            scrambled_pair(
+                index,
+                sobol_dimension_reversed(&SOBOL_SECOND_DIMENSION, index),
+                seeds,
+            ),
+            scrambled_pair(
+                sobol_dimension_reversed(&SOBOL_THIRD_DIMENSION, index),
+                sobol_dimension_reversed(&SOBOL_FOURTH_DIMENSION, index),
+                second_seeds,
+            ),
+        ]
+    }
+}
+
+/// Two bit-reversed Sobol' values Owen-scrambled by one dimension's seeds, as floats.
+#[inline(always)]
+fn scrambled_pair(first: u32, second: u32, seeds: &DimensionSeeds) -> (f32, f32) {
+    let first = owen_hash(first, seeds.scramble_first);
+    let second = owen_hash(second, seeds.permutation.seed);
+    // Both reversed at once: reversing the 64 bits (first, second) gives (second', first').
+    let reversed = ((first as u64) << 32 | second as u64).reverse_bits();
+    (
+        unit_float(reversed as u32),
+        unit_float((reversed >> 32) as u32),
+    )
 }
 
 /// The second dimension of Sobol's sequence (the first is the bit-reversed index): direction
@@ -307,37 +350,59 @@ impl PathSampler for SobolSampler<'_> {
 #[cfg(test)]
 #[inline]
 pub fn sobol_second_dimension(index: u32) -> u32 {
-    sobol_second_dimension_reversed(index).reverse_bits()
+    sobol_dimension_reversed(&SOBOL_SECOND_DIMENSION, index).reverse_bits()
 }
 
-/// `sobol_second_dimension` with its bits reversed, which is what the scrambler takes: the
-/// direction numbers run the other way, v_k = v_{k−1} ⊕ (v_{k−1} << 1). The result is the XOR
-/// of v_k over the set bits k of the index, so it is looked up a byte of the index at a time.
-#[inline]
-fn sobol_second_dimension_reversed(index: u32) -> u32 {
+/// A Sobol' dimension at `index` with its bits reversed, which is what the scrambler takes:
+/// the XOR of the dimension's reversed direction numbers over the set bits of the index,
+/// looked up a byte of the index at a time in the dimension's `tables`.
+#[inline(always)]
+fn sobol_dimension_reversed(tables: &[[u32; 256]; 4], index: u32) -> u32 {
     if index < 256 {
         // Up to 256 samples per pixel, one byte: the other three tables give 0.
-        return SOBOL_SECOND_DIMENSION[0][index as usize];
+        return tables[0][index as usize];
     }
     let [b0, b1, b2, b3] = index.to_le_bytes();
-    SOBOL_SECOND_DIMENSION[0][b0 as usize]
-        ^ SOBOL_SECOND_DIMENSION[1][b1 as usize]
-        ^ SOBOL_SECOND_DIMENSION[2][b2 as usize]
-        ^ SOBOL_SECOND_DIMENSION[3][b3 as usize]
+    tables[0][b0 as usize]
+        ^ tables[1][b1 as usize]
+        ^ tables[2][b2 as usize]
+        ^ tables[3][b3 as usize]
 }
 
-/// `SOBOL_SECOND_DIMENSION[k][b]`: the XOR of the reversed direction numbers v_{8k+j} over
-/// the set bits j of byte b.
-static SOBOL_SECOND_DIMENSION: [[u32; 256]; 4] = sobol_second_dimension_tables();
+/// Sobol' dimensions 1, 2 and 3 (counting from 0, the bit-reversed index): Joe and Kuo's
+/// direction numbers (`new-joe-kuo-6.21201`, their dimensions 2 to 4), by primitive
+/// polynomial degree s, its coefficients a and the initial numbers m.
+static SOBOL_SECOND_DIMENSION: [[u32; 256]; 4] = sobol_tables(1, 0, [1, 0, 0]);
+static SOBOL_THIRD_DIMENSION: [[u32; 256]; 4] = sobol_tables(2, 1, [1, 3, 0]);
+static SOBOL_FOURTH_DIMENSION: [[u32; 256]; 4] = sobol_tables(3, 1, [1, 3, 1]);
 
-const fn sobol_second_dimension_tables() -> [[u32; 256]; 4] {
-    let mut directions = [0u32; 32];
-    directions[0] = 1;
-    let mut k = 1;
+/// One dimension's 32 direction numbers v_1..v_32 as 32-bit fractions (Joe and Kuo's
+/// recurrence: the first s from m, each later one from the s before it).
+const fn sobol_directions(s: usize, a: u32, m: [u32; 3]) -> [u32; 32] {
+    let mut v = [0u32; 32];
+    let mut k = 0;
     while k < 32 {
-        directions[k] = directions[k - 1] ^ (directions[k - 1] << 1);
+        if k < s {
+            v[k] = m[k] << (31 - k);
+        } else {
+            v[k] = v[k - s] ^ (v[k - s] >> s);
+            let mut l = 1;
+            while l < s {
+                if (a >> (s - 1 - l)) & 1 != 0 {
+                    v[k] ^= v[k - l];
+                }
+                l += 1;
+            }
+        }
         k += 1;
     }
+    v
+}
+
+/// `tables[k][b]`: the XOR of the reversed direction numbers v_{8k+j+1} over the set bits j
+/// of byte b.
+const fn sobol_tables(s: usize, a: u32, m: [u32; 3]) -> [[u32; 256]; 4] {
+    let directions = sobol_directions(s, a, m);
     let mut tables = [[0u32; 256]; 4];
     let mut byte = 0;
     while byte < 4 {
@@ -347,7 +412,7 @@ const fn sobol_second_dimension_tables() -> [[u32; 256]; 4] {
             let mut j = 0;
             while j < 8 {
                 if b & (1 << j) != 0 {
-                    value ^= directions[8 * byte + j];
+                    value ^= directions[8 * byte + j].reverse_bits();
                 }
                 j += 1;
             }
@@ -509,8 +574,8 @@ mod tests {
 
     #[test]
     fn prepared_dimensions_give_the_same_values() {
-        // Dimensions prepared ahead (some of them never drawn, one beyond the Sobol' ones)
-        // draw exactly what unprepared ones do, whichever slot holds them.
+        // A dimension prepared ahead (some never drawn, one beyond the Sobol' ones) draws
+        // exactly what an unprepared one does, through `sample_2d` or `sample_4d`.
         for (n, pixel) in [(40, 3), (64, 8), (7, 1000)] {
             let sobol = SobolPixel::new(9, pixel, n);
             for s in 0..n {
@@ -518,14 +583,89 @@ mod tests {
                 let mut prepared = sobol.sampler(s);
                 for vertex in 0..6 {
                     let d = 2 + 6 * vertex;
-                    prepared.prepare(if vertex % 2 == 0 {
-                        [d, d + 3]
-                    } else {
-                        [d + 3, d]
-                    });
+                    prepared.prepare(d);
+                    assert_eq!(prepared.sample_4d(d), plain.sample_4d(d));
+                    assert_eq!(prepared.sample_1d(d + 4), plain.sample_1d(d + 4));
+                    prepared.prepare(d + 1);
+                    assert_eq!(prepared.sample_2d(d + 1), plain.sample_2d(d + 1));
+                    prepared.prepare(d + 3);
                     assert_eq!(prepared.sample_2d(d), plain.sample_2d(d));
-                    assert_eq!(prepared.sample_1d(d + 2), plain.sample_1d(d + 2));
-                    assert_eq!(prepared.sample_2d(d + 3), plain.sample_2d(d + 3));
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn four_dimensional_samples_extend_the_pair() {
+        // The first pair of `sample_4d(d)` is `sample_2d(d)`; the second is not
+        // `sample_2d(d + 2)` (other Sobol' dimensions at d's shuffled index).
+        let sobol = SobolPixel::new(4, 77, 40);
+        let mut differs = 0;
+        for s in 0..40 {
+            let [first, second] = sobol.sampler(s).sample_4d(8);
+            assert_eq!(first, sobol.sampler(s).sample_2d(8));
+            differs += u32::from(second != sobol.sampler(s).sample_2d(10));
+        }
+        assert_eq!(differs, 40);
+        // Beyond the Sobol' dimensions, the sample's PCG stream in order.
+        let mut sampler = sobol.sampler(5);
+        let mut rng = Rng::for_sample(4, 77, 5);
+        let [(a, b), (c, d)] = sampler.sample_4d(QMC_DIMENSIONS);
+        let expected = [
+            rng.next_f32(),
+            rng.next_f32(),
+            rng.next_f32(),
+            rng.next_f32(),
+        ];
+        assert_eq!([a, b, c, d], expected);
+    }
+
+    #[test]
+    fn four_dimensional_points_are_stratified() {
+        // A power-of-two count of points of Sobol' dimensions 0 to 3 (scrambled and shuffled:
+        // the same set, and Owen scrambling keeps every elementary interval's count) puts
+        // n / 2^k points in every box of 2^k cells whose sides halve the unit cube a total of
+        // k times, for k up to m - t: t = 2 for m = 4 and 7, and the first pair alone is a
+        // (0, 2)-sequence, the second a (0, 4, 2)-net at m = 4.
+        for (m, t) in [(4u32, 2u32), (7, 2)] {
+            let n = 1u32 << m;
+            for seed in [0u64, 5] {
+                let sobol = SobolPixel::new(seed, 12, n);
+                let points: Vec<[f32; 4]> = (0..n)
+                    .map(|s| {
+                        let [(a, b), (c, d)] = sobol.sampler(s).sample_4d(14);
+                        [a, b, c, d]
+                    })
+                    .collect();
+                let stratified = |bits: [u32; 4]| {
+                    let k: u32 = bits.iter().sum();
+                    let mut counts = vec![0u32; 1 << k];
+                    for p in &points {
+                        let cell = (0..4).fold(0usize, |cell, i| {
+                            (cell << bits[i]) | (p[i] * (1u32 << bits[i]) as f32) as usize
+                        });
+                        counts[cell] += 1;
+                    }
+                    counts.iter().all(|&c| c == n >> k)
+                };
+                for bits in (0..(m + 1).pow(4)).map(|c| {
+                    [
+                        c % (m + 1),
+                        c / (m + 1) % (m + 1),
+                        c / (m + 1).pow(2) % (m + 1),
+                        c / (m + 1).pow(3),
+                    ]
+                }) {
+                    let k: u32 = bits.iter().sum();
+                    if k <= m - t {
+                        assert!(stratified(bits), "m {m} seed {seed} {bits:?}");
+                    }
+                    if k == m && bits[2] == 0 && bits[3] == 0 {
+                        assert!(stratified(bits), "first pair, m {m} {bits:?}");
+                    }
+                    if m == 4 && k == m && bits[0] == 0 && bits[1] == 0 {
+                        assert!(stratified(bits), "second pair {bits:?}");
+                    }
                 }
             }
         }
@@ -561,10 +701,47 @@ mod tests {
         let mut rng = Rng::new(5, 0);
         for index in (0..4096).chain((0..4096).map(|_| rng.next_u32())) {
             assert_eq!(
-                sobol_second_dimension_reversed(index),
+                sobol_dimension_reversed(&SOBOL_SECOND_DIMENSION, index),
                 by_recurrence(index),
                 "{index}"
             );
+        }
+    }
+
+    #[test]
+    fn sobol_higher_dimensions_known_values() {
+        // Joe and Kuo's dimensions 3 and 4 in index order (scipy's `Sobol` lists the same
+        // points in Gray-code order): v_1..v_4 = 1/2, 3/4, 3/8, 9/16 and 1/2, 3/4, 1/8, 5/16.
+        let third = [0.0, 0.5, 0.75, 0.25, 0.375, 0.875, 0.625, 0.125, 0.5625];
+        let fourth = [0.0, 0.5, 0.75, 0.25, 0.125, 0.625, 0.875, 0.375, 0.3125];
+        for (tables, expected) in [
+            (&SOBOL_THIRD_DIMENSION, third),
+            (&SOBOL_FOURTH_DIMENSION, fourth),
+        ] {
+            for (i, e) in expected.iter().enumerate() {
+                let got = sobol_dimension_reversed(tables, i as u32).reverse_bits() as f64
+                    / 4_294_967_296.0;
+                assert_eq!(got, *e, "index {i}");
+            }
+        }
+        // Above one byte of index, the tables of the higher bytes.
+        let by_bits = |directions: [u32; 32], index: u32| {
+            (0..32)
+                .filter(|j| index >> j & 1 != 0)
+                .fold(0u32, |x, j| x ^ directions[j])
+        };
+        let mut rng = Rng::new(8, 2);
+        for _ in 0..1000 {
+            let index = rng.next_u32();
+            for (tables, directions) in [
+                (&SOBOL_THIRD_DIMENSION, sobol_directions(2, 1, [1, 3, 0])),
+                (&SOBOL_FOURTH_DIMENSION, sobol_directions(3, 1, [1, 3, 1])),
+            ] {
+                assert_eq!(
+                    sobol_dimension_reversed(tables, index).reverse_bits(),
+                    by_bits(directions, index)
+                );
+            }
         }
     }
 
