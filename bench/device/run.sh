@@ -78,18 +78,19 @@ for s in scenes_A/spheres_1K.xml:9 scenes_B/StanfordDragon_Instanced.json:16; do
 done | tee "$OUT/stages.txt"
 el stages
 # The stack's alignment: the single-ray walks run on the main thread (`--threads 1`), whose
-# stack starts below the environment, so the environment's size moves every frame. Before the
-# twenty-eighth pass the closest-hit walk's buffer of entry distances (written as one 32-byte
-# vector, read back 4 bytes at a time) had the stack's 16-byte alignment only, and Intel cores
-# forward a 32-byte store to narrower loads only when it is 32-byte aligned (the buffer is now,
-# whatever the stack). The kernel also moves the stack by a random multiple of 16 bytes for
-# every process (ASLR), which padding the environment alone does not undo (the sweeps of the
-# twenty-sixth and twenty-seventh passes measured random places; gdb, used to check them, turns
-# ASLR off). So each run goes under `setarch -R` (ASLR off for that process) where the machine
-# allows it: an environment 0, 16, 32 and 48 bytes longer then puts the stack at each of the
-# four 16-byte places in a 64-byte line: a build before the twenty-eighth pass, packed beside
-# HEAD, should run slow at two of them and HEAD at none. Every glint packed, the paddings
-# alternating, AL_ROUNDS times (limit AL_S, default 40 s): Mrays/s by padding.
+# stack starts below the environment, so the environment's size moves every frame. The
+# closest-hit walk writes its entry distances as one 32-byte vector and reads them back 4 bytes
+# at a time; Intel cores forward such a store to the loads only when it is 32-byte aligned.
+# Builds before 726c52c aligned that buffer to the stack's 16 bytes only, so their speed depended
+# on where the stack fell (it is aligned whatever the stack since). The kernel also moves the
+# stack by a random multiple of 16 bytes for every process (ASLR), which padding the environment
+# alone does not undo (gdb turns ASLR off, so placements checked under it are not the ones a
+# plain run gets). So each run goes under `setarch -R` (ASLR off for that process) where the
+# machine allows it: an environment 0, 16, 32 and 48 bytes longer then puts the stack at each of
+# the four 16-byte places in a 64-byte line: a build before 726c52c, packed beside HEAD, should
+# run slow at two of them and HEAD at none. Every glint packed, the paddings alternating,
+# AL_ROUNDS times (limit AL_S, default 40 s): Mrays/s by padding. The two speeds were found on
+# the lent Xeon: bench/results/2026-11-28-issue14-pass28-xeon-16core-alignment.md.
 align_sweep() {
   norand=(setarch "$(uname -m)" -R)
   "${norand[@]}" true 2> /dev/null || {
