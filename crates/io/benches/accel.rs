@@ -11,8 +11,8 @@ use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use glint_render::accel::instances::AccelKind;
-use glint_render::accel::workload;
 use glint_render::accel::{Isa, WideBvh, PACKET};
+use glint_render::bench::workload;
 use glint_render::{Ray, RenderSettings, Scene, SceneParts, Shape};
 
 fn bunny() -> SceneParts {
@@ -44,7 +44,7 @@ fn build(c: &mut Criterion) {
     group.bench_function("bunny/binary", |b| {
         b.iter(|| {
             let bounds: Vec<_> = shapes.iter().map(Shape::bounds).collect();
-            black_box(glint_render::bvh::Bvh::build(&bounds))
+            black_box(glint_render::accel::binary::Bvh::build(&bounds))
         })
     });
     group.finish();

@@ -4,7 +4,7 @@
 //! the wide and the binary bottom level.
 
 use glint_render::accel::instances::AccelKind;
-use glint_render::accel::workload;
+use glint_render::bench::workload;
 use glint_render::scene::SurfaceNeeds;
 use glint_render::testing::*;
 use glint_render::{Aabb, GeometryDesc, Instance, Matrix4, Ray, Scene, Shape, Transform, Vec3};

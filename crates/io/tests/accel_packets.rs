@@ -6,8 +6,8 @@
 //! scenes with spheres, boxes and transformed instances (the two-level path).
 
 use glint_render::accel::instances::{AccelKind, Hit};
-use glint_render::accel::workload;
 use glint_render::accel::{LocalHit, WideBvh, ALL_LANES, PACKET};
+use glint_render::bench::workload;
 use glint_render::sampling::Rng;
 use glint_render::testing::*;
 use glint_render::{

@@ -42,9 +42,9 @@
 //! rather than recomputing them.
 //!
 //! Everything else is private to the crate. The `bench` cargo feature exposes the ray engine's
-//! internals (`accel`, `bvh`, `scene` queries, the benchmark workloads and the verification
-//! helpers) to `glint bench` and to the tests in glint-io that need real meshes; they are not
-//! part of the API and may change at any time.
+//! internals (`accel`, its binary BVH among them, `scene` queries, the benchmark workloads of
+//! `bench` and the verification helpers) to `glint bench` and to the tests in glint-io that
+//! need real meshes; they are not part of the API and may change at any time.
 
 /// Modules private to the crate, public with the `bench` feature (for benchmarks and the
 /// cross-crate tests of the ray engine). `cargo fmt` does not look inside this macro's
@@ -64,7 +64,6 @@ macro_rules! internal_modules {
 
 internal_modules! {
     accel;
-    bvh;
     camera;
     geometry;
     integrator;
@@ -77,12 +76,17 @@ internal_modules! {
     texture;
 }
 
+/// The benchmark workloads, for `glint bench`, the criterion benches and glint-io's tests.
+#[cfg(feature = "bench")]
+pub mod bench;
+
 /// Helpers that verify the ray engine against references (brute force, the binary BVH), shared
 /// by the unit tests and glint-io's mesh tests.
 #[cfg(any(test, feature = "bench"))]
 pub mod testing;
 
 mod film;
+mod pages;
 mod pipeline;
 
 #[cfg(test)]

@@ -24,10 +24,11 @@ use rayon::prelude::*;
 use web_time::{Duration, Instant};
 
 use crate::accel::isa::Isa;
+use crate::accel::simd;
 use crate::accel::wide::{ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH};
-use crate::accel::{pages, simd};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
+use crate::pages;
 
 /// Below this depth the SAH (or the spatial median) chooses splits; deeper, median splits by
 /// count finish the job in at most log₂(2²⁷) more levels.

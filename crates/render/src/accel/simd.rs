@@ -255,7 +255,7 @@ pub(crate) fn measure_rows<'a>(
     }
 }
 
-/// The slab test of the binary BVH (`bvh::RayInverse::hits`) for eight rays against one node,
+/// The slab test of the binary BVH (`binary::RayInverse::hits`) for eight rays against one node,
 /// the same operations lane by lane: the mask of rays that hit it within [t_min, t_max]. For
 /// the top level's packet traversal (`Bvh::traverse_packet`).
 #[inline]
