@@ -345,7 +345,7 @@ fn bin_prims_portable(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
 #[cfg(not(target_arch = "x86_64"))]
 use bin_prims_portable as bin_prims;
 
-/// `bin_prims_portable` with the SSE2 pieces of `simd.rs`: the same bins, boxes and counts
+/// `bin_prims_portable` with the SSE2 pieces of `simd/binning.rs`: the same bins, boxes and counts
 /// (`binning_agrees_with_its_definition`), about half the instructions a primitive. The counts
 /// stay in arrays of their own: a count kept in the box's spare lane put an integer add and two
 /// shuffles on the chain through a bin that consecutive primitives share.

@@ -1,7 +1,7 @@
 //! Glint's ray engine for the bottom level of the scene: an 8-wide BVH (`wide.rs`) built by
 //! binned SAH with a block-aware leaf cost (`build.rs`), triangles in blocks of four tested by
 //! the watertight algorithm of Woop, Benthin and Wald (`triangle.rs`), traversed with AVX2
-//! kernels (`simd.rs`, one of the two modules with `unsafe`; `crate::pages`, the other, asks
+//! kernels (`simd/`, one of the two modules with `unsafe`; `crate::pages`, the other, asks
 //! for huge pages for the trees' arrays) or a scalar fallback, chosen once at build time
 //! (`isa.rs`) and applied in one place (`dispatch.rs`). The modules depend one way: `isa`,
 //! `triangle` <- `wide` (node layout, single-ray traversal) <- `packet` <- `simd` <-

@@ -18,10 +18,10 @@
 //! **Traversal** is ordered: the children a ray enters are visited nearest first (one child:
 //! straight on; two: compare; more: sort), the others wait on a stack with their entry distance,
 //! and a popped entry further than the closest hit so far is dropped. `t_max` shrinks with each
-//! hit. The box and block tests are the `Kernel`: AVX2 in `simd.rs` when the CPU has it, the
+//! hit. The box and block tests are the `Kernel`: AVX2 in `simd/` when the CPU has it, the
 //! scalar `ScalarKernel` here otherwise. Both give the same entry distances and hits; the
 //! AVX2 box test may also enter boxes the scalar one culls, never the reverse (see
-//! `simd::node_test`), which changes no hit. A block hit carries its barycentrics, so a
+//! `simd/node.rs`, `node_test`), which changes no hit. A block hit carries its barycentrics, so a
 //! closest hit needs no second triangle test (`finish` serves the preliminary hits).
 
 use crate::accel::isa::Isa;
@@ -184,7 +184,7 @@ pub struct WideBvh {
     pub(crate) isa: Isa,
     /// The largest magnitude of any plane of a child box in `nodes` (∞ if one is infinite or
     /// NaN; 0 without nodes): what bounds the rounding of the AVX2 walk's slab distances
-    /// (`simd.rs`, `SlabMargin`; read only where that walk exists).
+    /// (`simd/node.rs`, `SlabMargin`; read only where that walk exists).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub(crate) magnitude: f32,
 }
