@@ -1166,8 +1166,7 @@ fn leaf_runs(
 /// cache miss each on big meshes: most of the time), are then made in parallel on the
 /// current pool. Serial, this took 50-100 ms of igea-sub4's 1-thread build (1.07M
 /// triangles) and 6-9 ms of the instanced dragon's, more than the root node's splits, on one
-/// thread at any pool size (bench/README, issue 14, fourteenth pass). The result does not
-/// depend on the thread count.
+/// thread at any pool size. The result does not depend on the thread count.
 fn pack(
     shapes: &[Shape],
     prims: &[PrimRef],

@@ -611,7 +611,7 @@ fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
         // prefetched, then ordered by a sorting network on their keys (`child_key`) with no
         // branch on the distances, the nearest taken, the others pushed, the farthest first.
         // For incoherent rays the order is a coin toss that a branch mispredicts half the
-        // time (bench/README, issue 14, twenty-first pass).
+        // time.
         let i1 = rest.trailing_zeros() as usize;
         let rest = rest & (rest - 1);
         let key = |i: usize| child_key(entry[i], node.children[i]);
@@ -648,9 +648,9 @@ fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
             *current = ChildRef(key_parts(a).0);
             continue;
         }
-        // Five or more (rare: the bunny's visits entering four or more were 1-3 % of all,
-        // bench/README, issue 14, seventh pass): onto the stack sorted by entry distance,
-        // nearest on top (among equals the later slot), then the top taken.
+        // Five or more (rare: the bunny's visits entering four or more were 1-3 % of all):
+        // onto the stack sorted by entry distance, nearest on top (among equals the later
+        // slot), then the top taken.
         let base = *sp;
         while mask != 0 {
             let i = mask.trailing_zeros() as usize;
@@ -750,8 +750,7 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
 /// 16-byte alignment, which the kernel moves by a random multiple of 16 bytes for every
 /// process, half the processes got an unaligned buffer, and the lent Xeon's single rays ran at
 /// two speeds from one run of the same binary to the next (the bunny's primary rays 8.4 or
-/// 10.6 Mrays/s, 5 runs of 12 slow; `bench/README.md`, twenty-eighth pass). The Zen 4 forwards
-/// either way.
+/// 10.6 Mrays/s, 5 runs of 12 slow). The Zen 4 forwards either way.
 #[repr(C, align(32))]
 struct EntryDistances([f32; WIDTH]);
 

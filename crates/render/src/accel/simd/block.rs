@@ -17,7 +17,7 @@ use crate::accel::wide::{BlockHit, TriangleBlock, BLOCK};
 /// each, as a register spilled would take): made this way, the set-up is three lane
 /// permutations and two stores, where picking each value into a register of its own and
 /// spilling them all took some 75 instructions a ray (bunny bounce rays: 895 instructions
-/// a ray before, 858 after; bench/README, issue 14, tenth pass).
+/// a ray that way, 858 this way).
 #[repr(C, align(16))]
 pub(super) struct TriRay {
     // `lanes` reads `origin` and `shear` by their offsets: keep them first, in this order.

@@ -151,7 +151,7 @@ pub(super) const FOLDED_FAR_SCALE: f32 = 1.0 + 16.0 * f32::EPSILON;
 /// the value the scalar code gives. Through the scalar constructors the compiler kept their
 /// per-axis arrays on the stack and read them back by index, waiting on its own stores
 /// (`d[kx]`, `d[ky]` held 18 % of a missing ray's samples); rays that miss the bunny went
-/// from 40 to 44 Mrays/s with this alone (bench/README, fifth pass).
+/// from 40 to 44 Mrays/s with this alone.
 ///
 /// The ray's eight floats are read one by one: callers have most often just written the
 /// ray (a local copy, in object space), and a load wider than one of those stores, spanning

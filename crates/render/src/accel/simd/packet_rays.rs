@@ -16,7 +16,7 @@ const _: () = assert!(std::mem::size_of::<Ray>() == 32 && std::mem::align_of::<R
 /// `packet_set_up_matches_the_scalar_constructor`): the packet's rays as rows of a matrix,
 /// transposed into lanes, then each step of the scalar constructor as lane operations.
 /// The scalar constructor's lane loops compiled to some 900 instructions a packet, a sixth
-/// of a primary-ray packet's walk on igea-sub4 (bench/README, issue 14, tenth pass).
+/// of a primary-ray packet's walk on igea-sub4.
 #[target_feature(enable = "avx2,fma")]
 #[inline]
 pub(super) fn packet_rays(rays: &[Ray; PACKET], lanes: u8) -> PacketRays<'_> {

@@ -36,9 +36,10 @@ pub(super) unsafe fn any(bvh: &WideBvh, ray: &Ray) -> bool {
 
 // The same two walks compiled with AVX-512F and AVX-512VL as well: the same intrinsics,
 // but EVEX-encoded with 32 vector registers, so that the per-ray constants of the box and
-// triangle tests stay in registers (bench/README, issue 14, sixth pass; the margin box
-// test since the thirteenth, 4-11 % faster there on a Xeon). Only the names ending in
-// `_evex` may carry these features (`only_evex_kernels_need_avx512`).
+// triangle tests stay in registers instead of being spilled and reloaded at every node and
+// block. They take the margin box test too, which made them 4-11 % faster than with the
+// checked one on a Xeon. Only the names ending in `_evex` may carry these features
+// (`only_evex_kernels_need_avx512`).
 
 /// # Safety
 /// The CPU must have AVX2, FMA, AVX-512F and AVX-512VL.
@@ -57,7 +58,8 @@ pub(super) unsafe fn any_evex(bvh: &WideBvh, ray: &Ray) -> bool {
 }
 
 // The single-ray walks: rays that `SlabMargin` serves take its box test, the others the
-// checked one (bench/README, issue 14, ninth pass), each in a walk of its own.
+// checked one, each in a walk of its own, so that the choice is made once a ray and no node
+// pays for it.
 
 /// # Safety
 /// Only inside `target_feature(enable = "avx2,fma")` functions: the walks above, and the
@@ -94,8 +96,9 @@ pub(super) unsafe fn walk_any(bvh: &WideBvh, ray: &Ray) -> bool {
 /// its length, a power of two, so that no access is bounds-checked: the walks use
 /// positions below `STACK_SIZE` (at most 7 entries a level, and the build caps the depth),
 /// which the mask leaves as they are. The checks it replaces were a compare and a branch
-/// at every push and at every step of the sorted insertion (bench/README, issue 14,
-/// eleventh pass).
+/// at every push and at every step of the sorted insertion: 0.5-1.7 % of a ray's
+/// instructions (the bunny's primary rays, 583.5 instructions a ray with them, 576.3
+/// without).
 struct UninitStack {
     entries: [MaybeUninit<(u32, f32)>; UNINIT_STACK],
 }
