@@ -14,8 +14,8 @@ listing=$(mktemp)
 trap 'rm -f "$listing"' EXIT
 objdump -d --no-show-raw-insn -C "$binary" > "$listing"
 # The check means nothing on a binary without symbols, or without the kernels.
-if ! grep -q '<glint_render::accel::simd::x86::occluded_packet>:' "$listing"; then
-  echo "no symbol glint_render::accel::simd::x86::occluded_packet in $binary: cannot check" >&2
+if ! grep -q '<glint_render::accel::simd::packet_walk::occluded_packet>:' "$listing"; then
+  echo "no symbol glint_render::accel::simd::packet_walk::occluded_packet in $binary: cannot check" >&2
   exit 1
 fi
 # Callers of core::core_arch functions, but for the CPU feature detection of std and

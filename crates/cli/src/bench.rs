@@ -18,10 +18,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use clap::{Args, Subcommand, ValueEnum};
-use glint_render::accel::instances::AccelKind;
-use glint_render::accel::wide::WalkCounts;
-use glint_render::accel::workload::{self, Workload};
-use glint_render::accel::{Isa, PACKET};
+use glint_render::bench::workload::{self, Workload};
+use glint_render::bench::{AccelKind, Isa, WalkCounts, PACKET};
 use glint_render::{Aabb, Camera, Light, Ray, Scene, SceneParts, Vec3};
 use rayon::prelude::*;
 

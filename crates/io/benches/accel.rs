@@ -10,9 +10,7 @@ use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
-use glint_render::accel::instances::AccelKind;
-use glint_render::accel::workload;
-use glint_render::accel::{Isa, WideBvh, PACKET};
+use glint_render::bench::{workload, AccelKind, Isa, WideBvh, PACKET};
 use glint_render::{Ray, RenderSettings, Scene, SceneParts, Shape};
 
 fn bunny() -> SceneParts {
@@ -39,12 +37,12 @@ fn build(c: &mut Criterion) {
     group.sample_size(10);
     group.throughput(Throughput::Elements(shapes.len() as u64));
     group.bench_function("bunny/wide", |b| {
-        b.iter(|| black_box(glint_render::accel::build::build(&shapes)))
+        b.iter(|| black_box(glint_render::bench::build(&shapes)))
     });
     group.bench_function("bunny/binary", |b| {
         b.iter(|| {
             let bounds: Vec<_> = shapes.iter().map(Shape::bounds).collect();
-            black_box(glint_render::bvh::Bvh::build(&bounds))
+            black_box(glint_render::bench::Bvh::build(&bounds))
         })
     });
     group.finish();
@@ -55,7 +53,7 @@ fn traverse(c: &mut Criterion) {
     let (primary, bounce, shadow) = rays(&parts);
     let wide = Scene::with_accel(parts.clone(), AccelKind::Wide);
     let binary = Scene::with_accel(parts.clone(), AccelKind::Binary);
-    let built: WideBvh = glint_render::accel::build::build(&parts.geometries[0].shapes);
+    let built: WideBvh = glint_render::bench::build(&parts.geometries[0].shapes);
     let mut scalar = built.clone();
     scalar.set_isa(Isa::Scalar);
     let mut group = c.benchmark_group("bunny");

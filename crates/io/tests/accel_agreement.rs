@@ -3,9 +3,7 @@
 //! and real meshes; and whole scenes with spheres, boxes, triangles and instances agree between
 //! the wide and the binary bottom level.
 
-use glint_render::accel::instances::AccelKind;
-use glint_render::accel::workload;
-use glint_render::scene::SurfaceNeeds;
+use glint_render::bench::{workload, AccelKind, SurfaceNeeds};
 use glint_render::testing::*;
 use glint_render::{Aabb, GeometryDesc, Instance, Matrix4, Ray, Scene, Shape, Transform, Vec3};
 
@@ -171,7 +169,7 @@ fn nan_and_infinite_rays_do_not_crash() {
 
 #[test]
 fn empty_and_tiny_geometries() {
-    let wide = glint_render::accel::build::build(&[]);
+    let wide = glint_render::bench::build(&[]);
     assert!(wide.intersect(&Ray::new(Vec3::ZERO, Vec3::X)).is_none());
     assert!(!wide.occluded(&Ray::new(Vec3::ZERO, Vec3::X)));
     let tri = [[[0.0, 0.0, -1.0], [1.0, 0.0, -1.0], [0.0, 1.0, -1.0]]];
@@ -330,7 +328,7 @@ fn build_is_independent_of_the_thread_count() {
             .num_threads(threads)
             .build()
             .expect("thread pool")
-            .install(|| glint_render::accel::build::build(&shapes))
+            .install(|| glint_render::bench::build(&shapes))
     };
     let one = build_on(1);
     for threads in [2, 4] {
@@ -349,6 +347,6 @@ fn build_is_independent_of_the_thread_count() {
     // Negative control: the comparison sees a different structure (another triangle order).
     let mut reversed = shapes.clone();
     reversed.reverse();
-    let other = glint_render::accel::build::build(&reversed);
+    let other = glint_render::bench::build(&reversed);
     assert!(format!("{one:?}") != format!("{other:?}"));
 }

@@ -5,10 +5,7 @@
 //! holding NaN or infinite rays; over random soups, an exact-grid cube, the bunny, and whole
 //! scenes with spheres, boxes and transformed instances (the two-level path).
 
-use glint_render::accel::instances::{AccelKind, Hit};
-use glint_render::accel::workload;
-use glint_render::accel::{LocalHit, WideBvh, ALL_LANES, PACKET};
-use glint_render::sampling::Rng;
+use glint_render::bench::{workload, AccelKind, Hit, LocalHit, Rng, WideBvh, ALL_LANES, PACKET};
 use glint_render::testing::*;
 use glint_render::{
     Aabb, GeometryDesc, Instance, Matrix4, Ray, Scene, SceneParts, Shape, Transform, Vec3,

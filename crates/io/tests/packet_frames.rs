@@ -9,12 +9,10 @@
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-use glint_render::integrator::course::{shade_camera_ray, SampleContext};
-use glint_render::integrator::path::{PathIntegrator, PathSettings};
-use glint_render::integrator::FirstHit;
-use glint_render::light::sampler::LightSampler;
-use glint_render::sampling::sobol::{PathSampler, SobolPixel};
-use glint_render::sampling::Rng;
+use glint_render::bench::{
+    shade_camera_ray, FirstHit, LightSampler, PathIntegrator, PathSampler, PathSettings, Rng,
+    SampleContext, SobolPixel,
+};
 use glint_render::{render, Color, IntegratorKind, RenderSettings, Scene, ThinLens, Vec3};
 
 fn course_scene(relative: &str) -> Scene {

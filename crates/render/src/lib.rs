@@ -41,49 +41,36 @@
 //! end that samples the environment itself (the GPU's), so that it uploads the CPU's tables
 //! rather than recomputing them.
 //!
-//! Everything else is private to the crate. The `bench` cargo feature exposes the ray engine's
-//! internals (`accel`, `bvh`, `scene` queries, the benchmark workloads and the verification
-//! helpers) to `glint bench` and to the tests in glint-io that need real meshes; they are not
-//! part of the API and may change at any time.
+//! Everything else is private to the crate. With the `bench` cargo feature, the `bench` module
+//! re-exports the few internals that `glint bench`, the criterion benches and glint-io's tests
+//! of the ray engine use (the wide and binary BVHs, the instance structure, the integrators'
+//! per-sample pieces, the samplers) and holds the benchmark workloads, and `testing` the
+//! verification helpers; neither is part of the API, and either may change at any time.
 
-/// Modules private to the crate, public with the `bench` feature (for benchmarks and the
-/// cross-crate tests of the ray engine). `cargo fmt` does not look inside this macro's
-/// invocation, so it does not reach these modules: `scripts/fmt.sh` formats them.
-macro_rules! internal_modules {
-    ($($(#[$attr:meta])* $name:ident;)*) => {
-        $(
-            $(#[$attr])*
-            #[cfg(feature = "bench")]
-            pub mod $name;
-            $(#[$attr])*
-            #[cfg(not(feature = "bench"))]
-            pub(crate) mod $name;
-        )*
-    };
-}
+mod accel;
+mod camera;
+mod film;
+mod geometry;
+mod integrator;
+mod light;
+mod material;
+mod math;
+mod pages;
+mod pipeline;
+mod ray;
+mod sampling;
+mod scene;
+mod texture;
 
-internal_modules! {
-    accel;
-    bvh;
-    camera;
-    geometry;
-    integrator;
-    light;
-    material;
-    math;
-    ray;
-    sampling;
-    scene;
-    texture;
-}
+/// The ray engine's internals that `glint bench`, the criterion benches and glint-io's tests
+/// use, and the benchmark workloads: not part of the API.
+#[cfg(feature = "bench")]
+pub mod bench;
 
 /// Helpers that verify the ray engine against references (brute force, the binary BVH), shared
 /// by the unit tests and glint-io's mesh tests.
 #[cfg(any(test, feature = "bench"))]
 pub mod testing;
-
-mod film;
-mod pipeline;
 
 #[cfg(test)]
 mod tests;

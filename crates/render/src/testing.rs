@@ -2,9 +2,9 @@
 //! random rays and meshes.
 #![allow(dead_code)]
 
+use crate::accel::binary::Bvh;
 use crate::accel::triangle::{self, WoopRay};
 use crate::accel::{Isa, WideBvh};
-use crate::bvh::Bvh;
 use crate::sampling::Rng;
 use crate::{Aabb, Ray, Shape, Vec3};
 
@@ -62,7 +62,7 @@ pub fn count_hits(tris: &[Tri], ray: &Ray) -> usize {
         .count()
 }
 
-/// The reference binary BVH of `crate::bvh` with the same watertight test.
+/// The reference binary BVH of `accel::binary` with the same watertight test.
 pub struct BinaryReference {
     bvh: Bvh,
     order: Vec<u32>,

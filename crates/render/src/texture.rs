@@ -25,7 +25,7 @@ impl Image {
     pub fn from_rgb8(width: u32, height: u32, levels: &[u8]) -> Image {
         let count = width as usize * height as usize;
         assert_eq!(levels.len(), 3 * count, "{width} x {height} RGB levels");
-        let mut texels = crate::accel::pages::vec_with_capacity(count);
+        let mut texels = crate::pages::vec_with_capacity(count);
         levels
             .par_chunks_exact(3)
             .with_min_len(1 << 14)
@@ -207,7 +207,7 @@ fn cut_square<T>(
         x0 as usize + side <= width as usize && y0 as usize + side <= height,
         "a {size} x {size} square at ({x0}, {y0}) of a {width} x {height} image"
     );
-    let mut texels = crate::accel::pages::vec_with_capacity(side * side);
+    let mut texels = crate::pages::vec_with_capacity(side * side);
     for y in 0..side {
         let source_row = if turned { side - 1 - y } else { y };
         let start = (y0 as usize + source_row) * row_values + per_texel * x0 as usize;

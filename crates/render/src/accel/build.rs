@@ -24,10 +24,11 @@ use rayon::prelude::*;
 use web_time::{Duration, Instant};
 
 use crate::accel::isa::Isa;
+use crate::accel::simd;
 use crate::accel::wide::{ChildRef, TriangleBlock, WideBvh, WideNode, BLOCK, MAX_DEPTH, WIDTH};
-use crate::accel::{pages, simd};
 use crate::geometry::{Aabb, Shape};
 use crate::math::Vec3;
+use crate::pages;
 
 /// Below this depth the SAH (or the spatial median) chooses splits; deeper, median splits by
 /// count finish the job in at most log₂(2²⁷) more levels.
@@ -344,7 +345,7 @@ fn bin_prims_portable(prims: &[PrimRef], binner: &Binner, bins: &mut Bins) {
 #[cfg(not(target_arch = "x86_64"))]
 use bin_prims_portable as bin_prims;
 
-/// `bin_prims_portable` with the SSE2 pieces of `simd.rs`: the same bins, boxes and counts
+/// `bin_prims_portable` with the SSE2 pieces of `simd/binning.rs`: the same bins, boxes and counts
 /// (`binning_agrees_with_its_definition`), about half the instructions a primitive. The counts
 /// stay in arrays of their own: a count kept in the box's spare lane put an integer add and two
 /// shuffles on the chain through a bin that consecutive primitives share.
@@ -1165,8 +1166,7 @@ fn leaf_runs(
 /// cache miss each on big meshes: most of the time), are then made in parallel on the
 /// current pool. Serial, this took 50-100 ms of igea-sub4's 1-thread build (1.07M
 /// triangles) and 6-9 ms of the instanced dragon's, more than the root node's splits, on one
-/// thread at any pool size (bench/README, issue 14, fourteenth pass). The result does not
-/// depend on the thread count.
+/// thread at any pool size. The result does not depend on the thread count.
 fn pack(
     shapes: &[Shape],
     prims: &[PrimRef],

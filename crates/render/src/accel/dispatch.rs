@@ -1,5 +1,5 @@
 //! The one dispatch point of the ray engine: a `WideBvh`'s queries run the kernels of the
-//! `Isa` chosen when it was built, the AVX2 ones of `simd.rs` or the scalar ones of `wide.rs`
+//! `Isa` chosen when it was built, the AVX2 ones of `simd/` or the scalar ones of `wide.rs`
 //! and `packet.rs`. Layout and traversal (`wide.rs`, `packet.rs`) know nothing of the SIMD
 //! kernels; the kernels know the traversal; this module knows both.
 

@@ -5,10 +5,10 @@
 
 use rayon::prelude::*;
 
+use crate::accel::binary::Bvh;
 use crate::accel::build::{BuildPhases, SplitMethod};
 use crate::accel::wide::{TreeStats, WalkCounts, BLOCK};
 use crate::accel::{LocalHit, WideBvh, PACKET};
-use crate::bvh::Bvh;
 use crate::geometry::{Aabb, Shape};
 use crate::material::MaterialId;
 use crate::math::{Transform, Vec3};
@@ -368,7 +368,7 @@ pub enum AccelKind {
     /// 8-wide BVH with SIMD traversal and watertight triangle blocks (the default).
     #[default]
     Wide,
-    /// The reference binary BVH (`crate::bvh`) over the shapes, tested one by one.
+    /// The reference binary BVH (`accel::binary`) over the shapes, tested one by one.
     Binary,
 }
 

@@ -1,5 +1,5 @@
 //! Which kernels this CPU runs, decided once: `Isa::detect` when a structure is built. The
-//! `Avx2` value is the proof that the CPU has AVX2 and FMA; the AVX2 kernels of `simd.rs` take
+//! `Avx2` value is the proof that the CPU has AVX2 and FMA; the AVX2 kernels of `simd/` take
 //! it instead of checking again, so the choice is made in one place.
 
 /// Proof that this CPU has AVX2 and FMA: only `Avx2::detect` makes one. It also tells
@@ -14,7 +14,7 @@ pub struct Avx2 {
 }
 
 /// On other targets (wasm32, aarch64) there is no such proof: the type has no values, so the
-/// AVX2 paths of `simd.rs` are statically unreachable.
+/// AVX2 paths of `simd/` are statically unreachable.
 #[cfg(not(target_arch = "x86_64"))]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Avx2 {}

@@ -30,8 +30,8 @@
 //! packet; the packet traversal would answer them identically (tested).
 //!
 //! **Scalar fallback.** `ScalarPacketKernel` here does the same tests one ray at a time; the
-//! AVX2 kernel lives in `simd.rs` (where its `unsafe` lives). The traversal below is generic
-//! over both, like `wide::closest`.
+//! AVX2 kernel lives in `simd/packet_walk.rs` (where its `unsafe` lives). The traversal below
+//! is generic over both, like `wide::closest`.
 
 use crate::accel::triangle::WoopRay;
 use crate::accel::wide::{
@@ -101,7 +101,7 @@ pub(crate) struct PacketRays<'a> {
 
 impl<'a> PacketRays<'a> {
     /// Written lane by lane in plain loops, which the compiler turns into 8-lane code inside
-    /// the AVX2 functions of `simd.rs` (the reciprocals are then a few vector divisions).
+    /// the AVX2 functions of `simd/` (the reciprocals are then a few vector divisions).
     #[inline(always)]
     #[allow(clippy::needless_range_loop)] // Lane-indexed loops over several arrays at once.
     pub fn new(rays: &'a [Ray; PACKET], lanes: u8) -> PacketRays<'a> {
@@ -276,7 +276,7 @@ fn interval(origin: &[Lanes; 3], inv_dir: &[Lanes; 3], t_min: &Lanes) -> Option<
     })
 }
 
-/// The tests of a packet traversal (scalar here, AVX2 in `simd.rs`).
+/// The tests of a packet traversal (scalar here, AVX2 in `simd/packet_walk.rs`).
 pub(crate) trait PacketKernel {
     /// The packet's constants (`PacketRays::new`, which the AVX2 kernel computes on eight
     /// lanes at once).
@@ -640,8 +640,8 @@ pub(crate) fn occluded<K: PacketKernel, S: PacketStack>(
 }
 
 /// Closest hits of the packet's valid rays: per lane (t, primitive), primitive `u32::MAX` for
-/// none. Generic over kernel and stack so that `simd.rs` instantiates it inside its `avx2`
-/// functions.
+/// none. Generic over kernel and stack so that `simd/packet_walk.rs` instantiates it inside
+/// its `target_feature` functions.
 #[inline(always)]
 pub(crate) fn closest<K: PacketKernel, S: PacketStack>(
     kernel: &K,

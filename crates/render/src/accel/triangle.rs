@@ -11,7 +11,7 @@
 //! through the edge's line and the edge belongs to the one of its two triangles for which it
 //! runs "up or to the right" in the sheared plane (the top-left rule of rasterisers).
 //!
-//! The SIMD kernels (`simd.rs`) do the same operations in the same order, lane by lane, and
+//! The SIMD kernels (`simd/`) do the same operations in the same order, lane by lane, and
 //! defer to `resolve_edge` for lanes with a zero edge function, so they agree bit for bit with
 //! `intersect` here.
 

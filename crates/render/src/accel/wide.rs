@@ -18,10 +18,10 @@
 //! **Traversal** is ordered: the children a ray enters are visited nearest first (one child:
 //! straight on; two: compare; more: sort), the others wait on a stack with their entry distance,
 //! and a popped entry further than the closest hit so far is dropped. `t_max` shrinks with each
-//! hit. The box and block tests are the `Kernel`: AVX2 in `simd.rs` when the CPU has it, the
+//! hit. The box and block tests are the `Kernel`: AVX2 in `simd/` when the CPU has it, the
 //! scalar `ScalarKernel` here otherwise. Both give the same entry distances and hits; the
 //! AVX2 box test may also enter boxes the scalar one culls, never the reverse (see
-//! `simd::node_test`), which changes no hit. A block hit carries its barycentrics, so a
+//! `simd/node.rs`, `node_test`), which changes no hit. A block hit carries its barycentrics, so a
 //! closest hit needs no second triangle test (`finish` serves the preliminary hits).
 
 use crate::accel::isa::Isa;
@@ -184,7 +184,7 @@ pub struct WideBvh {
     pub(crate) isa: Isa,
     /// The largest magnitude of any plane of a child box in `nodes` (∞ if one is infinite or
     /// NaN; 0 without nodes): what bounds the rounding of the AVX2 walk's slab distances
-    /// (`simd.rs`, `SlabMargin`; read only where that walk exists).
+    /// (`simd/node.rs`, `SlabMargin`; read only where that walk exists).
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     pub(crate) magnitude: f32,
 }
@@ -611,7 +611,7 @@ fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
         // prefetched, then ordered by a sorting network on their keys (`child_key`) with no
         // branch on the distances, the nearest taken, the others pushed, the farthest first.
         // For incoherent rays the order is a coin toss that a branch mispredicts half the
-        // time (bench/README, issue 14, twenty-first pass).
+        // time.
         let i1 = rest.trailing_zeros() as usize;
         let rest = rest & (rest - 1);
         let key = |i: usize| child_key(entry[i], node.children[i]);
@@ -648,9 +648,9 @@ fn descend<K: Kernel, S: Stack, const ORDERED: bool>(
             *current = ChildRef(key_parts(a).0);
             continue;
         }
-        // Five or more (rare: the bunny's visits entering four or more were 1-3 % of all,
-        // bench/README, issue 14, seventh pass): onto the stack sorted by entry distance,
-        // nearest on top (among equals the later slot), then the top taken.
+        // Five or more (rare: the bunny's visits entering four or more were 1-3 % of all):
+        // onto the stack sorted by entry distance, nearest on top (among equals the later
+        // slot), then the top taken.
         let base = *sp;
         while mask != 0 {
             let i = mask.trailing_zeros() as usize;
@@ -750,8 +750,7 @@ pub(crate) fn closest<K: Kernel, S: Stack>(
 /// 16-byte alignment, which the kernel moves by a random multiple of 16 bytes for every
 /// process, half the processes got an unaligned buffer, and the lent Xeon's single rays ran at
 /// two speeds from one run of the same binary to the next (the bunny's primary rays 8.4 or
-/// 10.6 Mrays/s, 5 runs of 12 slow; `bench/README.md`, twenty-eighth pass). The Zen 4 forwards
-/// either way.
+/// 10.6 Mrays/s, 5 runs of 12 slow). The Zen 4 forwards either way.
 #[repr(C, align(32))]
 struct EntryDistances([f32; WIDTH]);
 

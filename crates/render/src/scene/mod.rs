@@ -102,8 +102,8 @@ pub enum SurfaceNeeds {
     Uv,
     /// Texture coordinates where the hit's material reads them (`Material::reads_uv`), else
     /// (0, 0) as for `Geometry`: what the course integrator's shading needs. A sphere's
-    /// coordinates take an `acos` and an `atan2`, for every hit of an untextured sphere
-    /// before (bench/README, issue 14, twenty-first pass).
+    /// coordinates take an `acos` and an `atan2`, which every hit of an untextured sphere
+    /// would otherwise pay.
     Shading,
 }
 

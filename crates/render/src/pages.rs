@@ -1,21 +1,22 @@
-//! Memory for the trees' two big arrays, the nodes and the triangle blocks, advised for
-//! transparent huge pages (Linux's `madvise(MADV_HUGEPAGE)`), as Embree advises the memory of
-//! its own trees (`os_malloc`, `common/sys/alloc.cpp`).
+//! Memory for big arrays (the trees' nodes and triangle blocks, the textures' texels), advised
+//! for transparent huge pages (Linux's `madvise(MADV_HUGEPAGE)`), as Embree advises the memory
+//! of its own trees (`os_malloc`, `common/sys/alloc.cpp`). At the bottom of the crate: it
+//! knows nothing of what it holds.
 //!
 //! Rays that wander over a big mesh (igea-sub4's random rays: 16 MB of nodes and 39 MB of
 //! blocks, each ray touching a few of them far apart) miss the TLB at nearly every node on
-//! 4 KB pages; 2 MB pages cover the whole tree with a few dozen entries (bench/README, issue
-//! 14, seventh pass). Where the system keeps huge pages for those who ask (the `madvise`
-//! setting of `/sys/kernel/mm/transparent_hugepage/enabled`, Debian's default) nothing else
-//! asks. The advice changes no byte of the memory, only how the kernel backs it, and it is
-//! a hint: where it is refused or unknown (other systems, wasm32) the arrays are ordinary
-//! `Vec`s on whatever pages the system gives.
+//! 4 KB pages; 2 MB pages cover the whole tree with a few dozen entries. Where the system
+//! keeps huge pages for those who ask (the `madvise` setting of
+//! `/sys/kernel/mm/transparent_hugepage/enabled`, Debian's default) nothing else asks. The
+//! advice changes no byte of the memory, only how the kernel backs it, and it is a hint:
+//! where it is refused or unknown (other systems, wasm32) the arrays are ordinary `Vec`s on
+//! whatever pages the system gives.
 //!
 //! The second module of glint-render allowed `unsafe` (DESIGN.md, Tooling; the first is
-//! `simd.rs`): the one `madvise` call below, no crate offering it without `unsafe` for memory
+//! `accel::simd`): the one `madvise` call below, no crate offering it without `unsafe` for memory
 //! a `Vec` owns. The benchmark that justified it: igea-sub4's random rays 2.38 -> 2.58 Mrays/s
-//! and its build 0.322 -> 0.306 s (1 thread), `glint bench rays` alternating with the binary
-//! before (bench/README, issue 14, seventh pass); no other set moved beyond noise.
+//! and its build 0.322 -> 0.306 s (1 thread), `glint bench rays` alternating with a binary
+//! without it; no other set moved beyond noise.
 
 #![allow(unsafe_code)]
 

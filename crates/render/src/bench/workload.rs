@@ -1,5 +1,5 @@
-//! Fixed ray workloads for measuring the ray engine (issue 3's item 1), generated before any
-//! timing so that a measurement is traversal and intersection alone:
+//! Fixed ray workloads for measuring the ray engine, generated before any timing so that a
+//! measurement is traversal and intersection alone:
 //!
 //! - **primary**: coherent camera rays, one through the centre of each pixel, row by row;
 //! - **bounce**: incoherent rays, cosine-distributed around the facing geometric normal of each
