@@ -23,8 +23,8 @@
 //!   the two halves, pixel by pixel: Var(g) ≈ ((g1 − g2) / 2)².
 //!
 //! `cornell_matches_mitsuba_128spp` runs always (N = 128, a few seconds on 2 cores);
-//! `cornell_matches_mitsuba_1024spp` is the full comparison at 1024 spp, also always
-//! (about a minute on 2 cores); `--nocapture` prints the figures.
+//! `cornell_matches_mitsuba_1024spp` is the full comparison at 1024 spp, also always (about a
+//! minute on 2 cores); `--nocapture` prints the figures.
 
 use std::path::PathBuf;
 
@@ -221,7 +221,7 @@ fn cornell_matches_mitsuba_128spp() {
     compare_with_mitsuba(128);
 }
 
-/// The comparison at 1024 samples per pixel: about a minute on 2 cores.
+/// The full comparison at 1024 samples per pixel: about a minute on 2 cores.
 #[test]
 fn cornell_matches_mitsuba_1024spp() {
     compare_with_mitsuba(1024);
