@@ -3,7 +3,7 @@
 
 One node per source file. An edge A -> B means a file of module A names `crate::B...` or
 `super::B...` (in a `use` or a path). Test-only code (`#[cfg(test)] mod tests` blocks, a
-crate's src/tests/ and src/testing.rs) is left out: tests may look anywhere.
+crate's src/tests/, src/testing.rs and src/testing/) is left out: tests may look anywhere.
 
 Every crate of the repository is read (the workspace's, the Python module's and the fuzz
 targets'). In glint-render the modules also sit in layers (LAYERS below, lowest first); an
@@ -64,7 +64,7 @@ def read_modules(root: Path) -> dict:
     files = {}
     for path in sorted(root.rglob("*.rs")):
         rel = path.relative_to(root).as_posix()
-        if rel.startswith("tests/") or rel == "testing.rs":
+        if rel.startswith(("tests/", "testing/")) or rel == "testing.rs":
             continue
         text = path.read_text()
         # Drop the unit-test module at the end of a file.

@@ -1,10 +1,11 @@
 //! The scene flattened into the storage buffers `path.wgsl` reads. Nothing here is shared with
 //! the CPU renderer's private structures: it is built from the public `SceneParts` alone, so
 //! the GPU back end has its own BVHs (binary, binned SAH: one per geometry in its object space,
-//! one over the instances, as glint-render's two-level structure) and its
-//! own copy of the light sampler's tables (selection by power, triangle areas), computed by the
-//! same formulas as `glint-render`'s `light::sampler`; the cube map's luminance distribution
-//! is glint-render's own (`CubeDistribution`, public for this), uploaded as it is.
+//! one over the instances, as glint-render's two-level structure) and its own light records
+//! and triangle area shares, computed by the same formulas as `glint-render`'s
+//! `light::sampler`. The table that chooses a light by power (`LightSelection`) and the cube
+//! map's luminance distribution (`CubeDistribution`) are glint-render's own, public for this,
+//! and uploaded as they are.
 //!
 //! Every buffer is an array of `vec4<f32>` (or of `f32` for `tables`); integers travel as the
 //! bits of an f32 (`bits`). The strides and kinds below are repeated, by name, as constants at
@@ -14,8 +15,8 @@ use std::f32::consts::PI;
 
 use bytemuck::{Pod, Zeroable};
 use glint_render::{
-    Background, Camera, Color, ColorSource, CubeDistribution, Image, Light, Material, Projection,
-    SceneParts, Shape, Transform, Vec3,
+    Background, Camera, Color, ColorSource, CubeDistribution, Image, Light, LightSelection,
+    Material, Projection, SceneParts, Shape, Transform, Vec3,
 };
 
 pub const NONE: u32 = u32::MAX;
@@ -254,7 +255,7 @@ impl FlatScene {
         let mut tables = Vec::new();
         let mut texels = Vec::new();
         let lights = LightTables::new(parts, (scene_lo, scene_hi));
-        tables.extend_from_slice(&lights.selection_cdf);
+        tables.extend_from_slice(lights.selection.cdf());
 
         // Textures: the material textures, then the cube map's six faces.
         let mut images: Vec<&Image> = parts.textures.iter().collect();
@@ -535,14 +536,14 @@ fn flatten_materials(parts: &SceneParts) -> Vec<[f32; 4]> {
         .collect()
 }
 
-/// The light sampler's tables (glint-render's `light::sampler::LightSampler::new`, the same
-/// powers, selection CDF, triangle area shares and cube-map distribution).
+/// The light sampler's tables (glint-render's `light::sampler::LightSampler::new`: the same
+/// light selection and cube-map distribution, the same triangle area shares).
 struct LightTables {
     words: Vec<[f32; 4]>,
     count: u32,
     environment: Option<u32>,
     triangles_offset: u32,
-    selection_cdf: Vec<f32>,
+    selection: LightSelection,
     cube: Option<CubeDistribution>,
 }
 
@@ -569,7 +570,9 @@ impl LightTables {
         for (index, light) in parts.lights.iter().enumerate() {
             let mut w = [[0.0f32; 4]; LIGHT_STRIDE];
             let reachable = if reachable[index] { 1.0 } else { 0.0 };
-            let phi = match light {
+            // The total area of emitting triangles, summed with their table.
+            let mut triangles_area = 0.0f64;
+            match light {
                 Light::Point {
                     position,
                     intensity,
@@ -577,7 +580,6 @@ impl LightTables {
                     w[0] = [bits(LIGHT_POINT), 0.0, 0.0, 0.0];
                     w[1] = v4(*position, 0.0);
                     w[5] = v4(*intensity, 0.0);
-                    4.0 * PI * mean(*intensity)
                 }
                 Light::Area {
                     position,
@@ -594,7 +596,6 @@ impl LightTables {
                     w[3] = v4(v_edge, 0.0);
                     w[4] = v4(normal.normalized(), 0.0);
                     w[5] = v4(*intensity, 0.0);
-                    PI * area * mean(*intensity)
                 }
                 Light::Sphere {
                     center,
@@ -605,7 +606,6 @@ impl LightTables {
                     w[0] = [bits(LIGHT_SPHERE), 0.0, 0.0, reachable];
                     w[1] = v4(*center, radius);
                     w[5] = v4(*intensity, 0.0);
-                    PI * 4.0 * PI * radius * radius * mean(*intensity)
                 }
                 Light::Triangles {
                     triangles: list,
@@ -642,11 +642,11 @@ impl LightTables {
                     w[1] = [0.0, 0.0, 0.0, total as f32];
                     w[2] = [0.0, 0.0, 0.0, 1.0 / total as f32];
                     w[5] = v4(*intensity, 0.0);
-                    PI * total as f32 * mean(*intensity)
+                    triangles_area = total;
                 }
-            };
+            }
             words.extend_from_slice(&w);
-            power.push(if phi.is_finite() { phi.max(0.0) } else { 0.0 });
+            power.push(LightSelection::power(light, triangles_area));
         }
         let (environment_integral, cube) = match &parts.background {
             Background::Color(c) => {
@@ -660,7 +660,7 @@ impl LightTables {
         };
         let mut environment = None;
         if let Some(integral) = environment_integral {
-            // pbrt-v4's power of an infinite light, π r² ∫ L dω, r the scene's bounding radius.
+            // The scene's bounding radius, for the environment's power.
             let radius = if scene_lo.x <= scene_hi.x {
                 0.5 * (scene_hi - scene_lo).length()
             } else {
@@ -670,24 +670,7 @@ impl LightTables {
             let mut w = [[0.0f32; 4]; LIGHT_STRIDE];
             w[0] = [bits(LIGHT_ENVIRONMENT), 0.0, 0.0, 1.0];
             words.extend_from_slice(&w);
-            power.push(PI * radius * radius * integral);
-        }
-        let total: f64 = power.iter().map(|&p| p as f64).sum();
-        let mut selection_cdf = Vec::with_capacity(power.len() + 1);
-        selection_cdf.push(0.0f32);
-        let mut running = 0.0f64;
-        for &p in &power {
-            running += p as f64;
-            selection_cdf.push(if total > 0.0 {
-                (running / total) as f32
-            } else {
-                0.0
-            });
-        }
-        if total > 0.0 {
-            if let Some(last) = selection_cdf.last_mut() {
-                *last = 1.0;
-            }
+            power.push(LightSelection::environment_power(radius, integral));
         }
         let count = power.len() as u32;
         let triangles_offset = words.len() as u32;
@@ -697,7 +680,7 @@ impl LightTables {
             count,
             environment,
             triangles_offset,
-            selection_cdf,
+            selection: LightSelection::new(&power),
             cube,
         }
     }

@@ -3,19 +3,14 @@
 //! Vulkan (lavapipe). Without an adapter the tests print SKIPPED and pass, except under
 //! `CI=1`, where they fail: CI installs the driver, so a missing adapter is a broken setup.
 //!
-//! The criterion is the noise-aware one of `crates/io/tests/path_cornell.rs`, with the CPU in
-//! Mitsuba's place and the reference's own noise measured instead of taken from a table:
-//!
-//! - The GPU renders the scene twice with different seeds at N/2 samples per pixel, g1 and
-//!   g2; g is their mean. The CPU renders it twice at M/2 (M much larger than N), r1 and r2;
-//!   r is their mean.
-//! - relMSE(a, b) = mean over pixels and channels of (a − b)² / (r² + 0.01).
-//! - If both are unbiased, E[relMSE(g, r)] = σ²_g + σ²_r, and each σ² is a quarter of the
-//!   relMSE between its own two halves (E[(x1 − x2)²] = 4 Var(mean)).
-//! - Pass: relMSE(g, r) ≤ 1.15 · (σ²_g + σ²_r), and every 16x16 block's mean agrees with the
-//!   CPU's within 2% per channel, or within five standard errors of the difference where
-//!   that is larger.
-//! - Negative control: the GPU's images made 3% darker must fail the same test.
+//! The criterion is the noise-aware one of `glint_render::testing::compare` (that of
+//! `crates/io/tests/path_cornell.rs`), with the CPU in Mitsuba's place and the reference's own
+//! noise measured instead of taken from a table: the GPU renders the scene twice with
+//! different seeds at N/2 samples per pixel, the CPU twice at M/2 (M much larger than N), and
+//! the GPU's mean must agree with the CPU's within 1.15 times what the noise of both explains
+//! in relMSE, and every 16x16 block within 2% per channel, or within five standard errors of
+//! the difference where that is larger; blocks the CPU renders black are not judged. Negative
+//! control: the GPU's images made 3% darker must fail the same test.
 //!
 //! `--nocapture` prints the figures and the timings.
 
@@ -25,6 +20,7 @@ use std::time::Instant;
 
 use common::{cornell, gpu};
 use glint_gpu::{GpuError, GpuRenderer};
+use glint_render::testing::compare::{judge, scaled, to_pixels, Criterion, Pixel, Reference};
 use glint_render::{
     Background, Camera, Color, ColorSource, CubeMap, GeometryDesc, Image, Instance, IntegratorKind,
     Light, Material, Matrix4, Projection, RenderSettings, Scene, SceneParts, Shape, Transform,
@@ -33,10 +29,10 @@ use glint_render::{
 
 const SIZE: u32 = 64;
 const BLOCK: u32 = 16;
-const TOLERANCE: f64 = 1.15;
-const BLOCK_TOLERANCE: f64 = 0.02;
+/// Block channels the CPU renders at or below this are not judged.
+const DARK_BLOCK: f64 = 1e-4;
 
-type Pixels = Vec<[f64; 3]>;
+type Pixels = Vec<Pixel>;
 
 fn settings(samples: u32, seed: u64) -> RenderSettings {
     RenderSettings {
@@ -49,18 +45,11 @@ fn settings(samples: u32, seed: u64) -> RenderSettings {
     }
 }
 
-fn to_pixels(film: &glint_render::Film) -> Pixels {
-    film.pixels
-        .iter()
-        .map(|c: &Color| [c.x as f64, c.y as f64, c.z as f64])
-        .collect()
-}
-
 fn render_cpu(parts: &SceneParts, samples: u32, seed: u64) -> Pixels {
     let scene = Scene::new(parts.clone());
     let (film, stats) = glint_render::render(&scene, &settings(samples, seed), &|_| true).unwrap();
     assert_eq!(stats.nonfinite_samples, 0);
-    to_pixels(&film)
+    to_pixels(&film.pixels)
 }
 
 fn render_gpu(gpu: &GpuRenderer, parts: &SceneParts, samples: u32, seed: u64) -> Pixels {
@@ -73,106 +62,7 @@ fn render_gpu(gpu: &GpuRenderer, parts: &SceneParts, samples: u32, seed: u64) ->
         stats.first_nonfinite_pixel
     );
     assert_eq!(stats.samples, (SIZE * SIZE * samples) as u64);
-    to_pixels(&film)
-}
-
-fn mean_of(a: &Pixels, b: &Pixels) -> Pixels {
-    a.iter()
-        .zip(b)
-        .map(|(a, b)| std::array::from_fn(|c| 0.5 * (a[c] + b[c])))
-        .collect()
-}
-
-/// Mean over pixels and channels of (a − b)² / (r² + 0.01).
-fn relative_mse(a: &Pixels, b: &Pixels, reference: &Pixels) -> f64 {
-    let mut sum = 0.0;
-    for ((a, b), r) in a.iter().zip(b).zip(reference) {
-        for c in 0..3 {
-            sum += (a[c] - b[c]).powi(2) / (r[c] * r[c] + 0.01);
-        }
-    }
-    sum / (3 * a.len()) as f64
-}
-
-/// Means of the blocks, per channel, row-major.
-fn block_means(image: &Pixels) -> Pixels {
-    let blocks = SIZE / BLOCK;
-    let mut means = vec![[0.0; 3]; (blocks * blocks) as usize];
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            let block = &mut means[((y / BLOCK) * blocks + x / BLOCK) as usize];
-            for c in 0..3 {
-                block[c] += image[(y * SIZE + x) as usize][c] / (BLOCK * BLOCK) as f64;
-            }
-        }
-    }
-    means
-}
-
-/// Per-pixel variance of the mean of two halves: ((x1 − x2) / 2)².
-fn half_variance(a: &Pixels, b: &Pixels) -> Pixels {
-    a.iter()
-        .zip(b)
-        .map(|(a, b)| std::array::from_fn(|c| ((a[c] - b[c]) / 2.0).powi(2)))
-        .collect()
-}
-
-/// The comparison of the module docs: `Ok` with the figures, or `Err` with the failure.
-fn judge(gpu: (&Pixels, &Pixels), cpu: (&Pixels, &Pixels)) -> Result<String, String> {
-    let g = mean_of(gpu.0, gpu.1);
-    let r = mean_of(cpu.0, cpu.1);
-    let error = relative_mse(&g, &r, &r);
-    let gpu_noise = relative_mse(gpu.0, gpu.1, &r) / 4.0;
-    let cpu_noise = relative_mse(cpu.0, cpu.1, &r) / 4.0;
-    let expected = gpu_noise + cpu_noise;
-
-    let ours = block_means(&g);
-    let theirs = block_means(&r);
-    // block_means divides by the block's pixel count once; a mean's variance needs it twice.
-    let variance_g = block_means(&half_variance(gpu.0, gpu.1));
-    let variance_r = block_means(&half_variance(cpu.0, cpu.1));
-    let pixels_per_block = (BLOCK * BLOCK) as f64;
-    // (error / limit, error, block, channel, noise) of the block closest to failing.
-    let mut worst = (f64::NEG_INFINITY, 0.0, 0, 0, 0.0);
-    for (block, r) in theirs.iter().enumerate() {
-        for c in 0..3 {
-            if r[c] <= 1e-4 {
-                continue;
-            }
-            let error = (ours[block][c] - r[c]).abs() / r[c];
-            let noise =
-                ((variance_g[block][c] + variance_r[block][c]) / pixels_per_block).sqrt() / r[c];
-            let limit = BLOCK_TOLERANCE.max(5.0 * noise);
-            if error / limit > worst.0 {
-                worst = (error / limit, error, block, c, noise);
-            }
-        }
-    }
-    let (_, block_error, block, channel, block_noise) = worst;
-    let block_limit = BLOCK_TOLERANCE.max(5.0 * block_noise);
-    let blocks = SIZE / BLOCK;
-    let (bx, by) = (block as u32 % blocks, block as u32 / blocks);
-    let figures = format!(
-        "relMSE GPU vs CPU {error:.3e}, expected from noise {expected:.3e} (GPU {gpu_noise:.3e}, \
-         CPU {cpu_noise:.3e}), ratio {:.3} (limit {TOLERANCE}); worst {BLOCK}x{BLOCK} block \
-         {:.2}% (block {bx},{by} channel {channel}; limit {:.2}%, noise {:.2}%)",
-        error / expected,
-        100.0 * block_error,
-        100.0 * block_limit,
-        100.0 * block_noise,
-    );
-    if error > TOLERANCE * expected {
-        return Err(format!(
-            "relMSE {error:.3e} exceeds {TOLERANCE} x the noise-expected {expected:.3e}: {figures}"
-        ));
-    }
-    if block_error > block_limit {
-        return Err(format!(
-            "block ({bx},{by}) channel {channel} is off by {:.2}%: {figures}",
-            100.0 * block_error
-        ));
-    }
-    Ok(figures)
+    to_pixels(&film.pixels)
 }
 
 /// Renders `parts` on both back ends and applies the criterion, then the negative control.
@@ -188,7 +78,12 @@ fn compare(test: &str, parts: &SceneParts, gpu_samples: u32, cpu_samples: u32) {
     let r1 = render_cpu(parts, cpu_samples / 2, 11);
     let r2 = render_cpu(parts, cpu_samples / 2, 12);
     let cpu_seconds = start.elapsed().as_secs_f64();
-    let verdict = judge((&g1, &g2), (&r1, &r2));
+    let criterion = Criterion {
+        dark_block: Some(DARK_BLOCK),
+        ..Criterion::new(SIZE, SIZE, BLOCK)
+    };
+    let cpu = Reference::Halves(&r1, &r2);
+    let verdict = judge(&criterion, (&g1, &g2), cpu);
     println!(
         "{test}: GPU {gpu_samples} spp ({gpu_seconds:.1} s) vs CPU {cpu_samples} spp \
          ({cpu_seconds:.1} s): {}",
@@ -197,13 +92,7 @@ fn compare(test: &str, parts: &SceneParts, gpu_samples: u32, cpu_samples: u32) {
     if let Err(failure) = verdict {
         panic!("{test}: {failure}");
     }
-    let darker = |image: &Pixels| -> Pixels {
-        image
-            .iter()
-            .map(|p| [0.97 * p[0], 0.97 * p[1], 0.97 * p[2]])
-            .collect()
-    };
-    let dark = judge((&darker(&g1), &darker(&g2)), (&r1, &r2));
+    let dark = judge(&criterion, (&scaled(&g1, 0.97), &scaled(&g2, 0.97)), cpu);
     println!(
         "{test}: GPU 3% darker (must fail): {}",
         dark.as_ref().unwrap_or_else(|e| e)

@@ -51,6 +51,7 @@ mod image_io;
 mod json;
 mod limits;
 mod mesh;
+mod mesh_file;
 mod obj;
 mod obj_fast;
 mod ply;
@@ -76,7 +77,8 @@ pub use image_io::{
     WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
 };
 pub use limits::{format_bytes, Limits, BYTES_PER_TEXEL};
-pub use mesh::{load_mesh, load_mesh_from, Mesh, MeshError};
+pub use mesh::Mesh;
+pub use mesh_file::{load_mesh, load_mesh_from, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
 pub use scene_hash::scene_hash;
 

@@ -80,6 +80,7 @@ pub use accel::build::{BuildPhases, SplitMethod};
 pub use camera::{Camera, Projection, ThinLens};
 pub use geometry::{Aabb, Shape};
 pub use light::sampler::CubeDistribution;
+pub use light::sampler::LightSelection;
 pub use light::Light;
 pub use material::{Material, MaterialId};
 pub use math::{Color, Matrix4, Transform, Vec3};

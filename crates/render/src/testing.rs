@@ -2,6 +2,8 @@
 //! random rays and meshes.
 #![allow(dead_code)]
 
+pub mod compare;
+
 use crate::accel::binary::Bvh;
 use crate::accel::triangle::{self, WoopRay};
 use crate::accel::{Isa, WideBvh};

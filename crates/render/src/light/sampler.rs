@@ -185,10 +185,7 @@ pub struct LightSampler {
     lights: Vec<PreparedLight>,
     /// Whether BSDF sampling can reach each light.
     reachable: Vec<bool>,
-    selection_probability: Vec<f32>,
-    /// `selection_cdf[i]` is the probability of choosing a light before `i`; one more entry
-    /// than lights, the last 1.
-    selection_cdf: Vec<f32>,
+    selection: LightSelection,
     triangles: Vec<PreparedTriangle>,
     environment: Option<EnvironmentDistribution>,
 }
@@ -225,17 +222,16 @@ impl LightSampler {
             }
         }
         for light in &scene.lights {
-            let (prepared, phi) = match light {
+            // The total area of emitting triangles, summed with their table.
+            let mut triangles_area = 0.0f64;
+            let prepared = match light {
                 Light::Point {
                     position,
                     intensity,
-                } => (
-                    PreparedLight::Point {
-                        position: *position,
-                        intensity: *intensity,
-                    },
-                    4.0 * PI * mean(*intensity),
-                ),
+                } => PreparedLight::Point {
+                    position: *position,
+                    intensity: *intensity,
+                },
                 Light::Area {
                     position,
                     normal,
@@ -244,34 +240,24 @@ impl LightSampler {
                     intensity,
                 } => {
                     let (u_edge, v_edge) = Light::area_edges(*normal, *width, *length);
-                    let area = u_edge.cross(v_edge).length();
-                    (
-                        PreparedLight::Rectangle {
-                            center: *position,
-                            u_edge,
-                            v_edge,
-                            normal: normal.normalized(),
-                            area,
-                            radiance: *intensity,
-                        },
-                        PI * area * mean(*intensity),
-                    )
+                    PreparedLight::Rectangle {
+                        center: *position,
+                        u_edge,
+                        v_edge,
+                        normal: normal.normalized(),
+                        area: u_edge.cross(v_edge).length(),
+                        radiance: *intensity,
+                    }
                 }
                 Light::Sphere {
                     center,
                     radius,
                     intensity,
-                } => {
-                    let radius = radius.abs();
-                    (
-                        PreparedLight::Sphere {
-                            center: *center,
-                            radius,
-                            radiance: *intensity,
-                        },
-                        PI * 4.0 * PI * radius * radius * mean(*intensity),
-                    )
-                }
+                } => PreparedLight::Sphere {
+                    center: *center,
+                    radius: radius.abs(),
+                    radiance: *intensity,
+                },
                 Light::Triangles {
                     triangles: list,
                     intensity,
@@ -301,27 +287,24 @@ impl LightSampler {
                     if let Some(last) = added.last_mut() {
                         last.cumulative = 1.0;
                     }
-                    (
-                        PreparedLight::Triangles {
-                            first,
-                            count: list.len() as u32,
-                            area: total as f32,
-                            inverse_area: 1.0 / total as f32,
-                            radiance: *intensity,
-                        },
-                        PI * total as f32 * mean(*intensity),
-                    )
+                    triangles_area = total;
+                    PreparedLight::Triangles {
+                        first,
+                        count: list.len() as u32,
+                        area: total as f32,
+                        inverse_area: 1.0 / total as f32,
+                        radiance: *intensity,
+                    }
                 }
             };
             lights.push(prepared);
-            power.push(if phi.is_finite() { phi.max(0.0) } else { 0.0 });
+            power.push(LightSelection::power(light, triangles_area));
         }
         let environment = with_environment
             .then(|| EnvironmentDistribution::new(&scene.background))
             .flatten();
         if let Some(env) = &environment {
-            // pbrt-v4's power of an infinite light: what it sends through a disk the size of
-            // the scene, π r² ∫ L dω.
+            // The scene's bounding radius, for the environment's power.
             let bounds = scene.bounds();
             let radius = if bounds.is_empty() {
                 1.0
@@ -330,40 +313,12 @@ impl LightSampler {
             };
             lights.push(PreparedLight::Environment);
             reachable.push(true);
-            power.push(PI * radius * radius * env.integral);
-        }
-        let total: f64 = power.iter().map(|&p| p as f64).sum();
-        let selection_probability: Vec<f32> = power
-            .iter()
-            .map(|&p| {
-                if total > 0.0 {
-                    (p as f64 / total) as f32
-                } else {
-                    0.0
-                }
-            })
-            .collect();
-        let mut selection_cdf = Vec::with_capacity(power.len() + 1);
-        let mut running = 0.0f64;
-        selection_cdf.push(0.0);
-        for &p in &power {
-            running += p as f64;
-            selection_cdf.push(if total > 0.0 {
-                (running / total) as f32
-            } else {
-                0.0
-            });
-        }
-        if total > 0.0 {
-            if let Some(last) = selection_cdf.last_mut() {
-                *last = 1.0;
-            }
+            power.push(LightSelection::environment_power(radius, env.integral));
         }
         LightSampler {
             lights,
             reachable,
-            selection_probability,
-            selection_cdf,
+            selection: LightSelection::new(&power),
             triangles,
             environment,
         }
@@ -376,10 +331,7 @@ impl LightSampler {
 
     /// Probability that `sample` chooses light `index`.
     pub fn selection_probability(&self, index: usize) -> f32 {
-        self.selection_probability
-            .get(index)
-            .copied()
-            .unwrap_or(0.0)
+        self.selection.probability(index)
     }
 
     /// Whether BSDF-sampled rays can hit light `index`.
@@ -395,7 +347,7 @@ impl LightSampler {
     /// one-sided emitter).
     #[inline(always)]
     pub fn sample(&self, scene: &Scene, reference: Vec3, u: (f32, f32)) -> Option<LightSample> {
-        let (index, probability, remapped) = sample_cdf(&self.selection_cdf, u.0)?;
+        let (index, probability, remapped) = self.selection.sample(u.0)?;
         let u = (remapped, u.1);
         // Shape emitters, the commonest lights, inline; the others out of line.
         let mut sample = match self.lights.get(index)? {
@@ -711,6 +663,115 @@ impl LightSampler {
             // Not emitters with a surface: nothing to add, nothing to hide.
             _ => Some(Color::ZERO),
         }
+    }
+}
+
+/// The table that chooses a light: each light (the environment last, when it emits) with a
+/// probability in proportion to its power Φ, by one uniform number and a binary search of the
+/// cumulative distribution, O(log n). The renderer's `LightSampler` samples with it, and the
+/// GPU back end uploads its `cdf` as it is, so the two back ends choose lights alike.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightSelection {
+    /// `probability[i]` is the probability of choosing light `i`.
+    probability: Vec<f32>,
+    /// `cdf[i]` is the probability of choosing a light before `i`; one more entry than
+    /// lights, the last 1 (all 0 when no light emits).
+    cdf: Vec<f32>,
+}
+
+impl LightSelection {
+    /// The table for the lights' powers, in order: [`LightSelection::power`] of each light,
+    /// then [`LightSelection::environment_power`] where the background emits. Light i is
+    /// chosen with probability power[i] / Σ power, summed in f64; no light at all when the sum
+    /// is 0.
+    pub fn new(power: &[f32]) -> LightSelection {
+        let total: f64 = power.iter().map(|&p| p as f64).sum();
+        let probability: Vec<f32> = power
+            .iter()
+            .map(|&p| {
+                if total > 0.0 {
+                    (p as f64 / total) as f32
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        let mut cdf = Vec::with_capacity(power.len() + 1);
+        let mut running = 0.0f64;
+        cdf.push(0.0);
+        for &p in power {
+            running += p as f64;
+            cdf.push(if total > 0.0 {
+                (running / total) as f32
+            } else {
+                0.0
+            });
+        }
+        if total > 0.0 {
+            if let Some(last) = cdf.last_mut() {
+                *last = 1.0;
+            }
+        }
+        LightSelection { probability, cdf }
+    }
+
+    /// Φ of `light`, by which the table weighs it, each colour by its channel mean: 4π I for a
+    /// point light, π A L for the one-sided area emitters (a rectangle; emitting triangles of
+    /// total area `triangles_area`, as the caller summed it with its triangle table), π 4π r² L
+    /// for a sphere. 0 where that is not a finite positive number.
+    pub fn power(light: &Light, triangles_area: f64) -> f32 {
+        let phi = match light {
+            Light::Point { intensity, .. } => 4.0 * PI * mean(*intensity),
+            Light::Area {
+                normal,
+                width,
+                length,
+                intensity,
+                ..
+            } => {
+                let (u_edge, v_edge) = Light::area_edges(*normal, *width, *length);
+                let area = u_edge.cross(v_edge).length();
+                PI * area * mean(*intensity)
+            }
+            Light::Sphere {
+                radius, intensity, ..
+            } => {
+                let radius = radius.abs();
+                PI * 4.0 * PI * radius * radius * mean(*intensity)
+            }
+            Light::Triangles { intensity, .. } => PI * triangles_area as f32 * mean(*intensity),
+        };
+        if phi.is_finite() {
+            phi.max(0.0)
+        } else {
+            0.0
+        }
+    }
+
+    /// Φ of an emitting background, pbrt-v4's power of an infinite light: what it sends
+    /// through a disk the size of the scene, π r² ∫ L dω, for the scene's bounding radius
+    /// `scene_radius` and `integral` = ∫ L dω (channel mean).
+    pub fn environment_power(scene_radius: f32, integral: f32) -> f32 {
+        PI * scene_radius * scene_radius * integral
+    }
+
+    /// The cumulative distribution: entry i is the probability of choosing a light before i,
+    /// one more entry than lights.
+    pub fn cdf(&self) -> &[f32] {
+        &self.cdf
+    }
+
+    /// The probability of choosing light `index` (0 for no light).
+    #[inline]
+    pub fn probability(&self, index: usize) -> f32 {
+        self.probability.get(index).copied().unwrap_or(0.0)
+    }
+
+    /// The light `u` chooses, with its probability and `u` remapped to [0, 1) within its
+    /// share; `None` when no light emits.
+    #[inline(always)]
+    fn sample(&self, u: f32) -> Option<(usize, f32, f32)> {
+        sample_cdf(&self.cdf, u)
     }
 }
 
