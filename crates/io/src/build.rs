@@ -29,9 +29,9 @@ use crate::desc::{
     TextureDesc, TransformOperation, TransformStep,
 };
 use crate::diagnostic::{did_you_mean, Diagnostics, SceneError};
-use crate::image_io::{load_cube_map, load_image, read_image, Checked, TextureBudget};
 use crate::limits::Limits;
 use crate::obj::load_triangles;
+use crate::texture_io::{load_cube_map, load_image, read_image, Checked, TextureBudget};
 
 pub(crate) fn build(
     desc: &SceneDesc,

@@ -60,6 +60,7 @@ mod read;
 mod scene_hash;
 #[cfg(test)]
 mod testing;
+mod texture_io;
 mod tree;
 mod values;
 mod xml;
