@@ -107,9 +107,18 @@ pub enum Command {
     },
     /// Assemble farm parts (tiles, sample ranges: EXRs written by `glint render`) into one
     /// image, refusing parts that do not fit together.
-    #[command(after_help = crate::merge::AFTER_HELP)]
+    #[command(after_help = MERGE_AFTER_HELP)]
     Merge(MergeArgs),
 }
+
+const MERGE_AFTER_HELP: &str = "\
+Example (four tiles, then four sample ranges of the same render):
+  for i in 0 1 2 3; do glint render s.json -w 640 -h 480 --tile $i/4 -o part$i.exr; done
+  glint merge -o s.png part0.exr part1.exr part2.exr part3.exr
+
+Refused (exit status 2, nothing written): parts of other renders (scene hash, seed, size,
+integrator, samples per pixel, depth, aspect or Glint version differ), pixels in no part (a
+gap), pixels in two tiles (an overlap), samples in no part or in two.";
 
 /// `glint merge -o OUT PART...`
 #[derive(Args, Debug, Clone)]

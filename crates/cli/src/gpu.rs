@@ -16,7 +16,9 @@ use glint_render::{RenderStats, SceneParts};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::{Job, UsageError};
-use crate::run::{plural, si, Failure, Interrupt, Phase, Summary};
+use crate::failure::Failure;
+use crate::interrupt::{Interrupt, Phase};
+use crate::report::{plural, si, Summary};
 
 /// Renders `parts` on the GPU and writes the image.
 pub fn run(

@@ -9,8 +9,10 @@ mod args;
 mod bench;
 mod checkpoint;
 mod diff;
+mod failure;
 mod farm;
 mod gpu;
+mod interrupt;
 mod merge;
 mod preview;
 mod report;
@@ -22,7 +24,8 @@ use std::process::ExitCode;
 use clap::Parser;
 
 use crate::args::Cli;
-use crate::run::{Failure, Interrupt, SignalAction, EXIT_INTERRUPTED};
+use crate::failure::{Failure, EXIT_INTERRUPTED};
+use crate::interrupt::{Interrupt, SignalAction};
 
 /// Shared with the Ctrl-C handler, which must be `'static`.
 static INTERRUPT: Interrupt = Interrupt::new();

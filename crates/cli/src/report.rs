@@ -1,11 +1,67 @@
-//! What a run tells a log: the progress line printed every few seconds when stderr is not a
-//! terminal, and the `--stats` sections.
+//! What a run tells the user: the closing line and the summary it stands for, the progress
+//! line printed every few seconds when stderr is not a terminal, and the `--stats` sections.
 
 use std::fmt::Write as _;
 use std::io::Write;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::Mutex;
 use std::time::{Duration, Instant};
+
+use glint_render::RenderStats;
+
+use crate::args::Job;
+
+/// What a successful run did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Summary {
+    pub stats: RenderStats,
+    pub render_time: Duration,
+    pub threads: usize,
+}
+
+/// `rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png`
+pub fn closing_line(job: &Job, stats: &RenderStats, render_time: Duration) -> String {
+    let settings = &job.settings;
+    let seconds = render_time.as_secs_f64();
+    let rate = if seconds > 0.0 {
+        stats.rays as f64 / seconds
+    } else {
+        0.0
+    };
+    format!(
+        "rendered {}x{}, {} rpp in {seconds:.2} s: {} rays, {} rays/s, {} -> {}",
+        settings.width,
+        settings.height,
+        settings.samples_per_pixel(),
+        si(stats.rays as f64),
+        si(rate),
+        threads_text(job.threads),
+        job.output.display()
+    )
+}
+
+/// A count with an SI prefix: "950", "12.3 k", "4.5 M".
+pub fn si(value: f64) -> String {
+    const PREFIXES: [(f64, &str); 4] = [(1e12, "T"), (1e9, "G"), (1e6, "M"), (1e3, "k")];
+    for (scale, prefix) in PREFIXES {
+        if value >= scale {
+            return format!("{:.1} {prefix}", value / scale);
+        }
+    }
+    format!("{value:.0}")
+}
+
+pub fn threads_text(threads: usize) -> String {
+    format!("{threads} thread{}", plural(threads as u64))
+}
+
+pub(crate) fn plural(count: u64) -> &'static str {
+    if count == 1 {
+        ""
+    } else {
+        "s"
+    }
+}
 
 /// The progress line, one every `--progress-every` seconds on a stderr that is not a terminal
 /// (a farm job's log). Space-separated `key=value` fields, in this order:
@@ -153,6 +209,56 @@ pub fn seconds(duration: Duration) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glint_render::RenderSettings;
+
+    use crate::args::DeviceArg;
+
+    #[test]
+    fn si_prefixes() {
+        assert_eq!(si(0.0), "0");
+        assert_eq!(si(950.0), "950");
+        assert_eq!(si(12_345.0), "12.3 k");
+        assert_eq!(si(4_500_000.0), "4.5 M");
+        assert_eq!(si(2.0e9), "2.0 G");
+    }
+
+    #[test]
+    fn closing_line_names_size_samples_rays_threads_and_output() {
+        let job = Job {
+            scene: "s.xml".into(),
+            output: "out.png".into(),
+            settings: RenderSettings {
+                width: 250,
+                height: 250,
+                samples_per_pixel: 16,
+                ..RenderSettings::default()
+            },
+            threads: 2,
+            background: None,
+            png: glint_io::PngEncoding::Course,
+            device: DeviceArg::Cpu,
+            verbose: false,
+            split: glint_render::SplitMethod::Sah,
+            depth_of_field: None,
+            stats: false,
+            preview: None,
+            preview_close: false,
+            notes: Vec::new(),
+            strict: false,
+            limits: glint_io::Limits::default(),
+            max_memory: 1 << 30,
+            checkpoint: None,
+            progress_every: Duration::from_secs(5),
+        };
+        let stats = RenderStats {
+            rays: 4_500_000,
+            ..RenderStats::default()
+        };
+        assert_eq!(
+            closing_line(&job, &stats, Duration::from_millis(1230)),
+            "rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png"
+        );
+    }
 
     #[test]
     fn progress_lines_are_key_value_pairs() {

@@ -1,14 +1,12 @@
 //! One run of `glint`: load the scene, render it on a pool of the requested size, write the
 //! image, and tell the user what happened. The libraries report; this module decides what the
-//! terminal shows and which exit status each outcome gets.
+//! terminal shows, and `failure` which exit status each outcome gets.
 
-use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
-use glint_io::{Diagnostic, ImageWriteError, SceneError};
+use glint_io::Diagnostic;
 use glint_render::{
     Background, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings, RenderStats,
     Scene, SceneOptions, ThinLens,
@@ -17,179 +15,13 @@ use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::{DeviceArg, Job, UsageError};
 use crate::checkpoint;
+use crate::failure::{located, Failure};
 use crate::farm;
+use crate::interrupt::{Interrupt, Phase};
 use crate::preview::TileSink;
-use crate::report::{peak_rss, seconds, ProgressLog, Stats};
-
-/// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).
-pub const EXIT_INTERRUPTED: u8 = 130;
-
-/// Why a run failed, and so which exit status it gets.
-#[derive(Debug)]
-pub enum Failure {
-    /// Arguments that parsed but cannot be used (exit 2, like clap's own usage errors).
-    Usage(UsageError),
-    /// The scene could not be read or is invalid (exit 2).
-    Scene(SceneError),
-    /// The image could not be written (exit 1).
-    Write(ImageWriteError),
-    /// The GPU back end cannot render this scene with these settings (exit 2: like a bad
-    /// argument, the user asked for something this device does not do).
-    GpuUnsupported(glint_gpu::GpuError),
-    /// No GPU adapter, or the device failed (exit 1: the machine, not the input, is at fault).
-    Gpu(glint_gpu::GpuError),
-    /// The render threads could not be started (exit 1).
-    ThreadPool(rayon::ThreadPoolBuildError),
-    /// Ctrl-C or SIGTERM (exit 130). Nothing was written.
-    Interrupted,
-    /// `--strict` and the scene has warnings (exit 2); they were printed as errors.
-    Strict { scene: PathBuf, warnings: usize },
-    /// The render would need more memory than `--max-memory` allows (exit 2).
-    Memory(String),
-    /// Ctrl-C or SIGTERM with `--checkpoint` (exit 130): the finished rows are in the file.
-    InterruptedWithCheckpoint(std::path::PathBuf),
-}
-
-impl Failure {
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            Failure::Usage(_)
-            | Failure::Scene(_)
-            | Failure::Strict { .. }
-            | Failure::Memory(_)
-            | Failure::GpuUnsupported(_) => 2,
-            Failure::Write(_) | Failure::ThreadPool(_) | Failure::Gpu(_) => 1,
-            Failure::Interrupted | Failure::InterruptedWithCheckpoint(_) => EXIT_INTERRUPTED,
-        }
-    }
-}
-
-impl fmt::Display for Failure {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Failure::Usage(error) => write!(f, "{error}"),
-            Failure::Scene(SceneError::Invalid(diagnostic)) => f.write_str(&located(diagnostic)),
-            Failure::Scene(error @ SceneError::Io { source, .. }) => {
-                write!(f, "{error}")?;
-                if glint_io::TooLarge::of(source).is_some() {
-                    f.write_str(" (--max-file-size raises it)")?;
-                }
-                Ok(())
-            }
-            // It names the file: "cannot write out.png: ...".
-            Failure::Write(error) => write!(f, "{error}"),
-            Failure::GpuUnsupported(error) | Failure::Gpu(error) => write!(f, "{error}"),
-            Failure::ThreadPool(error) => write!(f, "cannot start the render threads: {error}"),
-            Failure::Interrupted => f.write_str("interrupted: no image was written"),
-            Failure::Strict { scene, warnings } => write!(
-                f,
-                "{}: {warnings} warning{} with --strict; nothing was rendered",
-                scene.display(),
-                plural(*warnings as u64)
-            ),
-            Failure::Memory(why) => f.write_str(why),
-            Failure::InterruptedWithCheckpoint(file) => write!(
-                f,
-                "interrupted: the finished rows are in {0}; continue with --resume {0}",
-                file.display()
-            ),
-        }
-    }
-}
-
-impl From<UsageError> for Failure {
-    fn from(error: UsageError) -> Failure {
-        Failure::Usage(error)
-    }
-}
-
-/// `file:line:col: message` with the offending line and a caret (glint-io's
-/// `Diagnostic::located`); the caller puts the severity label in front (`error: `,
-/// `warning: `) the same way as for every other message of the CLI.
-pub fn located(diagnostic: &Diagnostic) -> String {
-    diagnostic.located()
-}
-
-/// Where a run is, so that Ctrl-C does the right thing at each point.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u8)]
-pub enum Phase {
-    /// Reading and building the scene: nothing to clean up, so Ctrl-C exits at once.
-    Loading = 0,
-    /// Rendering: Ctrl-C cancels at the end of the current tiles; a second one exits at once
-    /// (rendering writes nothing, so that is safe too).
-    Rendering = 1,
-    /// Writing the image: Ctrl-C is noted but the (atomic) write completes, so that no
-    /// temporary file is left behind.
-    Writing = 2,
-}
-
-/// What the Ctrl-C handler should do.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SignalAction {
-    ExitNow,
-    Cancel,
-    Ignore,
-}
-
-/// The state shared between the Ctrl-C handler and the run. Const-constructible, so `main` can
-/// keep it in a `static` that the handler (which must be `'static`) reads.
-#[derive(Debug)]
-pub struct Interrupt {
-    phase: AtomicU8,
-    requested: AtomicBool,
-}
-
-impl Default for Interrupt {
-    fn default() -> Self {
-        Interrupt::new()
-    }
-}
-
-impl Interrupt {
-    pub const fn new() -> Interrupt {
-        Interrupt {
-            phase: AtomicU8::new(Phase::Loading as u8),
-            requested: AtomicBool::new(false),
-        }
-    }
-
-    pub fn set_phase(&self, phase: Phase) {
-        self.phase.store(phase as u8, Ordering::SeqCst);
-    }
-
-    fn phase(&self) -> Phase {
-        match self.phase.load(Ordering::SeqCst) {
-            0 => Phase::Loading,
-            1 => Phase::Rendering,
-            _ => Phase::Writing,
-        }
-    }
-
-    /// Whether Ctrl-C was pressed.
-    pub fn requested(&self) -> bool {
-        self.requested.load(Ordering::SeqCst)
-    }
-
-    /// Records a Ctrl-C and says what to do about it.
-    pub fn on_signal(&self) -> SignalAction {
-        let again = self.requested.swap(true, Ordering::SeqCst);
-        match self.phase() {
-            Phase::Loading => SignalAction::ExitNow,
-            Phase::Rendering if again => SignalAction::ExitNow,
-            Phase::Rendering => SignalAction::Cancel,
-            Phase::Writing => SignalAction::Ignore,
-        }
-    }
-}
-
-/// What a successful run did.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Summary {
-    pub stats: RenderStats,
-    pub render_time: Duration,
-    pub threads: usize,
-}
+use crate::report::{
+    closing_line, peak_rss, plural, seconds, threads_text, ProgressLog, Stats, Summary,
+};
 
 /// Runs `job`, printing notes, warnings, the progress bar (only if `progress_bar`) and the
 /// closing line to `err`, and handing each finished tile to `preview` if there is one.
@@ -731,136 +563,9 @@ fn new_progress_bar(tiles: u64) -> ProgressBar {
     bar
 }
 
-/// `rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png`
-pub fn closing_line(job: &Job, stats: &RenderStats, render_time: Duration) -> String {
-    let settings = &job.settings;
-    let seconds = render_time.as_secs_f64();
-    let rate = if seconds > 0.0 {
-        stats.rays as f64 / seconds
-    } else {
-        0.0
-    };
-    format!(
-        "rendered {}x{}, {} rpp in {seconds:.2} s: {} rays, {} rays/s, {} -> {}",
-        settings.width,
-        settings.height,
-        settings.samples_per_pixel(),
-        si(stats.rays as f64),
-        si(rate),
-        threads_text(job.threads),
-        job.output.display()
-    )
-}
-
-/// A count with an SI prefix: "950", "12.3 k", "4.5 M".
-pub fn si(value: f64) -> String {
-    const PREFIXES: [(f64, &str); 4] = [(1e12, "T"), (1e9, "G"), (1e6, "M"), (1e3, "k")];
-    for (scale, prefix) in PREFIXES {
-        if value >= scale {
-            return format!("{:.1} {prefix}", value / scale);
-        }
-    }
-    format!("{value:.0}")
-}
-
-fn threads_text(threads: usize) -> String {
-    format!("{threads} thread{}", plural(threads as u64))
-}
-
-pub(crate) fn plural(count: u64) -> &'static str {
-    if count == 1 {
-        ""
-    } else {
-        "s"
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glint_render::RenderSettings;
-
-    #[test]
-    fn ctrl_c_exits_while_loading_cancels_while_rendering_and_waits_for_the_write() {
-        let interrupt = Interrupt::new();
-        assert_eq!(interrupt.on_signal(), SignalAction::ExitNow);
-
-        let interrupt = Interrupt::new();
-        interrupt.set_phase(Phase::Rendering);
-        assert!(!interrupt.requested());
-        assert_eq!(interrupt.on_signal(), SignalAction::Cancel);
-        assert!(interrupt.requested());
-        assert_eq!(interrupt.on_signal(), SignalAction::ExitNow);
-
-        let interrupt = Interrupt::new();
-        interrupt.set_phase(Phase::Writing);
-        assert_eq!(interrupt.on_signal(), SignalAction::Ignore);
-        assert_eq!(interrupt.on_signal(), SignalAction::Ignore);
-        assert!(interrupt.requested());
-    }
-
-    #[test]
-    fn si_prefixes() {
-        assert_eq!(si(0.0), "0");
-        assert_eq!(si(950.0), "950");
-        assert_eq!(si(12_345.0), "12.3 k");
-        assert_eq!(si(4_500_000.0), "4.5 M");
-        assert_eq!(si(2.0e9), "2.0 G");
-    }
-
-    #[test]
-    fn closing_line_names_size_samples_rays_threads_and_output() {
-        let job = Job {
-            scene: "s.xml".into(),
-            output: "out.png".into(),
-            settings: RenderSettings {
-                width: 250,
-                height: 250,
-                samples_per_pixel: 16,
-                ..RenderSettings::default()
-            },
-            threads: 2,
-            background: None,
-            png: glint_io::PngEncoding::Course,
-            device: DeviceArg::Cpu,
-            verbose: false,
-            split: glint_render::SplitMethod::Sah,
-            depth_of_field: None,
-            stats: false,
-            preview: None,
-            preview_close: false,
-            notes: Vec::new(),
-            strict: false,
-            limits: glint_io::Limits::default(),
-            max_memory: 1 << 30,
-            checkpoint: None,
-            progress_every: Duration::from_secs(5),
-        };
-        let stats = RenderStats {
-            rays: 4_500_000,
-            ..RenderStats::default()
-        };
-        assert_eq!(
-            closing_line(&job, &stats, Duration::from_millis(1230)),
-            "rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png"
-        );
-    }
-
-    #[test]
-    fn located_diagnostics_show_the_line_and_a_caret() {
-        let diagnostic = Diagnostic {
-            severity: glint_io::Severity::Error,
-            path: "scene.xml".into(),
-            line: 3,
-            column: 5,
-            message: "radius must be > 0".into(),
-            source: Some(glint_io::SourceLine::new("\tab cd")),
-        };
-        assert_eq!(
-            located(&diagnostic),
-            "scene.xml:3:5: radius must be > 0\n\tab cd\n\t   ^"
-        );
-    }
 
     #[test]
     fn memory_estimates_refuse_what_does_not_fit() {
@@ -897,16 +602,5 @@ mod tests {
         assert!(text.contains("s.xml:20:1: w20"), "{text}");
         assert!(!text.contains("w21"), "{text}");
         assert!(text.ends_with("5 more warnings not shown (`glint check SCENE` lists them all)\n"));
-    }
-
-    #[test]
-    fn exit_codes() {
-        assert_eq!(Failure::Usage(UsageError("x".into())).exit_code(), 2);
-        assert_eq!(Failure::Interrupted.exit_code(), 130);
-        let io = SceneError::Io {
-            path: "x.xml".into(),
-            source: std::io::Error::from(std::io::ErrorKind::NotFound),
-        };
-        assert_eq!(Failure::Scene(io).exit_code(), 2);
     }
 }
