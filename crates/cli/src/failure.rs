@@ -6,7 +6,7 @@ use std::path::PathBuf;
 
 use glint_io::{Diagnostic, ImageWriteError, SceneError};
 
-use crate::args::UsageError;
+use crate::job::UsageError;
 use crate::report::plural;
 
 /// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).

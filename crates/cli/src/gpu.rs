@@ -15,9 +15,9 @@ use glint_gpu::{GpuError, GpuRenderer};
 use glint_render::{RenderStats, SceneParts};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::args::{Job, UsageError};
 use crate::failure::Failure;
 use crate::interrupt::{Interrupt, Phase};
+use crate::job::{Job, UsageError};
 use crate::report::{plural, si, Summary};
 
 /// Renders `parts` on the GPU and writes the image.

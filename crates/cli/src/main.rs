@@ -2,7 +2,8 @@
 //!
 //! This file only wires the process to the run: it parses the arguments (clap exits with
 //! status 2 on usage errors and 0 for help), installs the Ctrl-C handler, and turns the
-//! outcome into an exit status. Arguments live in `args.rs`, the run in `run.rs`.
+//! outcome into an exit status. What the user typed lives in `args.rs`, what a render needs in
+//! `job.rs`, the run in `run.rs`.
 #![forbid(unsafe_code)]
 
 mod args;
@@ -13,6 +14,7 @@ mod failure;
 mod farm;
 mod gpu;
 mod interrupt;
+mod job;
 mod merge;
 mod preview;
 mod report;

@@ -19,9 +19,10 @@ use std::path::{Path, PathBuf};
 
 use glint_render::{Color, Features, Film};
 
-use crate::args::{MergeArgs, UsageError};
+use crate::args::MergeArgs;
 use crate::failure::Failure;
 use crate::farm::{self, key};
+use crate::job::UsageError;
 
 /// One part, read and checked.
 struct Part {

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use glint_render::RenderStats;
 
-use crate::args::Job;
+use crate::job::Job;
 
 /// What a successful run did.
 #[derive(Clone, Debug, PartialEq)]

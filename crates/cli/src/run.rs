@@ -13,11 +13,12 @@ use glint_render::{
 };
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::args::{DeviceArg, Job, UsageError};
+use crate::args::DeviceArg;
 use crate::checkpoint;
 use crate::failure::{located, Failure};
 use crate::farm;
 use crate::interrupt::{Interrupt, Phase};
+use crate::job::{Job, UsageError};
 use crate::preview::TileSink;
 use crate::report::{
     closing_line, peak_rss, plural, seconds, threads_text, ProgressLog, Stats, Summary,
