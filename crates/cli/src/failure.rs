@@ -4,10 +4,10 @@
 use std::fmt;
 use std::path::PathBuf;
 
-use glint_io::{Diagnostic, ImageWriteError, SceneError};
+use glint_io::{ImageWriteError, SceneError};
 
 use crate::job::UsageError;
-use crate::report::plural;
+use crate::report::{located, plural};
 
 /// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).
 pub const EXIT_INTERRUPTED: u8 = 130;
@@ -91,32 +91,9 @@ impl From<UsageError> for Failure {
     }
 }
 
-/// `file:line:col: message` with the offending line and a caret (glint-io's
-/// `Diagnostic::located`); the caller puts the severity label in front (`error: `,
-/// `warning: `) the same way as for every other message of the CLI.
-pub fn located(diagnostic: &Diagnostic) -> String {
-    diagnostic.located()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn located_diagnostics_show_the_line_and_a_caret() {
-        let diagnostic = Diagnostic {
-            severity: glint_io::Severity::Error,
-            path: "scene.xml".into(),
-            line: 3,
-            column: 5,
-            message: "radius must be > 0".into(),
-            source: Some(glint_io::SourceLine::new("\tab cd")),
-        };
-        assert_eq!(
-            located(&diagnostic),
-            "scene.xml:3:5: radius must be > 0\n\tab cd\n\t   ^"
-        );
-    }
 
     #[test]
     fn exit_codes() {

@@ -8,6 +8,7 @@
 
 mod args;
 mod bench;
+mod check;
 mod checkpoint;
 mod diff;
 mod failure;
@@ -15,10 +16,13 @@ mod farm;
 mod gpu;
 mod interrupt;
 mod job;
+mod memory;
 mod merge;
 mod preview;
+mod progress;
 mod report;
 mod run;
+mod stats;
 
 use std::io::IsTerminal;
 use std::process::ExitCode;
@@ -52,7 +56,7 @@ fn main() -> ExitCode {
     }
     if let Some(crate::args::Command::Check { scenes, limits, .. }) = &cli.command {
         let (resolved, _) = limits.resolve();
-        let status = run::check(scenes, &resolved, limits.strict, &mut std::io::stderr());
+        let status = check::run(scenes, &resolved, limits.strict, &mut std::io::stderr());
         return ExitCode::from(status);
     }
     if matches!(cli.command, Some(crate::args::Command::Merge(_))) {

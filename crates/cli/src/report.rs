@@ -1,12 +1,10 @@
-//! What a run tells the user: the closing line and the summary it stands for, the progress
-//! line printed every few seconds when stderr is not a terminal, and the `--stats` sections.
+//! What a run tells the user: the scene's warnings, the closing line and the summary it
+//! stands for.
 
-use std::fmt::Write as _;
 use std::io::Write;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
+use glint_io::Diagnostic;
 use glint_render::RenderStats;
 
 use crate::job::Job;
@@ -51,11 +49,13 @@ pub fn si(value: f64) -> String {
     format!("{value:.0}")
 }
 
+/// `1 thread`, `2 threads`.
 pub fn threads_text(threads: usize) -> String {
     format!("{threads} thread{}", plural(threads as u64))
 }
 
-pub(crate) fn plural(count: u64) -> &'static str {
+/// The `s` of a plural noun after `count`.
+pub fn plural(count: u64) -> &'static str {
     if count == 1 {
         ""
     } else {
@@ -63,147 +63,29 @@ pub(crate) fn plural(count: u64) -> &'static str {
     }
 }
 
-/// The progress line, one every `--progress-every` seconds on a stderr that is not a terminal
-/// (a farm job's log). Space-separated `key=value` fields, in this order:
-///
-/// ```text
-/// progress done=0.4125 elapsed=12.3 eta=17.5 rays_per_s=1234567
-/// ```
-///
-/// `done`: the share of the run's pixels finished (0 to 1, four decimals); `elapsed`: seconds
-/// since this run started rendering; `eta`: seconds left at the rate so far (`?` before the
-/// first tile); `rays_per_s`: rays traced per second so far, a whole number.
-pub fn progress_line(done: f64, elapsed: Duration, rays: u64) -> String {
-    let seconds = elapsed.as_secs_f64();
-    let eta = if done > 0.0 {
-        format!("{:.1}", seconds * (1.0 - done) / done)
-    } else {
-        "?".to_string()
-    };
-    let rate = if seconds > 0.0 {
-        (rays as f64 / seconds).round() as u64
-    } else {
-        0
-    };
-    format!("progress done={done:.4} elapsed={seconds:.1} eta={eta} rays_per_s={rate}")
+/// `file:line:col: message` with the offending line and a caret (glint-io's
+/// `Diagnostic::located`); the caller puts the severity label in front (`error: `,
+/// `warning: `) the same way as for every other message of the CLI.
+pub fn located(diagnostic: &Diagnostic) -> String {
+    diagnostic.located()
 }
 
-/// Counts finished pixels and rays from the render threads and prints a progress line to
-/// stderr whenever `every` has passed since the last one.
-#[derive(Debug)]
-pub struct ProgressLog {
-    start: Instant,
-    every: Duration,
-    total_pixels: u64,
-    pixels: AtomicU64,
-    rays: AtomicU64,
-    /// When the last line was printed; the lock also keeps lines whole.
-    last: Mutex<Instant>,
-}
+/// How many warnings a render prints; `glint check` prints them all.
+pub const MAX_SHOWN_WARNINGS: usize = 20;
 
-impl ProgressLog {
-    /// A log of a run of `total_pixels` pixels, `done_pixels` of which (from a checkpoint) are
-    /// already finished.
-    pub fn new(every: Duration, total_pixels: u64, done_pixels: u64) -> ProgressLog {
-        let start = Instant::now();
-        ProgressLog {
-            start,
-            every,
-            total_pixels: total_pixels.max(1),
-            pixels: AtomicU64::new(done_pixels),
-            rays: AtomicU64::new(0),
-            last: Mutex::new(start),
-        }
+/// Prints the first `limit` warnings and then how many more there were.
+pub fn print_warnings(warnings: &[Diagnostic], limit: usize, err: &mut dyn Write) {
+    for warning in warnings.iter().take(limit) {
+        let _ = writeln!(err, "warning: {}", located(warning));
     }
-
-    /// Records a finished tile of `pixels` pixels and `rays` rays; prints a line when due.
-    pub fn tile(&self, pixels: u64, rays: u64) {
-        self.pixels.fetch_add(pixels, Ordering::SeqCst);
-        self.rays.fetch_add(rays, Ordering::SeqCst);
-        let Ok(mut last) = self.last.lock() else {
-            return;
-        };
-        if last.elapsed() >= self.every {
-            *last = Instant::now();
-            // Read under the lock, so that the lines' figures never go backwards.
-            let done = self.pixels.load(Ordering::SeqCst);
-            let rays = self.rays.load(Ordering::SeqCst);
-            let line = progress_line(
-                done as f64 / self.total_pixels as f64,
-                self.start.elapsed(),
-                rays,
-            );
-            // A closed stderr must not fail a render.
-            let _ = writeln!(std::io::stderr(), "{line}");
-        }
+    if warnings.len() > limit {
+        let rest = warnings.len() - limit;
+        let _ = writeln!(
+            err,
+            "warning: {rest} more warning{} not shown (`glint check SCENE` lists them all)",
+            plural(rest as u64)
+        );
     }
-}
-
-/// The `--stats` printout: named sections of labelled values, printed in the order they were
-/// added. Each part of the program adds its own section (times, rays, memory, the ray
-/// engine's figures), so one can be added without touching the others.
-#[derive(Debug, Default)]
-pub struct Stats {
-    sections: Vec<(String, Vec<(String, String)>)>,
-}
-
-impl Stats {
-    /// Adds a section and returns it to fill with `row`.
-    pub fn section(&mut self, title: &str) -> Section<'_> {
-        self.sections.push((title.to_string(), Vec::new()));
-        let rows = &mut self.sections.last_mut().expect("just pushed").1;
-        Section { rows }
-    }
-
-    /// The printout: `stats:`, then per section its title and indented, aligned rows.
-    pub fn render(&self) -> String {
-        let width = self
-            .sections
-            .iter()
-            .flat_map(|(_, rows)| rows.iter().map(|(label, _)| label.len()))
-            .max()
-            .unwrap_or(0);
-        let mut text = String::from("stats:\n");
-        for (title, rows) in &self.sections {
-            let _ = writeln!(text, "  {title}");
-            for (label, value) in rows {
-                let _ = writeln!(text, "    {label:<width$}  {value}");
-            }
-        }
-        text
-    }
-}
-
-/// One section of `Stats`.
-#[derive(Debug)]
-pub struct Section<'a> {
-    rows: &'a mut Vec<(String, String)>,
-}
-
-impl Section<'_> {
-    pub fn row(&mut self, label: &str, value: impl std::fmt::Display) -> &mut Self {
-        self.rows.push((label.to_string(), value.to_string()));
-        self
-    }
-}
-
-/// The process's peak resident memory in bytes (Linux: `VmHWM` in /proc/self/status).
-pub fn peak_rss() -> Option<u64> {
-    let status = std::fs::read_to_string("/proc/self/status").ok()?;
-    let line = status.lines().find(|line| line.starts_with("VmHWM:"))?;
-    let kib: u64 = line
-        .trim_start_matches("VmHWM:")
-        .trim()
-        .trim_end_matches("kB")
-        .trim()
-        .parse()
-        .ok()?;
-    Some(kib * 1024)
-}
-
-/// `1.234 s`
-pub fn seconds(duration: Duration) -> String {
-    format!("{:.3} s", duration.as_secs_f64())
 }
 
 #[cfg(test)]
@@ -261,36 +143,39 @@ mod tests {
     }
 
     #[test]
-    fn progress_lines_are_key_value_pairs() {
-        assert_eq!(
-            progress_line(0.25, Duration::from_secs(10), 5_000_000),
-            "progress done=0.2500 elapsed=10.0 eta=30.0 rays_per_s=500000"
-        );
-        assert_eq!(
-            progress_line(0.0, Duration::ZERO, 0),
-            "progress done=0.0000 elapsed=0.0 eta=? rays_per_s=0"
-        );
+    fn warnings_beyond_the_cap_are_counted() {
+        let warnings: Vec<Diagnostic> = (1..=25)
+            .map(|line| Diagnostic {
+                severity: glint_io::Severity::Warning,
+                path: "s.xml".into(),
+                line,
+                column: 1,
+                message: format!("w{line}"),
+                source: None,
+            })
+            .collect();
+        let mut out = Vec::new();
+        print_warnings(&warnings, 20, &mut out);
+        let text = String::from_utf8(out).unwrap();
+        assert_eq!(text.lines().count(), 21, "{text}");
+        assert!(text.contains("s.xml:20:1: w20"), "{text}");
+        assert!(!text.contains("w21"), "{text}");
+        assert!(text.ends_with("5 more warnings not shown (`glint check SCENE` lists them all)\n"));
     }
 
     #[test]
-    fn stats_sections_print_in_order_and_align() {
-        let mut stats = Stats::default();
-        stats
-            .section("time")
-            .row("load", "0.1 s")
-            .row("render", "2 s");
-        stats.section("memory").row("peak resident", "12 MiB");
+    fn located_diagnostics_show_the_line_and_a_caret() {
+        let diagnostic = Diagnostic {
+            severity: glint_io::Severity::Error,
+            path: "scene.xml".into(),
+            line: 3,
+            column: 5,
+            message: "radius must be > 0".into(),
+            source: Some(glint_io::SourceLine::new("\tab cd")),
+        };
         assert_eq!(
-            stats.render(),
-            "stats:\n  time\n    load           0.1 s\n    render         2 s\n  memory\n    \
-             peak resident  12 MiB\n"
+            located(&diagnostic),
+            "scene.xml:3:5: radius must be > 0\n\tab cd\n\t   ^"
         );
-    }
-
-    #[test]
-    fn peak_memory_is_read_on_linux() {
-        if cfg!(target_os = "linux") {
-            assert!(peak_rss().is_some_and(|bytes| bytes > 0));
-        }
     }
 }

@@ -3,26 +3,26 @@
 //! terminal shows, and `failure` which exit status each outcome gets.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-use glint_io::Diagnostic;
 use glint_render::{
-    Background, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings, RenderStats,
-    Scene, SceneOptions, ThinLens,
+    Background, PixelBounds, Progress, RenderError, RenderStats, Scene, SceneOptions, ThinLens,
 };
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
 use crate::args::DeviceArg;
 use crate::checkpoint;
-use crate::failure::{located, Failure};
+use crate::failure::Failure;
 use crate::farm;
 use crate::interrupt::{Interrupt, Phase};
 use crate::job::{Job, UsageError};
+use crate::memory;
 use crate::preview::TileSink;
+use crate::progress::{new_progress_bar, ProgressLog};
 use crate::report::{
-    closing_line, peak_rss, plural, seconds, threads_text, ProgressLog, Stats, Summary,
+    closing_line, located, plural, print_warnings, threads_text, Summary, MAX_SHOWN_WARNINGS,
 };
+use crate::stats::{bvh_stats, peak_rss, rays_section, seconds, Stats};
 
 /// Runs `job`, printing notes, warnings, the progress bar (only if `progress_bar`) and the
 /// closing line to `err`, and handing each finished tile to `preview` if there is one.
@@ -57,8 +57,8 @@ pub fn run(
             plural(removed as u64)
         );
     }
-    let film_bytes = film_bytes(&job.settings);
-    check_memory(film_bytes, 0, 0, job.max_memory)?;
+    let film_bytes = memory::film_bytes(&job.settings);
+    memory::check(film_bytes, 0, 0, job.max_memory)?;
     let load_start = Instant::now();
     // Textures get what the film leaves of the budget.
     let mut limits = job.limits;
@@ -90,10 +90,10 @@ pub fn run(
             ..lens
         });
     }
-    check_memory(
+    memory::check(
         film_bytes,
-        texture_bytes(&parts),
-        shape_count(&parts),
+        memory::texture_bytes(&parts),
+        memory::shape_count(&parts),
         job.max_memory,
     )?;
     if job.device == DeviceArg::Gpu {
@@ -302,113 +302,6 @@ pub fn run(
     })
 }
 
-/// `--stats`' BVH figures: how the split method shaped the tree and what it costs the camera
-/// rays (measured in a separate counting pass, so the render itself counted nothing).
-pub fn bvh_stats(scene: &Scene, settings: &RenderSettings) -> String {
-    let bvh = scene.bvh_stats();
-    let walk = glint_render::measure_traversal(scene, settings);
-    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-    // Where the largest tree's build spent its time: the root node's splits run before any
-    // subtree can run apart, so they are what more threads shorten least.
-    let phases = bvh.largest.map_or_else(String::new, |(primitives, p)| {
-        format!(
-            "BVH build phases, largest tree ({primitives} primitives): boxes {:.1} ms, root \
-             splits {:.1} ms, subtrees {:.1} ms, blocks {:.1} ms\n",
-            ms(p.boxes),
-            ms(p.top_splits),
-            ms(p.subtrees),
-            ms(p.pack),
-        )
-    });
-    format!(
-        "BVH ({}): built in {:.1} ms; {} tree{}, {} nodes, {} leaves, depth {}, SAH cost {:.2}\n\
-         {phases}\
-         BVH traversal: {:.2} nodes and {:.2} triangle blocks per camera ray ({} rays through \
-         pixel centres, {:.0}% hit)\n",
-        bvh.split.name(),
-        ms(bvh.build_time),
-        bvh.trees,
-        plural(bvh.trees as u64),
-        bvh.nodes,
-        bvh.leaves,
-        bvh.depth,
-        bvh.sah_cost,
-        walk.nodes_per_ray(),
-        walk.blocks_per_ray(),
-        walk.rays,
-        100.0 * walk.hits as f64 / walk.rays.max(1) as f64,
-    )
-}
-
-/// `glint check`: loads every scene under `limits`, prints every diagnostic (warnings as
-/// errors with `strict`) and a line per scene, and returns the exit status: 0 when every scene
-/// loads (with `strict`: without warnings), 2 otherwise.
-pub fn check(
-    scenes: &[PathBuf],
-    limits: &glint_io::Limits,
-    strict: bool,
-    err: &mut dyn Write,
-) -> u8 {
-    let mut failed = 0usize;
-    for scene in scenes {
-        match glint_io::load_scene_limited(scene, limits) {
-            Ok(loaded) => {
-                let label = if strict { "error" } else { "warning" };
-                for warning in &loaded.warnings {
-                    let _ = writeln!(err, "{label}: {}", located(warning));
-                }
-                let count = loaded.warnings.len();
-                let verdict = if strict && count > 0 {
-                    failed += 1;
-                    "fails under --strict"
-                } else {
-                    "ok"
-                };
-                let _ = writeln!(
-                    err,
-                    "{}: {verdict} ({count} warning{})",
-                    scene.display(),
-                    plural(count as u64)
-                );
-            }
-            Err(error) => {
-                failed += 1;
-                let _ = writeln!(err, "error: {}", Failure::Scene(error));
-                let _ = writeln!(err, "{}: cannot be loaded", scene.display());
-            }
-        }
-    }
-    if failed > 0 {
-        let _ = writeln!(
-            err,
-            "{failed} of {} scene{} failed",
-            scenes.len(),
-            plural(scenes.len() as u64)
-        );
-        2
-    } else {
-        0
-    }
-}
-
-/// How many warnings a render prints; `glint check` prints them all.
-pub const MAX_SHOWN_WARNINGS: usize = 20;
-
-/// Prints the first `limit` warnings and then how many more there were.
-pub fn print_warnings(warnings: &[Diagnostic], limit: usize, err: &mut dyn Write) {
-    for warning in warnings.iter().take(limit) {
-        let _ = writeln!(err, "warning: {}", located(warning));
-    }
-    if warnings.len() > limit {
-        let rest = warnings.len() - limit;
-        let _ = writeln!(
-            err,
-            "warning: {rest} more warning{} not shown (`glint check SCENE` lists them all)",
-            plural(rest as u64)
-        );
-    }
-}
-
 /// The folder the output goes into.
 fn output_directory(output: &Path) -> &Path {
     match output.parent() {
@@ -457,151 +350,8 @@ fn check_output(output: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Bytes per pixel of a render: the pipeline's per-pixel values (40), the film (12), the
-/// 8-bit copy and its encoding (6), and with feature layers their film copies (28).
-fn film_bytes(settings: &glint_render::RenderSettings) -> u64 {
-    let per_pixel = if settings.features { 86 } else { 58 };
-    u64::from(settings.width) * u64::from(settings.height) * per_pixel
-}
-
-/// Bytes per shape of the scene and its acceleration structures: the shape (up to 40 bytes),
-/// its material, its triangle copy in the ray engine and its share of BVH nodes, with room.
-const BYTES_PER_SHAPE: u64 = 160;
-
-fn texture_bytes(parts: &glint_render::SceneParts) -> u64 {
-    let mut texels: u64 = parts
-        .textures
-        .iter()
-        .map(|texture| texture.texels.len() as u64)
-        .sum();
-    if let Background::CubeMap(map) = &parts.background {
-        texels += map
-            .faces
-            .iter()
-            .map(|face| face.texels.len() as u64)
-            .sum::<u64>();
-    }
-    texels * 12
-}
-
-fn shape_count(parts: &glint_render::SceneParts) -> u64 {
-    let shapes: u64 = parts
-        .geometries
-        .iter()
-        .map(|geometry| geometry.shapes.len() as u64)
-        .sum();
-    let light_triangles: u64 = parts
-        .lights
-        .iter()
-        .map(|light| match light {
-            glint_render::Light::Triangles { triangles, .. } => triangles.len() as u64,
-            _ => 1,
-        })
-        .sum();
-    shapes + light_triangles + parts.instances.len() as u64
-}
-
-/// Refuses a render whose estimated memory is over the budget.
-fn check_memory(film: u64, textures: u64, shapes: u64, budget: u64) -> Result<(), Failure> {
-    let structures = shapes.saturating_mul(BYTES_PER_SHAPE);
-    let total = film.saturating_add(textures).saturating_add(structures);
-    if total <= budget {
-        return Ok(());
-    }
-    let bytes = glint_io::format_bytes;
-    Err(Failure::Memory(format!(
-        "the render would need about {} (image {}, textures {}, shapes and their acceleration \
-         structures {}), more than the limit of {}; render a smaller image, or raise the limit \
-         with --max-memory",
-        bytes(total),
-        bytes(film),
-        bytes(textures),
-        bytes(structures),
-        bytes(budget)
-    )))
-}
-
-/// Rays by kind: every sample of every rendered pixel starts with one camera ray, and the
-/// course family traces one more per sample for the feature layers; the rest are the
-/// secondary (reflection, refraction, bounce) and shadow rays.
-fn rays_section(report: &mut Stats, settings: &RenderSettings, stats: &RenderStats) {
-    let bounds = settings.bounds();
-    let camera = u64::from(bounds.width())
-        * u64::from(bounds.height())
-        * u64::from(settings.samples().len() as u32);
-    let features = if settings.features && settings.integrator != IntegratorKind::Path {
-        camera
-    } else {
-        0
-    };
-    let mut section = report.section("rays");
-    section.row("camera", camera);
-    if features > 0 {
-        section.row("feature layers", features);
-    }
-    section
-        .row(
-            "secondary and shadow",
-            stats.rays.saturating_sub(camera + features),
-        )
-        .row("total", stats.rays);
-}
-
 /// Tiles of `TILE_SIZE` the render of `bounds` runs.
 fn tile_count(bounds: PixelBounds) -> u64 {
     let tile = glint_render::TILE_SIZE;
     u64::from(bounds.width().div_ceil(tile)) * u64::from(bounds.height().div_ceil(tile))
-}
-
-fn new_progress_bar(tiles: u64) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(Some(tiles), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(
-        "{elapsed_precise} [{wide_bar}] {percent:>3}% of {len} tiles, ETA {eta}",
-    )
-    .unwrap_or_else(|_| ProgressStyle::default_bar())
-    .progress_chars("=> ");
-    bar.set_style(style);
-    bar
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn memory_estimates_refuse_what_does_not_fit() {
-        let huge = glint_render::RenderSettings {
-            width: 65_535,
-            height: 65_535,
-            ..glint_render::RenderSettings::default()
-        };
-        let film = film_bytes(&huge);
-        assert!(film > 200 << 30, "{film}");
-        let refused = check_memory(film, 0, 0, 8 << 30).unwrap_err();
-        assert_eq!(refused.exit_code(), 2);
-        assert!(refused.to_string().contains("--max-memory"), "{refused}");
-        assert!(check_memory(1 << 20, 1 << 20, 1000, 8 << 30).is_ok());
-        assert!(check_memory(0, 0, u64::MAX, 8 << 30).is_err());
-    }
-
-    #[test]
-    fn warnings_beyond_the_cap_are_counted() {
-        let warnings: Vec<Diagnostic> = (1..=25)
-            .map(|line| Diagnostic {
-                severity: glint_io::Severity::Warning,
-                path: "s.xml".into(),
-                line,
-                column: 1,
-                message: format!("w{line}"),
-                source: None,
-            })
-            .collect();
-        let mut out = Vec::new();
-        print_warnings(&warnings, 20, &mut out);
-        let text = String::from_utf8(out).unwrap();
-        assert_eq!(text.lines().count(), 21, "{text}");
-        assert!(text.contains("s.xml:20:1: w20"), "{text}");
-        assert!(!text.contains("w21"), "{text}");
-        assert!(text.ends_with("5 more warnings not shown (`glint check SCENE` lists them all)\n"));
-    }
 }
