@@ -4,10 +4,11 @@
 
 use std::io::Write;
 use std::path::Path;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use glint_render::{
-    Background, PixelBounds, Progress, RenderError, RenderStats, Scene, SceneOptions, ThinLens,
+    Background, Film, PixelBounds, Progress, RenderError, RenderSettings, RenderStats, Scene,
+    SceneOptions, SceneParts, ThinLens,
 };
 
 use crate::args::DeviceArg;
@@ -27,7 +28,8 @@ use crate::stats::{bvh_stats, peak_rss, rays_section, seconds, Stats};
 /// Runs `job`, printing notes, warnings, the progress bar (only if `progress_bar`) and the
 /// closing line to `err`, and handing each finished tile to `preview` if there is one.
 /// Errors are returned, not printed: `main` prints them and exits. No image is written unless
-/// the whole run succeeds.
+/// the whole run succeeds. Write errors on stderr are ignored throughout: a closed stderr must
+/// not fail a render.
 pub fn run(
     job: &Job,
     interrupt: &Interrupt,
@@ -35,21 +37,102 @@ pub fn run(
     progress_bar: bool,
     preview: Option<&TileSink>,
 ) -> Result<Summary, Failure> {
-    // Write errors on stderr are ignored throughout: a closed stderr must not fail a render.
-    for note in &job.notes {
-        let _ = writeln!(err, "note: {note}");
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(job.threads)
-        .thread_name(|index| format!("glint-render-{index}"))
-        .build()
-        .map_err(Failure::ThreadPool)?;
-
+    print_notes(job, err);
+    let pool = thread_pool(job.threads)?;
     interrupt.set_phase(Phase::Loading);
     // Everything that can be known before the render is checked before it: the output can
     // be written, and the film fits in the memory budget.
     check_output(&job.output)?;
-    let removed = glint_io::remove_stale_partials(output_directory(&job.output));
+    remove_stale_partials(&job.output, err);
+    let film_bytes = memory::film_bytes(&job.settings);
+    memory::check(film_bytes, 0, 0, job.max_memory)?;
+    let loaded = load(job, &pool, film_bytes, err)?;
+    check_memory(job, film_bytes, &loaded.parts)?;
+    if job.device == DeviceArg::Gpu {
+        return crate::gpu::run(job, &loaded.parts, interrupt, err, progress_bar);
+    }
+    let built = build(job, &pool, loaded);
+    if job.verbose {
+        print_settings(job, &built, err);
+    }
+    let rendered = render(job, &pool, &built, interrupt, err, progress_bar, preview)?;
+    warn_nonfinite(&rendered.stats, err);
+    let write_time = write(job, &pool, &built, &rendered, err)?;
+    let _ = writeln!(err, "{}", closing_line(job, &rendered.stats, rendered.time));
+    if job.stats {
+        print_stats(job, &pool, &built, &rendered, write_time, err);
+    }
+    Ok(Summary {
+        stats: rendered.stats,
+        render_time: rendered.time,
+        threads: job.threads,
+    })
+}
+
+/// The scene as read, with the job's overrides applied.
+struct Loaded {
+    parts: SceneParts,
+    /// From the start of the read to the overrides.
+    time: Duration,
+}
+
+/// The scene ready to render, with what it took to get there.
+struct Built {
+    scene: Scene,
+    /// `glint_io::scene_hash` of the loaded scene, for the image's metadata.
+    hash: String,
+    load_time: Duration,
+    hash_time: Duration,
+    build_time: Duration,
+}
+
+impl Built {
+    /// The metadata of an image of this scene after `rays` rays and `render_seconds` seconds
+    /// of rendering.
+    fn metadata(
+        &self,
+        settings: &RenderSettings,
+        rays: u64,
+        render_seconds: f64,
+    ) -> Vec<(String, String)> {
+        let stats = RenderStats {
+            rays,
+            ..RenderStats::default()
+        };
+        farm::metadata(settings, &self.hash, &stats, render_seconds)
+    }
+}
+
+/// A finished render.
+struct Rendered {
+    film: Film,
+    stats: RenderStats,
+    /// Render seconds for the image's metadata: this run's and, after `--resume`, those of
+    /// the runs before it.
+    render_seconds: f64,
+    /// This run's render, checkpoint writes included.
+    time: Duration,
+}
+
+/// Notes about accepted options that have no effect.
+fn print_notes(job: &Job, err: &mut dyn Write) {
+    for note in &job.notes {
+        let _ = writeln!(err, "note: {note}");
+    }
+}
+
+/// The pool of `-n` threads that reads, builds, renders and writes.
+fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, Failure> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|index| format!("glint-render-{index}"))
+        .build()
+        .map_err(Failure::ThreadPool)
+}
+
+/// Removes the temporary files that killed runs left beside the output, and says so.
+fn remove_stale_partials(output: &Path, err: &mut dyn Write) {
+    let removed = glint_io::remove_stale_partials(output_directory(output));
     if removed > 0 {
         let _ = writeln!(
             err,
@@ -57,9 +140,17 @@ pub fn run(
             plural(removed as u64)
         );
     }
-    let film_bytes = memory::film_bytes(&job.settings);
-    memory::check(film_bytes, 0, 0, job.max_memory)?;
-    let load_start = Instant::now();
+}
+
+/// Reads the scene within the job's limits, prints its warnings (or, with `--strict`, refuses
+/// it for them) and applies the job's background and depth of field.
+fn load(
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    film_bytes: u64,
+    err: &mut dyn Write,
+) -> Result<Loaded, Failure> {
+    let start = Instant::now();
     // Textures get what the film leaves of the budget.
     let mut limits = job.limits;
     limits.max_texture_bytes = limits
@@ -90,75 +181,113 @@ pub fn run(
             ..lens
         });
     }
+    Ok(Loaded {
+        parts,
+        time: start.elapsed(),
+    })
+}
+
+/// Refuses a scene whose film, textures and acceleration structures would not fit in the
+/// memory budget.
+fn check_memory(job: &Job, film_bytes: u64, parts: &SceneParts) -> Result<(), Failure> {
     memory::check(
         film_bytes,
-        memory::texture_bytes(&parts),
-        memory::shape_count(&parts),
+        memory::texture_bytes(parts),
+        memory::shape_count(parts),
         job.max_memory,
-    )?;
-    if job.device == DeviceArg::Gpu {
-        return crate::gpu::run(job, &parts, interrupt, err, progress_bar);
-    }
-    let load_time = load_start.elapsed();
+    )
+}
+
+/// Hashes the scene for the image's metadata and builds its acceleration structures.
+fn build(job: &Job, pool: &rayon::ThreadPool, loaded: Loaded) -> Built {
     let hash_start = Instant::now();
-    let scene_hash = glint_io::scene_hash(&parts);
+    let hash = glint_io::scene_hash(&loaded.parts);
     let hash_time = hash_start.elapsed();
     let build_start = Instant::now();
     let options = SceneOptions { split: job.split };
-    let scene = pool.install(|| Scene::with_options(parts, options));
-    let build_time = build_start.elapsed();
+    let scene = pool.install(|| Scene::with_options(loaded.parts, options));
+    Built {
+        scene,
+        hash,
+        load_time: loaded.time,
+        hash_time,
+        build_time: build_start.elapsed(),
+    }
+}
 
+/// `-v`: how long the scene took to load and what is about to be rendered.
+fn print_settings(job: &Job, built: &Built, err: &mut dyn Write) {
     let settings = &job.settings;
-    if job.verbose {
-        let depth = format!("depth {}", settings.max_depth());
-        let _ = writeln!(
-            err,
-            "loaded {} in {:.2} s ({} BVH)\nrendering {}x{}, {} samples per pixel, {depth}, seed \
-             {}, {} integrator{}, {} -> {}",
-            job.scene.display(),
-            (load_time + build_time).as_secs_f64(),
-            job.split.name(),
-            settings.width,
-            settings.height,
-            settings.samples_per_pixel(),
-            settings.seed,
-            settings.integrator.name(),
-            scene.camera.lens.map_or(String::new(), |lens| format!(
+    let depth = format!("depth {}", settings.max_depth());
+    let _ = writeln!(
+        err,
+        "loaded {} in {:.2} s ({} BVH)\nrendering {}x{}, {} samples per pixel, {depth}, seed \
+         {}, {} integrator{}, {} -> {}",
+        job.scene.display(),
+        (built.load_time + built.build_time).as_secs_f64(),
+        job.split.name(),
+        settings.width,
+        settings.height,
+        settings.samples_per_pixel(),
+        settings.seed,
+        settings.integrator.name(),
+        built
+            .scene
+            .camera
+            .lens
+            .map_or(String::new(), |lens| format!(
                 ", focused at {} with a lens of radius {}",
                 lens.focus_distance, lens.radius
             )),
-            threads_text(job.threads),
-            job.output.display()
-        );
-    }
-    let metadata = |rays: u64, render_seconds: f64| {
-        let stats = RenderStats {
-            rays,
-            ..RenderStats::default()
-        };
-        farm::metadata(settings, &scene_hash, &stats, render_seconds)
+        threads_text(job.threads),
+        job.output.display()
+    );
+}
+
+/// `--resume`: what the checkpoint holds, if it exists yet, and a note saying which. The
+/// checkpoint must have been made by the same scene and options.
+fn resume(
+    job: &Job,
+    built: &Built,
+    err: &mut dyn Write,
+) -> Result<Option<checkpoint::Resumed>, Failure> {
+    let Some(checkpoint) = job.checkpoint.as_ref().filter(|c| c.resume) else {
+        return Ok(None);
     };
-    let resumed = match &job.checkpoint {
-        Some(checkpoint) if checkpoint.resume => {
-            let resumed = checkpoint::load(&checkpoint.file, settings, &metadata(0, 0.0))?;
-            let _ = match &resumed {
-                Some(resumed) => writeln!(
-                    err,
-                    "note: resuming {}: {} of {} rows done",
-                    checkpoint.file.display(),
-                    resumed.film.height,
-                    settings.bounds().height()
-                ),
-                None => writeln!(
-                    err,
-                    "note: {} does not exist yet: starting from the first row",
-                    checkpoint.file.display()
-                ),
-            };
-            resumed
-        }
-        _ => None,
+    let expected = built.metadata(&job.settings, 0, 0.0);
+    let resumed = checkpoint::load(&checkpoint.file, &job.settings, &expected)?;
+    let _ = match &resumed {
+        Some(resumed) => writeln!(
+            err,
+            "note: resuming {}: {} of {} rows done",
+            checkpoint.file.display(),
+            resumed.film.height,
+            job.settings.bounds().height()
+        ),
+        None => writeln!(
+            err,
+            "note: {} does not exist yet: starting from the first row",
+            checkpoint.file.display()
+        ),
     };
+    Ok(resumed)
+}
+
+/// Renders the scene on the pool, in checkpointed bands with `--checkpoint` or `--resume`,
+/// showing the progress and handing each tile to the preview. Ctrl-C stops it at the end of
+/// the current tiles.
+fn render(
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    built: &Built,
+    interrupt: &Interrupt,
+    err: &mut dyn Write,
+    progress_bar: bool,
+    preview: Option<&TileSink>,
+) -> Result<Rendered, Failure> {
+    let settings = &job.settings;
+    let metadata = |rays: u64, render_seconds: f64| built.metadata(settings, rays, render_seconds);
+    let resumed = resume(job, built, err)?;
 
     let bounds = settings.bounds();
     let done_pixels = resumed
@@ -196,8 +325,8 @@ pub fn run(
     let render_start = Instant::now();
     let rendered = match &job.checkpoint {
         Some(checkpointing) => checkpoint::render(
-            &pool,
-            &scene,
+            pool,
+            &built.scene,
             settings,
             job.threads,
             checkpointing,
@@ -207,13 +336,13 @@ pub fn run(
             interrupt,
         )
         .map(|banded| (banded.film, banded.stats, banded.render_seconds)),
-        None => match pool.install(|| glint_render::render(&scene, settings, &progress)) {
+        None => match pool.install(|| glint_render::render(&built.scene, settings, &progress)) {
             Ok((film, stats)) => Ok((film, stats, render_start.elapsed().as_secs_f64())),
             Err(RenderError::Invalid(why)) => Err(Failure::Usage(UsageError(why))),
             Err(RenderError::Cancelled) => Err(Failure::Interrupted),
         },
     };
-    let render_time = render_start.elapsed();
+    let time = render_start.elapsed();
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -226,7 +355,16 @@ pub fn run(
         Ok(rendered) => rendered,
         Err(failure) => return Err(failure),
     };
+    Ok(Rendered {
+        film,
+        stats,
+        render_seconds,
+        time,
+    })
+}
 
+/// Warns about the samples the render left out of the image for being NaN or infinite.
+fn warn_nonfinite(stats: &RenderStats, err: &mut dyn Write) {
     if stats.nonfinite_samples > 0 {
         let first = stats
             .first_nonfinite_pixel
@@ -245,18 +383,24 @@ pub fn run(
             },
         );
     }
+}
 
-    let write_start = Instant::now();
+/// Writes the image with its metadata and removes the checkpoint it completes; returns the
+/// time that took.
+fn write(
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    built: &Built,
+    rendered: &Rendered,
+    err: &mut dyn Write,
+) -> Result<Duration, Failure> {
+    let start = Instant::now();
     let options = glint_io::WriteOptions { png: job.png };
+    let metadata = built.metadata(&job.settings, rendered.stats.rays, rendered.render_seconds);
     // In the pool: the PNG's 8-bit conversion runs on `-n` threads, and `-n 1` keeps the
     // EXR's compression on one.
     pool.install(|| {
-        glint_io::write_image_with_metadata(
-            &job.output,
-            &film,
-            &options,
-            &metadata(stats.rays, render_seconds),
-        )
+        glint_io::write_image_with_metadata(&job.output, &rendered.film, &options, &metadata)
     })
     .map_err(Failure::Write)?;
     if let Some(checkpoint) = &job.checkpoint {
@@ -272,34 +416,40 @@ pub fn run(
             _ => {}
         }
     }
-    let write_time = write_start.elapsed();
+    Ok(start.elapsed())
+}
 
-    let _ = writeln!(err, "{}", closing_line(job, &stats, render_time));
-    if job.stats {
-        let mut report = Stats::default();
-        report
-            .section("time")
-            .row("load", seconds(load_time))
-            .row("hash", seconds(hash_time))
-            .row("build", seconds(build_time))
-            .row("render", seconds(render_time))
-            .row("write", seconds(write_time));
-        rays_section(&mut report, settings, &stats);
-        report.section("memory").row(
-            "peak resident",
-            peak_rss().map_or_else(
-                || "unknown".to_string(),
-                |bytes| format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0)),
-            ),
-        );
-        let _ = write!(err, "{}", report.render());
-        let _ = write!(err, "{}", pool.install(|| bvh_stats(&scene, settings)));
-    }
-    Ok(Summary {
-        stats,
-        render_time,
-        threads: job.threads,
-    })
+/// `--stats`: time per stage, rays by kind, peak memory and the BVH's figures.
+fn print_stats(
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    built: &Built,
+    rendered: &Rendered,
+    write_time: Duration,
+    err: &mut dyn Write,
+) {
+    let mut report = Stats::default();
+    report
+        .section("time")
+        .row("load", seconds(built.load_time))
+        .row("hash", seconds(built.hash_time))
+        .row("build", seconds(built.build_time))
+        .row("render", seconds(rendered.time))
+        .row("write", seconds(write_time));
+    rays_section(&mut report, &job.settings, &rendered.stats);
+    report.section("memory").row(
+        "peak resident",
+        peak_rss().map_or_else(
+            || "unknown".to_string(),
+            |bytes| format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0)),
+        ),
+    );
+    let _ = write!(err, "{}", report.render());
+    let _ = write!(
+        err,
+        "{}",
+        pool.install(|| bvh_stats(&built.scene, &job.settings))
+    );
 }
 
 /// The folder the output goes into.
