@@ -8,16 +8,34 @@ use std::time::{Duration, Instant};
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-/// The progress bar over the tiles of a render.
-pub fn new_progress_bar(tiles: u64) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(Some(tiles), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(
-        "{elapsed_precise} [{wide_bar}] {percent:>3}% of {len} tiles, ETA {eta}",
-    )
-    .unwrap_or_else(|_| ProgressStyle::default_bar())
-    .progress_chars("=> ");
+/// What a progress bar counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// The CPU's tiles, which finish in no set order: the bar gives the share done and the
+    /// number of tiles.
+    Tiles,
+    /// The GPU's sample passes over the whole image, one after another: the bar gives the
+    /// samples per pixel done of all.
+    SamplePasses,
+}
+
+/// A progress bar on stderr over `length` of `unit`.
+pub fn bar(unit: Unit, length: u64) -> ProgressBar {
+    let bar = ProgressBar::with_draw_target(Some(length), ProgressDrawTarget::stderr());
+    let style = ProgressStyle::with_template(template(unit))
+        .unwrap_or_else(|_| ProgressStyle::default_bar())
+        .progress_chars("=> ");
     bar.set_style(style);
     bar
+}
+
+fn template(unit: Unit) -> &'static str {
+    match unit {
+        Unit::Tiles => "{elapsed_precise} [{wide_bar}] {percent:>3}% of {len} tiles, ETA {eta}",
+        Unit::SamplePasses => {
+            "{elapsed_precise} [{wide_bar}] {pos}/{len} samples per pixel, ETA {eta}"
+        }
+    }
 }
 
 /// The progress line, one every `--progress-every` seconds on a stderr that is not a terminal
@@ -99,6 +117,14 @@ impl ProgressLog {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn both_bar_templates_parse() {
+        for unit in [Unit::Tiles, Unit::SamplePasses] {
+            assert!(ProgressStyle::with_template(template(unit)).is_ok());
+            assert_eq!(bar(unit, 10).length(), Some(10));
+        }
+    }
 
     #[test]
     fn progress_lines_are_key_value_pairs() {

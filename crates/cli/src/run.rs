@@ -19,9 +19,10 @@ use crate::interrupt::{Interrupt, Phase};
 use crate::job::{Job, UsageError};
 use crate::memory;
 use crate::preview::TileSink;
-use crate::progress::{new_progress_bar, ProgressLog};
+use crate::progress::{self, ProgressLog, Unit};
 use crate::report::{
-    closing_line, located, plural, print_warnings, threads_text, Summary, MAX_SHOWN_WARNINGS,
+    finish, located, plural, print_warnings, rendering_line, warn_nonfinite, Device, Summary,
+    MAX_SHOWN_WARNINGS,
 };
 use crate::stats::{bvh_stats, peak_rss, rays_section, seconds, Stats};
 
@@ -56,17 +57,14 @@ pub fn run(
         print_settings(job, &built, err);
     }
     let rendered = render(job, &pool, &built, interrupt, err, progress_bar, preview)?;
-    warn_nonfinite(&rendered.stats, err);
+    warn_nonfinite(Device::Cpu, &rendered.stats, err);
     let write_time = write(job, &pool, &built, &rendered, err)?;
-    let _ = writeln!(err, "{}", closing_line(job, &rendered.stats, rendered.time));
+    let (rays, stats) = (rendered.stats.rays, rendered.stats);
+    let summary = finish(job, Device::Cpu, rays, stats, rendered.time, err);
     if job.stats {
-        print_stats(job, &pool, &built, &rendered, write_time, err);
+        print_stats(job, &pool, &built, &summary, write_time, err);
     }
-    Ok(Summary {
-        stats: rendered.stats,
-        render_time: rendered.time,
-        threads: job.threads,
-    })
+    Ok(summary)
 }
 
 /// The scene as read, with the job's overrides applied.
@@ -217,30 +215,13 @@ fn build(job: &Job, pool: &rayon::ThreadPool, loaded: Loaded) -> Built {
 
 /// `-v`: how long the scene took to load and what is about to be rendered.
 fn print_settings(job: &Job, built: &Built, err: &mut dyn Write) {
-    let settings = &job.settings;
-    let depth = format!("depth {}", settings.max_depth());
     let _ = writeln!(
         err,
-        "loaded {} in {:.2} s ({} BVH)\nrendering {}x{}, {} samples per pixel, {depth}, seed \
-         {}, {} integrator{}, {} -> {}",
+        "loaded {} in {:.2} s ({} BVH)\n{}",
         job.scene.display(),
         (built.load_time + built.build_time).as_secs_f64(),
         job.split.name(),
-        settings.width,
-        settings.height,
-        settings.samples_per_pixel(),
-        settings.seed,
-        settings.integrator.name(),
-        built
-            .scene
-            .camera
-            .lens
-            .map_or(String::new(), |lens| format!(
-                ", focused at {} with a lens of radius {}",
-                lens.focus_distance, lens.radius
-            )),
-        threads_text(job.threads),
-        job.output.display()
+        rendering_line(job, Device::Cpu, built.scene.camera.lens.as_ref())
     );
 }
 
@@ -300,7 +281,7 @@ fn render(
             .sum(),
         None => tile_count(bounds),
     };
-    let bar = progress_bar.then(|| new_progress_bar(total_tiles));
+    let bar = progress_bar.then(|| progress::bar(Unit::Tiles, total_tiles));
     let log = (!progress_bar).then(|| {
         ProgressLog::new(
             job.progress_every,
@@ -363,28 +344,6 @@ fn render(
     })
 }
 
-/// Warns about the samples the render left out of the image for being NaN or infinite.
-fn warn_nonfinite(stats: &RenderStats, err: &mut dyn Write) {
-    if stats.nonfinite_samples > 0 {
-        let first = stats
-            .first_nonfinite_pixel
-            .map(|(x, y)| format!("; the first in pixel ({x}, {y}) from the top-left"))
-            .unwrap_or_default();
-        let _ = writeln!(
-            err,
-            "warning: {} sample{} returned NaN or infinity (or overflowed) and {} left out of \
-             the image{first}",
-            stats.nonfinite_samples,
-            plural(stats.nonfinite_samples),
-            if stats.nonfinite_samples == 1 {
-                "was"
-            } else {
-                "were"
-            },
-        );
-    }
-}
-
 /// Writes the image with its metadata and removes the checkpoint it completes; returns the
 /// time that took.
 fn write(
@@ -424,7 +383,7 @@ fn print_stats(
     job: &Job,
     pool: &rayon::ThreadPool,
     built: &Built,
-    rendered: &Rendered,
+    summary: &Summary,
     write_time: Duration,
     err: &mut dyn Write,
 ) {
@@ -434,9 +393,9 @@ fn print_stats(
         .row("load", seconds(built.load_time))
         .row("hash", seconds(built.hash_time))
         .row("build", seconds(built.build_time))
-        .row("render", seconds(rendered.time))
+        .row("render", seconds(summary.render_time))
         .row("write", seconds(write_time));
-    rays_section(&mut report, &job.settings, &rendered.stats);
+    rays_section(&mut report, &job.settings, &summary.stats);
     report.section("memory").row(
         "peak resident",
         peak_rss().map_or_else(
