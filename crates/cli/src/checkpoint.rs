@@ -17,9 +17,10 @@ use std::time::Instant;
 
 use glint_render::{Film, PixelBounds, Progress, RenderError, RenderSettings, RenderStats, Scene};
 
-use crate::args::{Checkpointing, UsageError};
+use crate::failure::Failure;
 use crate::farm::{self, key};
-use crate::run::{Failure, Interrupt, Phase};
+use crate::interrupt::{Interrupt, Phase};
+use crate::job::{Checkpointing, UsageError};
 
 /// The bands the render runs in: whole rows of `TILE_SIZE` tiles, enough of them per band to
 /// keep `threads` threads busy (at least four tiles a thread).

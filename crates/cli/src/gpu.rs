@@ -1,7 +1,8 @@
 //! `--device gpu`: the path tracer on the GPU back end (glint-gpu) instead of the CPU's render
-//! pipeline. The run is the CPU's (`run::run` loads the scene, this module renders and writes)
-//! with the GPU's own reporting: the adapter's name first, a progress bar over sample passes,
-//! and a closing line in samples per second (the GPU does not count rays).
+//! pipeline. The run is the CPU's (`run::run` loads the scene, this module renders and writes),
+//! and so is its reporting (`progress`, `report`), in the GPU's own terms: the adapter's name
+//! first, a progress bar over sample passes, and a closing line in samples per second (the GPU
+//! does not count rays).
 //!
 //! Exit statuses: 2 when the GPU path does not support what was asked (another integrator,
 //! or a scene whose buffers exceed what the adapter can bind), like any other unusable
@@ -13,10 +14,12 @@ use std::time::Instant;
 
 use glint_gpu::{GpuError, GpuRenderer};
 use glint_render::{RenderStats, SceneParts};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::args::{Job, UsageError};
-use crate::run::{plural, si, Failure, Interrupt, Phase, Summary};
+use crate::failure::Failure;
+use crate::interrupt::{Interrupt, Phase};
+use crate::job::{Job, UsageError};
+use crate::progress::{self, Unit};
+use crate::report::{finish, rendering_line, warn_nonfinite, Device, Summary};
 
 /// Renders `parts` on the GPU and writes the image.
 pub fn run(
@@ -43,35 +46,14 @@ pub fn run(
     }
     glint_gpu::check_supported(parts, settings).map_err(unsupported)?;
     let gpu = GpuRenderer::new().map_err(Failure::Gpu)?;
-    let adapter = gpu.adapter_name();
-    let _ = writeln!(err, "device: {adapter}");
+    let _ = writeln!(err, "device: {}", gpu.adapter_name());
     if job.verbose {
-        let _ = writeln!(
-            err,
-            "rendering {}x{}, {} samples per pixel, depth {}, seed {}, path integrator on the \
-             GPU -> {}",
-            settings.width,
-            settings.height,
-            settings.samples_per_pixel(),
-            settings.max_depth(),
-            settings.seed,
-            job.output.display()
-        );
+        let lens = parts.camera.lens.as_ref();
+        let _ = writeln!(err, "{}", rendering_line(job, Device::Gpu, lens));
     }
 
-    let bar = progress_bar.then(|| {
-        let bar = ProgressBar::with_draw_target(
-            Some(settings.samples_per_pixel() as u64),
-            ProgressDrawTarget::stderr(),
-        );
-        let style = ProgressStyle::with_template(
-            "{elapsed_precise} [{wide_bar}] {pos}/{len} samples per pixel, ETA {eta}",
-        )
-        .unwrap_or_else(|_| ProgressStyle::default_bar())
-        .progress_chars("=> ");
-        bar.set_style(style);
-        bar
-    });
+    let bar = progress_bar
+        .then(|| progress::bar(Unit::SamplePasses, settings.samples_per_pixel() as u64));
     let progress = |done: u32, total: u32| {
         if let Some(bar) = &bar {
             bar.set_length(total as u64);
@@ -87,56 +69,22 @@ pub fn run(
         bar.finish_and_clear();
     }
     interrupt.set_phase(Phase::Writing);
-    let (film, stats) = match result {
+    let (film, gpu_stats) = match result {
         Ok(rendered) if !interrupt.requested() => rendered,
         Ok(_) | Err(GpuError::Cancelled) => return Err(Failure::Interrupted),
         Err(error) => return Err(unsupported(error)),
     };
-    if stats.nonfinite_samples > 0 {
-        let first = stats
-            .first_nonfinite_pixel
-            .map(|(x, y)| format!("; the first in pixel ({x}, {y}) from the top-left"))
-            .unwrap_or_default();
-        let _ = writeln!(
-            err,
-            "warning: {} sample{} returned NaN or infinity and {} left out of the image{first}",
-            stats.nonfinite_samples,
-            plural(stats.nonfinite_samples),
-            if stats.nonfinite_samples == 1 {
-                "was"
-            } else {
-                "were"
-            },
-        );
-    }
+    // The CPU's statistics, as far as the GPU has them.
+    let stats = RenderStats {
+        nonfinite_samples: gpu_stats.nonfinite_samples,
+        first_nonfinite_pixel: gpu_stats.first_nonfinite_pixel,
+        ..RenderStats::default()
+    };
+    warn_nonfinite(Device::Gpu, &stats, err);
     let options = glint_io::WriteOptions { png: job.png };
     glint_io::write_image_with(&job.output, &film, &options).map_err(Failure::Write)?;
-
-    let seconds = render_time.as_secs_f64();
-    let rate = if seconds > 0.0 {
-        stats.samples as f64 / seconds
-    } else {
-        0.0
-    };
-    let _ = writeln!(
-        err,
-        "rendered {}x{}, {} rpp in {seconds:.2} s on the GPU: {} samples, {} samples/s -> {}",
-        settings.width,
-        settings.height,
-        settings.samples_per_pixel(),
-        si(stats.samples as f64),
-        si(rate),
-        job.output.display()
-    );
-    Ok(Summary {
-        stats: RenderStats {
-            nonfinite_samples: stats.nonfinite_samples,
-            first_nonfinite_pixel: stats.first_nonfinite_pixel,
-            ..RenderStats::default()
-        },
-        render_time,
-        threads: 0,
-    })
+    let samples = gpu_stats.samples;
+    Ok(finish(job, Device::Gpu, samples, stats, render_time, err))
 }
 
 /// The failure for a `GpuError`: what the user asked for (exit 2) or what the machine lacks

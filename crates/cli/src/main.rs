@@ -2,19 +2,27 @@
 //!
 //! This file only wires the process to the run: it parses the arguments (clap exits with
 //! status 2 on usage errors and 0 for help), installs the Ctrl-C handler, and turns the
-//! outcome into an exit status. Arguments live in `args.rs`, the run in `run.rs`.
+//! outcome into an exit status. What the user typed lives in `args.rs`, what a render needs in
+//! `job.rs`, the run in `run.rs`.
 #![forbid(unsafe_code)]
 
 mod args;
 mod bench;
+mod check;
 mod checkpoint;
 mod diff;
+mod failure;
 mod farm;
 mod gpu;
+mod interrupt;
+mod job;
+mod memory;
 mod merge;
 mod preview;
+mod progress;
 mod report;
 mod run;
+mod stats;
 
 use std::io::IsTerminal;
 use std::process::ExitCode;
@@ -22,7 +30,8 @@ use std::process::ExitCode;
 use clap::Parser;
 
 use crate::args::Cli;
-use crate::run::{Failure, Interrupt, SignalAction, EXIT_INTERRUPTED};
+use crate::failure::{Failure, EXIT_INTERRUPTED};
+use crate::interrupt::{Interrupt, SignalAction};
 
 /// Shared with the Ctrl-C handler, which must be `'static`.
 static INTERRUPT: Interrupt = Interrupt::new();
@@ -47,7 +56,7 @@ fn main() -> ExitCode {
     }
     if let Some(crate::args::Command::Check { scenes, limits, .. }) = &cli.command {
         let (resolved, _) = limits.resolve();
-        let status = run::check(scenes, &resolved, limits.strict, &mut std::io::stderr());
+        let status = check::run(scenes, &resolved, limits.strict, &mut std::io::stderr());
         return ExitCode::from(status);
     }
     if matches!(cli.command, Some(crate::args::Command::Merge(_))) {

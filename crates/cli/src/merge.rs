@@ -19,18 +19,10 @@ use std::path::{Path, PathBuf};
 
 use glint_render::{Color, Features, Film};
 
-use crate::args::{MergeArgs, UsageError};
+use crate::args::MergeArgs;
+use crate::failure::Failure;
 use crate::farm::{self, key};
-use crate::run::Failure;
-
-pub const AFTER_HELP: &str = "\
-Example (four tiles, then four sample ranges of the same render):
-  for i in 0 1 2 3; do glint render s.json -w 640 -h 480 --tile $i/4 -o part$i.exr; done
-  glint merge -o s.png part0.exr part1.exr part2.exr part3.exr
-
-Refused (exit status 2, nothing written): parts of other renders (scene hash, seed, size,
-integrator, samples per pixel, depth, aspect or Glint version differ), pixels in no part (a
-gap), pixels in two tiles (an overlap), samples in no part or in two.";
+use crate::job::UsageError;
 
 /// One part, read and checked.
 struct Part {

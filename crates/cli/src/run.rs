@@ -1,200 +1,36 @@
 //! One run of `glint`: load the scene, render it on a pool of the requested size, write the
 //! image, and tell the user what happened. The libraries report; this module decides what the
-//! terminal shows and which exit status each outcome gets.
+//! terminal shows, and `failure` which exit status each outcome gets.
 
-use std::fmt;
 use std::io::Write;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
+use std::path::Path;
 use std::time::{Duration, Instant};
 
-use glint_io::{Diagnostic, ImageWriteError, SceneError};
 use glint_render::{
-    Background, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings, RenderStats,
-    Scene, SceneOptions, ThinLens,
+    Background, Film, PixelBounds, Progress, RenderError, RenderSettings, RenderStats, Scene,
+    SceneOptions, SceneParts, ThinLens,
 };
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 
-use crate::args::{DeviceArg, Job, UsageError};
+use crate::args::DeviceArg;
 use crate::checkpoint;
+use crate::failure::Failure;
 use crate::farm;
+use crate::interrupt::{Interrupt, Phase};
+use crate::job::{Job, UsageError};
+use crate::memory;
 use crate::preview::TileSink;
-use crate::report::{peak_rss, seconds, ProgressLog, Stats};
-
-/// Exit status of a run that was interrupted with Ctrl-C (128 + SIGINT, as shells report it).
-pub const EXIT_INTERRUPTED: u8 = 130;
-
-/// Why a run failed, and so which exit status it gets.
-#[derive(Debug)]
-pub enum Failure {
-    /// Arguments that parsed but cannot be used (exit 2, like clap's own usage errors).
-    Usage(UsageError),
-    /// The scene could not be read or is invalid (exit 2).
-    Scene(SceneError),
-    /// The image could not be written (exit 1).
-    Write(ImageWriteError),
-    /// The GPU back end cannot render this scene with these settings (exit 2: like a bad
-    /// argument, the user asked for something this device does not do).
-    GpuUnsupported(glint_gpu::GpuError),
-    /// No GPU adapter, or the device failed (exit 1: the machine, not the input, is at fault).
-    Gpu(glint_gpu::GpuError),
-    /// The render threads could not be started (exit 1).
-    ThreadPool(rayon::ThreadPoolBuildError),
-    /// Ctrl-C or SIGTERM (exit 130). Nothing was written.
-    Interrupted,
-    /// `--strict` and the scene has warnings (exit 2); they were printed as errors.
-    Strict { scene: PathBuf, warnings: usize },
-    /// The render would need more memory than `--max-memory` allows (exit 2).
-    Memory(String),
-    /// Ctrl-C or SIGTERM with `--checkpoint` (exit 130): the finished rows are in the file.
-    InterruptedWithCheckpoint(std::path::PathBuf),
-}
-
-impl Failure {
-    pub fn exit_code(&self) -> u8 {
-        match self {
-            Failure::Usage(_)
-            | Failure::Scene(_)
-            | Failure::Strict { .. }
-            | Failure::Memory(_)
-            | Failure::GpuUnsupported(_) => 2,
-            Failure::Write(_) | Failure::ThreadPool(_) | Failure::Gpu(_) => 1,
-            Failure::Interrupted | Failure::InterruptedWithCheckpoint(_) => EXIT_INTERRUPTED,
-        }
-    }
-}
-
-impl fmt::Display for Failure {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Failure::Usage(error) => write!(f, "{error}"),
-            Failure::Scene(SceneError::Invalid(diagnostic)) => f.write_str(&located(diagnostic)),
-            Failure::Scene(error @ SceneError::Io { source, .. }) => {
-                write!(f, "{error}")?;
-                if glint_io::TooLarge::of(source).is_some() {
-                    f.write_str(" (--max-file-size raises it)")?;
-                }
-                Ok(())
-            }
-            // It names the file: "cannot write out.png: ...".
-            Failure::Write(error) => write!(f, "{error}"),
-            Failure::GpuUnsupported(error) | Failure::Gpu(error) => write!(f, "{error}"),
-            Failure::ThreadPool(error) => write!(f, "cannot start the render threads: {error}"),
-            Failure::Interrupted => f.write_str("interrupted: no image was written"),
-            Failure::Strict { scene, warnings } => write!(
-                f,
-                "{}: {warnings} warning{} with --strict; nothing was rendered",
-                scene.display(),
-                plural(*warnings as u64)
-            ),
-            Failure::Memory(why) => f.write_str(why),
-            Failure::InterruptedWithCheckpoint(file) => write!(
-                f,
-                "interrupted: the finished rows are in {0}; continue with --resume {0}",
-                file.display()
-            ),
-        }
-    }
-}
-
-impl From<UsageError> for Failure {
-    fn from(error: UsageError) -> Failure {
-        Failure::Usage(error)
-    }
-}
-
-/// `file:line:col: message` with the offending line and a caret (glint-io's
-/// `Diagnostic::located`); the caller puts the severity label in front (`error: `,
-/// `warning: `) the same way as for every other message of the CLI.
-pub fn located(diagnostic: &Diagnostic) -> String {
-    diagnostic.located()
-}
-
-/// Where a run is, so that Ctrl-C does the right thing at each point.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u8)]
-pub enum Phase {
-    /// Reading and building the scene: nothing to clean up, so Ctrl-C exits at once.
-    Loading = 0,
-    /// Rendering: Ctrl-C cancels at the end of the current tiles; a second one exits at once
-    /// (rendering writes nothing, so that is safe too).
-    Rendering = 1,
-    /// Writing the image: Ctrl-C is noted but the (atomic) write completes, so that no
-    /// temporary file is left behind.
-    Writing = 2,
-}
-
-/// What the Ctrl-C handler should do.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SignalAction {
-    ExitNow,
-    Cancel,
-    Ignore,
-}
-
-/// The state shared between the Ctrl-C handler and the run. Const-constructible, so `main` can
-/// keep it in a `static` that the handler (which must be `'static`) reads.
-#[derive(Debug)]
-pub struct Interrupt {
-    phase: AtomicU8,
-    requested: AtomicBool,
-}
-
-impl Default for Interrupt {
-    fn default() -> Self {
-        Interrupt::new()
-    }
-}
-
-impl Interrupt {
-    pub const fn new() -> Interrupt {
-        Interrupt {
-            phase: AtomicU8::new(Phase::Loading as u8),
-            requested: AtomicBool::new(false),
-        }
-    }
-
-    pub fn set_phase(&self, phase: Phase) {
-        self.phase.store(phase as u8, Ordering::SeqCst);
-    }
-
-    fn phase(&self) -> Phase {
-        match self.phase.load(Ordering::SeqCst) {
-            0 => Phase::Loading,
-            1 => Phase::Rendering,
-            _ => Phase::Writing,
-        }
-    }
-
-    /// Whether Ctrl-C was pressed.
-    pub fn requested(&self) -> bool {
-        self.requested.load(Ordering::SeqCst)
-    }
-
-    /// Records a Ctrl-C and says what to do about it.
-    pub fn on_signal(&self) -> SignalAction {
-        let again = self.requested.swap(true, Ordering::SeqCst);
-        match self.phase() {
-            Phase::Loading => SignalAction::ExitNow,
-            Phase::Rendering if again => SignalAction::ExitNow,
-            Phase::Rendering => SignalAction::Cancel,
-            Phase::Writing => SignalAction::Ignore,
-        }
-    }
-}
-
-/// What a successful run did.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Summary {
-    pub stats: RenderStats,
-    pub render_time: Duration,
-    pub threads: usize,
-}
+use crate::progress::{self, ProgressLog, Unit};
+use crate::report::{
+    finish, located, plural, print_warnings, rendering_line, warn_nonfinite, Device, Summary,
+    MAX_SHOWN_WARNINGS,
+};
+use crate::stats::{bvh_stats, peak_rss, rays_section, seconds, Stats};
 
 /// Runs `job`, printing notes, warnings, the progress bar (only if `progress_bar`) and the
 /// closing line to `err`, and handing each finished tile to `preview` if there is one.
 /// Errors are returned, not printed: `main` prints them and exits. No image is written unless
-/// the whole run succeeds.
+/// the whole run succeeds. Write errors on stderr are ignored throughout: a closed stderr must
+/// not fail a render.
 pub fn run(
     job: &Job,
     interrupt: &Interrupt,
@@ -202,21 +38,99 @@ pub fn run(
     progress_bar: bool,
     preview: Option<&TileSink>,
 ) -> Result<Summary, Failure> {
-    // Write errors on stderr are ignored throughout: a closed stderr must not fail a render.
-    for note in &job.notes {
-        let _ = writeln!(err, "note: {note}");
-    }
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(job.threads)
-        .thread_name(|index| format!("glint-render-{index}"))
-        .build()
-        .map_err(Failure::ThreadPool)?;
-
+    print_notes(job, err);
+    let pool = thread_pool(job.threads)?;
     interrupt.set_phase(Phase::Loading);
     // Everything that can be known before the render is checked before it: the output can
     // be written, and the film fits in the memory budget.
     check_output(&job.output)?;
-    let removed = glint_io::remove_stale_partials(output_directory(&job.output));
+    remove_stale_partials(&job.output, err);
+    let film_bytes = memory::film_bytes(&job.settings);
+    memory::check(film_bytes, 0, 0, job.max_memory)?;
+    let loaded = load(job, &pool, film_bytes, err)?;
+    check_memory(job, film_bytes, &loaded.parts)?;
+    if job.device == DeviceArg::Gpu {
+        return crate::gpu::run(job, &loaded.parts, interrupt, err, progress_bar);
+    }
+    let built = build(job, &pool, loaded);
+    if job.verbose {
+        print_settings(job, &built, err);
+    }
+    let rendered = render(job, &pool, &built, interrupt, err, progress_bar, preview)?;
+    warn_nonfinite(Device::Cpu, &rendered.stats, err);
+    let write_time = write(job, &pool, &built, &rendered, err)?;
+    let (rays, stats) = (rendered.stats.rays, rendered.stats);
+    let summary = finish(job, Device::Cpu, rays, stats, rendered.time, err);
+    if job.stats {
+        print_stats(job, &pool, &built, &summary, write_time, err);
+    }
+    Ok(summary)
+}
+
+/// The scene as read, with the job's overrides applied.
+struct Loaded {
+    parts: SceneParts,
+    /// From the start of the read to the overrides.
+    time: Duration,
+}
+
+/// The scene ready to render, with what it took to get there.
+struct Built {
+    scene: Scene,
+    /// `glint_io::scene_hash` of the loaded scene, for the image's metadata.
+    hash: String,
+    load_time: Duration,
+    hash_time: Duration,
+    build_time: Duration,
+}
+
+impl Built {
+    /// The metadata of an image of this scene after `rays` rays and `render_seconds` seconds
+    /// of rendering.
+    fn metadata(
+        &self,
+        settings: &RenderSettings,
+        rays: u64,
+        render_seconds: f64,
+    ) -> Vec<(String, String)> {
+        let stats = RenderStats {
+            rays,
+            ..RenderStats::default()
+        };
+        farm::metadata(settings, &self.hash, &stats, render_seconds)
+    }
+}
+
+/// A finished render.
+struct Rendered {
+    film: Film,
+    stats: RenderStats,
+    /// Render seconds for the image's metadata: this run's and, after `--resume`, those of
+    /// the runs before it.
+    render_seconds: f64,
+    /// This run's render, checkpoint writes included.
+    time: Duration,
+}
+
+/// Notes about accepted options that have no effect.
+fn print_notes(job: &Job, err: &mut dyn Write) {
+    for note in &job.notes {
+        let _ = writeln!(err, "note: {note}");
+    }
+}
+
+/// The pool of `-n` threads that reads, builds, renders and writes.
+fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, Failure> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .thread_name(|index| format!("glint-render-{index}"))
+        .build()
+        .map_err(Failure::ThreadPool)
+}
+
+/// Removes the temporary files that killed runs left beside the output, and says so.
+fn remove_stale_partials(output: &Path, err: &mut dyn Write) {
+    let removed = glint_io::remove_stale_partials(output_directory(output));
     if removed > 0 {
         let _ = writeln!(
             err,
@@ -224,9 +138,17 @@ pub fn run(
             plural(removed as u64)
         );
     }
-    let film_bytes = film_bytes(&job.settings);
-    check_memory(film_bytes, 0, 0, job.max_memory)?;
-    let load_start = Instant::now();
+}
+
+/// Reads the scene within the job's limits, prints its warnings (or, with `--strict`, refuses
+/// it for them) and applies the job's background and depth of field.
+fn load(
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    film_bytes: u64,
+    err: &mut dyn Write,
+) -> Result<Loaded, Failure> {
+    let start = Instant::now();
     // Textures get what the film leaves of the budget.
     let mut limits = job.limits;
     limits.max_texture_bytes = limits
@@ -257,75 +179,96 @@ pub fn run(
             ..lens
         });
     }
-    check_memory(
+    Ok(Loaded {
+        parts,
+        time: start.elapsed(),
+    })
+}
+
+/// Refuses a scene whose film, textures and acceleration structures would not fit in the
+/// memory budget.
+fn check_memory(job: &Job, film_bytes: u64, parts: &SceneParts) -> Result<(), Failure> {
+    memory::check(
         film_bytes,
-        texture_bytes(&parts),
-        shape_count(&parts),
+        memory::texture_bytes(parts),
+        memory::shape_count(parts),
         job.max_memory,
-    )?;
-    if job.device == DeviceArg::Gpu {
-        return crate::gpu::run(job, &parts, interrupt, err, progress_bar);
-    }
-    let load_time = load_start.elapsed();
+    )
+}
+
+/// Hashes the scene for the image's metadata and builds its acceleration structures.
+fn build(job: &Job, pool: &rayon::ThreadPool, loaded: Loaded) -> Built {
     let hash_start = Instant::now();
-    let scene_hash = glint_io::scene_hash(&parts);
+    let hash = glint_io::scene_hash(&loaded.parts);
     let hash_time = hash_start.elapsed();
     let build_start = Instant::now();
     let options = SceneOptions { split: job.split };
-    let scene = pool.install(|| Scene::with_options(parts, options));
-    let build_time = build_start.elapsed();
-
-    let settings = &job.settings;
-    if job.verbose {
-        let depth = format!("depth {}", settings.max_depth());
-        let _ = writeln!(
-            err,
-            "loaded {} in {:.2} s ({} BVH)\nrendering {}x{}, {} samples per pixel, {depth}, seed \
-             {}, {} integrator{}, {} -> {}",
-            job.scene.display(),
-            (load_time + build_time).as_secs_f64(),
-            job.split.name(),
-            settings.width,
-            settings.height,
-            settings.samples_per_pixel(),
-            settings.seed,
-            settings.integrator.name(),
-            scene.camera.lens.map_or(String::new(), |lens| format!(
-                ", focused at {} with a lens of radius {}",
-                lens.focus_distance, lens.radius
-            )),
-            threads_text(job.threads),
-            job.output.display()
-        );
+    let scene = pool.install(|| Scene::with_options(loaded.parts, options));
+    Built {
+        scene,
+        hash,
+        load_time: loaded.time,
+        hash_time,
+        build_time: build_start.elapsed(),
     }
-    let metadata = |rays: u64, render_seconds: f64| {
-        let stats = RenderStats {
-            rays,
-            ..RenderStats::default()
-        };
-        farm::metadata(settings, &scene_hash, &stats, render_seconds)
+}
+
+/// `-v`: how long the scene took to load and what is about to be rendered.
+fn print_settings(job: &Job, built: &Built, err: &mut dyn Write) {
+    let _ = writeln!(
+        err,
+        "loaded {} in {:.2} s ({} BVH)\n{}",
+        job.scene.display(),
+        (built.load_time + built.build_time).as_secs_f64(),
+        job.split.name(),
+        rendering_line(job, Device::Cpu, built.scene.camera.lens.as_ref())
+    );
+}
+
+/// `--resume`: what the checkpoint holds, if it exists yet, and a note saying which. The
+/// checkpoint must have been made by the same scene and options.
+fn resume(
+    job: &Job,
+    built: &Built,
+    err: &mut dyn Write,
+) -> Result<Option<checkpoint::Resumed>, Failure> {
+    let Some(checkpoint) = job.checkpoint.as_ref().filter(|c| c.resume) else {
+        return Ok(None);
     };
-    let resumed = match &job.checkpoint {
-        Some(checkpoint) if checkpoint.resume => {
-            let resumed = checkpoint::load(&checkpoint.file, settings, &metadata(0, 0.0))?;
-            let _ = match &resumed {
-                Some(resumed) => writeln!(
-                    err,
-                    "note: resuming {}: {} of {} rows done",
-                    checkpoint.file.display(),
-                    resumed.film.height,
-                    settings.bounds().height()
-                ),
-                None => writeln!(
-                    err,
-                    "note: {} does not exist yet: starting from the first row",
-                    checkpoint.file.display()
-                ),
-            };
-            resumed
-        }
-        _ => None,
+    let expected = built.metadata(&job.settings, 0, 0.0);
+    let resumed = checkpoint::load(&checkpoint.file, &job.settings, &expected)?;
+    let _ = match &resumed {
+        Some(resumed) => writeln!(
+            err,
+            "note: resuming {}: {} of {} rows done",
+            checkpoint.file.display(),
+            resumed.film.height,
+            job.settings.bounds().height()
+        ),
+        None => writeln!(
+            err,
+            "note: {} does not exist yet: starting from the first row",
+            checkpoint.file.display()
+        ),
     };
+    Ok(resumed)
+}
+
+/// Renders the scene on the pool, in checkpointed bands with `--checkpoint` or `--resume`,
+/// showing the progress and handing each tile to the preview. Ctrl-C stops it at the end of
+/// the current tiles.
+fn render(
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    built: &Built,
+    interrupt: &Interrupt,
+    err: &mut dyn Write,
+    progress_bar: bool,
+    preview: Option<&TileSink>,
+) -> Result<Rendered, Failure> {
+    let settings = &job.settings;
+    let metadata = |rays: u64, render_seconds: f64| built.metadata(settings, rays, render_seconds);
+    let resumed = resume(job, built, err)?;
 
     let bounds = settings.bounds();
     let done_pixels = resumed
@@ -338,7 +281,7 @@ pub fn run(
             .sum(),
         None => tile_count(bounds),
     };
-    let bar = progress_bar.then(|| new_progress_bar(total_tiles));
+    let bar = progress_bar.then(|| progress::bar(Unit::Tiles, total_tiles));
     let log = (!progress_bar).then(|| {
         ProgressLog::new(
             job.progress_every,
@@ -363,8 +306,8 @@ pub fn run(
     let render_start = Instant::now();
     let rendered = match &job.checkpoint {
         Some(checkpointing) => checkpoint::render(
-            &pool,
-            &scene,
+            pool,
+            &built.scene,
             settings,
             job.threads,
             checkpointing,
@@ -374,13 +317,13 @@ pub fn run(
             interrupt,
         )
         .map(|banded| (banded.film, banded.stats, banded.render_seconds)),
-        None => match pool.install(|| glint_render::render(&scene, settings, &progress)) {
+        None => match pool.install(|| glint_render::render(&built.scene, settings, &progress)) {
             Ok((film, stats)) => Ok((film, stats, render_start.elapsed().as_secs_f64())),
             Err(RenderError::Invalid(why)) => Err(Failure::Usage(UsageError(why))),
             Err(RenderError::Cancelled) => Err(Failure::Interrupted),
         },
     };
-    let render_time = render_start.elapsed();
+    let time = render_start.elapsed();
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -393,37 +336,30 @@ pub fn run(
         Ok(rendered) => rendered,
         Err(failure) => return Err(failure),
     };
+    Ok(Rendered {
+        film,
+        stats,
+        render_seconds,
+        time,
+    })
+}
 
-    if stats.nonfinite_samples > 0 {
-        let first = stats
-            .first_nonfinite_pixel
-            .map(|(x, y)| format!("; the first in pixel ({x}, {y}) from the top-left"))
-            .unwrap_or_default();
-        let _ = writeln!(
-            err,
-            "warning: {} sample{} returned NaN or infinity (or overflowed) and {} left out of \
-             the image{first}",
-            stats.nonfinite_samples,
-            plural(stats.nonfinite_samples),
-            if stats.nonfinite_samples == 1 {
-                "was"
-            } else {
-                "were"
-            },
-        );
-    }
-
-    let write_start = Instant::now();
+/// Writes the image with its metadata and removes the checkpoint it completes; returns the
+/// time that took.
+fn write(
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    built: &Built,
+    rendered: &Rendered,
+    err: &mut dyn Write,
+) -> Result<Duration, Failure> {
+    let start = Instant::now();
     let options = glint_io::WriteOptions { png: job.png };
+    let metadata = built.metadata(&job.settings, rendered.stats.rays, rendered.render_seconds);
     // In the pool: the PNG's 8-bit conversion runs on `-n` threads, and `-n 1` keeps the
     // EXR's compression on one.
     pool.install(|| {
-        glint_io::write_image_with_metadata(
-            &job.output,
-            &film,
-            &options,
-            &metadata(stats.rays, render_seconds),
-        )
+        glint_io::write_image_with_metadata(&job.output, &rendered.film, &options, &metadata)
     })
     .map_err(Failure::Write)?;
     if let Some(checkpoint) = &job.checkpoint {
@@ -439,141 +375,40 @@ pub fn run(
             _ => {}
         }
     }
-    let write_time = write_start.elapsed();
-
-    let _ = writeln!(err, "{}", closing_line(job, &stats, render_time));
-    if job.stats {
-        let mut report = Stats::default();
-        report
-            .section("time")
-            .row("load", seconds(load_time))
-            .row("hash", seconds(hash_time))
-            .row("build", seconds(build_time))
-            .row("render", seconds(render_time))
-            .row("write", seconds(write_time));
-        rays_section(&mut report, settings, &stats);
-        report.section("memory").row(
-            "peak resident",
-            peak_rss().map_or_else(
-                || "unknown".to_string(),
-                |bytes| format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0)),
-            ),
-        );
-        let _ = write!(err, "{}", report.render());
-        let _ = write!(err, "{}", pool.install(|| bvh_stats(&scene, settings)));
-    }
-    Ok(Summary {
-        stats,
-        render_time,
-        threads: job.threads,
-    })
+    Ok(start.elapsed())
 }
 
-/// `--stats`' BVH figures: how the split method shaped the tree and what it costs the camera
-/// rays (measured in a separate counting pass, so the render itself counted nothing).
-pub fn bvh_stats(scene: &Scene, settings: &RenderSettings) -> String {
-    let bvh = scene.bvh_stats();
-    let walk = glint_render::measure_traversal(scene, settings);
-    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-    // Where the largest tree's build spent its time: the root node's splits run before any
-    // subtree can run apart, so they are what more threads shorten least.
-    let phases = bvh.largest.map_or_else(String::new, |(primitives, p)| {
-        format!(
-            "BVH build phases, largest tree ({primitives} primitives): boxes {:.1} ms, root \
-             splits {:.1} ms, subtrees {:.1} ms, blocks {:.1} ms\n",
-            ms(p.boxes),
-            ms(p.top_splits),
-            ms(p.subtrees),
-            ms(p.pack),
-        )
-    });
-    format!(
-        "BVH ({}): built in {:.1} ms; {} tree{}, {} nodes, {} leaves, depth {}, SAH cost {:.2}\n\
-         {phases}\
-         BVH traversal: {:.2} nodes and {:.2} triangle blocks per camera ray ({} rays through \
-         pixel centres, {:.0}% hit)\n",
-        bvh.split.name(),
-        ms(bvh.build_time),
-        bvh.trees,
-        plural(bvh.trees as u64),
-        bvh.nodes,
-        bvh.leaves,
-        bvh.depth,
-        bvh.sah_cost,
-        walk.nodes_per_ray(),
-        walk.blocks_per_ray(),
-        walk.rays,
-        100.0 * walk.hits as f64 / walk.rays.max(1) as f64,
-    )
-}
-
-/// `glint check`: loads every scene under `limits`, prints every diagnostic (warnings as
-/// errors with `strict`) and a line per scene, and returns the exit status: 0 when every scene
-/// loads (with `strict`: without warnings), 2 otherwise.
-pub fn check(
-    scenes: &[PathBuf],
-    limits: &glint_io::Limits,
-    strict: bool,
+/// `--stats`: time per stage, rays by kind, peak memory and the BVH's figures.
+fn print_stats(
+    job: &Job,
+    pool: &rayon::ThreadPool,
+    built: &Built,
+    summary: &Summary,
+    write_time: Duration,
     err: &mut dyn Write,
-) -> u8 {
-    let mut failed = 0usize;
-    for scene in scenes {
-        match glint_io::load_scene_limited(scene, limits) {
-            Ok(loaded) => {
-                let label = if strict { "error" } else { "warning" };
-                for warning in &loaded.warnings {
-                    let _ = writeln!(err, "{label}: {}", located(warning));
-                }
-                let count = loaded.warnings.len();
-                let verdict = if strict && count > 0 {
-                    failed += 1;
-                    "fails under --strict"
-                } else {
-                    "ok"
-                };
-                let _ = writeln!(
-                    err,
-                    "{}: {verdict} ({count} warning{})",
-                    scene.display(),
-                    plural(count as u64)
-                );
-            }
-            Err(error) => {
-                failed += 1;
-                let _ = writeln!(err, "error: {}", Failure::Scene(error));
-                let _ = writeln!(err, "{}: cannot be loaded", scene.display());
-            }
-        }
-    }
-    if failed > 0 {
-        let _ = writeln!(
-            err,
-            "{failed} of {} scene{} failed",
-            scenes.len(),
-            plural(scenes.len() as u64)
-        );
-        2
-    } else {
-        0
-    }
-}
-
-/// How many warnings a render prints; `glint check` prints them all.
-pub const MAX_SHOWN_WARNINGS: usize = 20;
-
-/// Prints the first `limit` warnings and then how many more there were.
-pub fn print_warnings(warnings: &[Diagnostic], limit: usize, err: &mut dyn Write) {
-    for warning in warnings.iter().take(limit) {
-        let _ = writeln!(err, "warning: {}", located(warning));
-    }
-    if warnings.len() > limit {
-        let rest = warnings.len() - limit;
-        let _ = writeln!(
-            err,
-            "warning: {rest} more warning{} not shown (`glint check SCENE` lists them all)",
-            plural(rest as u64)
-        );
-    }
+) {
+    let mut report = Stats::default();
+    report
+        .section("time")
+        .row("load", seconds(built.load_time))
+        .row("hash", seconds(built.hash_time))
+        .row("build", seconds(built.build_time))
+        .row("render", seconds(summary.render_time))
+        .row("write", seconds(write_time));
+    rays_section(&mut report, &job.settings, &summary.stats);
+    report.section("memory").row(
+        "peak resident",
+        peak_rss().map_or_else(
+            || "unknown".to_string(),
+            |bytes| format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0)),
+        ),
+    );
+    let _ = write!(err, "{}", report.render());
+    let _ = write!(
+        err,
+        "{}",
+        pool.install(|| bvh_stats(&built.scene, &job.settings))
+    );
 }
 
 /// The folder the output goes into.
@@ -624,289 +459,8 @@ fn check_output(output: &Path) -> Result<(), Failure> {
     Ok(())
 }
 
-/// Bytes per pixel of a render: the pipeline's per-pixel values (40), the film (12), the
-/// 8-bit copy and its encoding (6), and with feature layers their film copies (28).
-fn film_bytes(settings: &glint_render::RenderSettings) -> u64 {
-    let per_pixel = if settings.features { 86 } else { 58 };
-    u64::from(settings.width) * u64::from(settings.height) * per_pixel
-}
-
-/// Bytes per shape of the scene and its acceleration structures: the shape (up to 40 bytes),
-/// its material, its triangle copy in the ray engine and its share of BVH nodes, with room.
-const BYTES_PER_SHAPE: u64 = 160;
-
-fn texture_bytes(parts: &glint_render::SceneParts) -> u64 {
-    let mut texels: u64 = parts
-        .textures
-        .iter()
-        .map(|texture| texture.texels.len() as u64)
-        .sum();
-    if let Background::CubeMap(map) = &parts.background {
-        texels += map
-            .faces
-            .iter()
-            .map(|face| face.texels.len() as u64)
-            .sum::<u64>();
-    }
-    texels * 12
-}
-
-fn shape_count(parts: &glint_render::SceneParts) -> u64 {
-    let shapes: u64 = parts
-        .geometries
-        .iter()
-        .map(|geometry| geometry.shapes.len() as u64)
-        .sum();
-    let light_triangles: u64 = parts
-        .lights
-        .iter()
-        .map(|light| match light {
-            glint_render::Light::Triangles { triangles, .. } => triangles.len() as u64,
-            _ => 1,
-        })
-        .sum();
-    shapes + light_triangles + parts.instances.len() as u64
-}
-
-/// Refuses a render whose estimated memory is over the budget.
-fn check_memory(film: u64, textures: u64, shapes: u64, budget: u64) -> Result<(), Failure> {
-    let structures = shapes.saturating_mul(BYTES_PER_SHAPE);
-    let total = film.saturating_add(textures).saturating_add(structures);
-    if total <= budget {
-        return Ok(());
-    }
-    let bytes = glint_io::format_bytes;
-    Err(Failure::Memory(format!(
-        "the render would need about {} (image {}, textures {}, shapes and their acceleration \
-         structures {}), more than the limit of {}; render a smaller image, or raise the limit \
-         with --max-memory",
-        bytes(total),
-        bytes(film),
-        bytes(textures),
-        bytes(structures),
-        bytes(budget)
-    )))
-}
-
-/// Rays by kind: every sample of every rendered pixel starts with one camera ray, and the
-/// course family traces one more per sample for the feature layers; the rest are the
-/// secondary (reflection, refraction, bounce) and shadow rays.
-fn rays_section(report: &mut Stats, settings: &RenderSettings, stats: &RenderStats) {
-    let bounds = settings.bounds();
-    let camera = u64::from(bounds.width())
-        * u64::from(bounds.height())
-        * u64::from(settings.samples().len() as u32);
-    let features = if settings.features && settings.integrator != IntegratorKind::Path {
-        camera
-    } else {
-        0
-    };
-    let mut section = report.section("rays");
-    section.row("camera", camera);
-    if features > 0 {
-        section.row("feature layers", features);
-    }
-    section
-        .row(
-            "secondary and shadow",
-            stats.rays.saturating_sub(camera + features),
-        )
-        .row("total", stats.rays);
-}
-
 /// Tiles of `TILE_SIZE` the render of `bounds` runs.
 fn tile_count(bounds: PixelBounds) -> u64 {
     let tile = glint_render::TILE_SIZE;
     u64::from(bounds.width().div_ceil(tile)) * u64::from(bounds.height().div_ceil(tile))
-}
-
-fn new_progress_bar(tiles: u64) -> ProgressBar {
-    let bar = ProgressBar::with_draw_target(Some(tiles), ProgressDrawTarget::stderr());
-    let style = ProgressStyle::with_template(
-        "{elapsed_precise} [{wide_bar}] {percent:>3}% of {len} tiles, ETA {eta}",
-    )
-    .unwrap_or_else(|_| ProgressStyle::default_bar())
-    .progress_chars("=> ");
-    bar.set_style(style);
-    bar
-}
-
-/// `rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png`
-pub fn closing_line(job: &Job, stats: &RenderStats, render_time: Duration) -> String {
-    let settings = &job.settings;
-    let seconds = render_time.as_secs_f64();
-    let rate = if seconds > 0.0 {
-        stats.rays as f64 / seconds
-    } else {
-        0.0
-    };
-    format!(
-        "rendered {}x{}, {} rpp in {seconds:.2} s: {} rays, {} rays/s, {} -> {}",
-        settings.width,
-        settings.height,
-        settings.samples_per_pixel(),
-        si(stats.rays as f64),
-        si(rate),
-        threads_text(job.threads),
-        job.output.display()
-    )
-}
-
-/// A count with an SI prefix: "950", "12.3 k", "4.5 M".
-pub fn si(value: f64) -> String {
-    const PREFIXES: [(f64, &str); 4] = [(1e12, "T"), (1e9, "G"), (1e6, "M"), (1e3, "k")];
-    for (scale, prefix) in PREFIXES {
-        if value >= scale {
-            return format!("{:.1} {prefix}", value / scale);
-        }
-    }
-    format!("{value:.0}")
-}
-
-fn threads_text(threads: usize) -> String {
-    format!("{threads} thread{}", plural(threads as u64))
-}
-
-pub(crate) fn plural(count: u64) -> &'static str {
-    if count == 1 {
-        ""
-    } else {
-        "s"
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use glint_render::RenderSettings;
-
-    #[test]
-    fn ctrl_c_exits_while_loading_cancels_while_rendering_and_waits_for_the_write() {
-        let interrupt = Interrupt::new();
-        assert_eq!(interrupt.on_signal(), SignalAction::ExitNow);
-
-        let interrupt = Interrupt::new();
-        interrupt.set_phase(Phase::Rendering);
-        assert!(!interrupt.requested());
-        assert_eq!(interrupt.on_signal(), SignalAction::Cancel);
-        assert!(interrupt.requested());
-        assert_eq!(interrupt.on_signal(), SignalAction::ExitNow);
-
-        let interrupt = Interrupt::new();
-        interrupt.set_phase(Phase::Writing);
-        assert_eq!(interrupt.on_signal(), SignalAction::Ignore);
-        assert_eq!(interrupt.on_signal(), SignalAction::Ignore);
-        assert!(interrupt.requested());
-    }
-
-    #[test]
-    fn si_prefixes() {
-        assert_eq!(si(0.0), "0");
-        assert_eq!(si(950.0), "950");
-        assert_eq!(si(12_345.0), "12.3 k");
-        assert_eq!(si(4_500_000.0), "4.5 M");
-        assert_eq!(si(2.0e9), "2.0 G");
-    }
-
-    #[test]
-    fn closing_line_names_size_samples_rays_threads_and_output() {
-        let job = Job {
-            scene: "s.xml".into(),
-            output: "out.png".into(),
-            settings: RenderSettings {
-                width: 250,
-                height: 250,
-                samples_per_pixel: 16,
-                ..RenderSettings::default()
-            },
-            threads: 2,
-            background: None,
-            png: glint_io::PngEncoding::Course,
-            device: DeviceArg::Cpu,
-            verbose: false,
-            split: glint_render::SplitMethod::Sah,
-            depth_of_field: None,
-            stats: false,
-            preview: None,
-            preview_close: false,
-            notes: Vec::new(),
-            strict: false,
-            limits: glint_io::Limits::default(),
-            max_memory: 1 << 30,
-            checkpoint: None,
-            progress_every: Duration::from_secs(5),
-        };
-        let stats = RenderStats {
-            rays: 4_500_000,
-            ..RenderStats::default()
-        };
-        assert_eq!(
-            closing_line(&job, &stats, Duration::from_millis(1230)),
-            "rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png"
-        );
-    }
-
-    #[test]
-    fn located_diagnostics_show_the_line_and_a_caret() {
-        let diagnostic = Diagnostic {
-            severity: glint_io::Severity::Error,
-            path: "scene.xml".into(),
-            line: 3,
-            column: 5,
-            message: "radius must be > 0".into(),
-            source: Some(glint_io::SourceLine::new("\tab cd")),
-        };
-        assert_eq!(
-            located(&diagnostic),
-            "scene.xml:3:5: radius must be > 0\n\tab cd\n\t   ^"
-        );
-    }
-
-    #[test]
-    fn memory_estimates_refuse_what_does_not_fit() {
-        let huge = glint_render::RenderSettings {
-            width: 65_535,
-            height: 65_535,
-            ..glint_render::RenderSettings::default()
-        };
-        let film = film_bytes(&huge);
-        assert!(film > 200 << 30, "{film}");
-        let refused = check_memory(film, 0, 0, 8 << 30).unwrap_err();
-        assert_eq!(refused.exit_code(), 2);
-        assert!(refused.to_string().contains("--max-memory"), "{refused}");
-        assert!(check_memory(1 << 20, 1 << 20, 1000, 8 << 30).is_ok());
-        assert!(check_memory(0, 0, u64::MAX, 8 << 30).is_err());
-    }
-
-    #[test]
-    fn warnings_beyond_the_cap_are_counted() {
-        let warnings: Vec<Diagnostic> = (1..=25)
-            .map(|line| Diagnostic {
-                severity: glint_io::Severity::Warning,
-                path: "s.xml".into(),
-                line,
-                column: 1,
-                message: format!("w{line}"),
-                source: None,
-            })
-            .collect();
-        let mut out = Vec::new();
-        print_warnings(&warnings, 20, &mut out);
-        let text = String::from_utf8(out).unwrap();
-        assert_eq!(text.lines().count(), 21, "{text}");
-        assert!(text.contains("s.xml:20:1: w20"), "{text}");
-        assert!(!text.contains("w21"), "{text}");
-        assert!(text.ends_with("5 more warnings not shown (`glint check SCENE` lists them all)\n"));
-    }
-
-    #[test]
-    fn exit_codes() {
-        assert_eq!(Failure::Usage(UsageError("x".into())).exit_code(), 2);
-        assert_eq!(Failure::Interrupted.exit_code(), 130);
-        let io = SceneError::Io {
-            path: "x.xml".into(),
-            source: std::io::Error::from(std::io::ErrorKind::NotFound),
-        };
-        assert_eq!(Failure::Scene(io).exit_code(), 2);
-    }
 }

@@ -1,0 +1,94 @@
+//! The memory a render would need, estimated before anything is allocated, against the
+//! `--max-memory` budget: a render that cannot fit is refused before it starts.
+
+use glint_render::{Background, SceneParts};
+
+use crate::failure::Failure;
+
+/// Bytes per pixel of a render: the pipeline's per-pixel values (40), the film (12), the
+/// 8-bit copy and its encoding (6), and with feature layers their film copies (28).
+pub fn film_bytes(settings: &glint_render::RenderSettings) -> u64 {
+    let per_pixel = if settings.features { 86 } else { 58 };
+    u64::from(settings.width) * u64::from(settings.height) * per_pixel
+}
+
+/// Bytes per shape of the scene and its acceleration structures: the shape (up to 40 bytes),
+/// its material, its triangle copy in the ray engine and its share of BVH nodes, with room.
+const BYTES_PER_SHAPE: u64 = 160;
+
+/// Bytes of the scene's textures and cube map, as the renderer holds them (12 a texel).
+pub fn texture_bytes(parts: &SceneParts) -> u64 {
+    let mut texels: u64 = parts
+        .textures
+        .iter()
+        .map(|texture| texture.texels.len() as u64)
+        .sum();
+    if let Background::CubeMap(map) = &parts.background {
+        texels += map
+            .faces
+            .iter()
+            .map(|face| face.texels.len() as u64)
+            .sum::<u64>();
+    }
+    texels * 12
+}
+
+/// Shapes the scene's acceleration structures hold: the geometry's, every emitting
+/// triangle and every instance.
+pub fn shape_count(parts: &SceneParts) -> u64 {
+    let shapes: u64 = parts
+        .geometries
+        .iter()
+        .map(|geometry| geometry.shapes.len() as u64)
+        .sum();
+    let light_triangles: u64 = parts
+        .lights
+        .iter()
+        .map(|light| match light {
+            glint_render::Light::Triangles { triangles, .. } => triangles.len() as u64,
+            _ => 1,
+        })
+        .sum();
+    shapes + light_triangles + parts.instances.len() as u64
+}
+
+/// Refuses a render whose estimated memory is over the budget.
+pub fn check(film: u64, textures: u64, shapes: u64, budget: u64) -> Result<(), Failure> {
+    let structures = shapes.saturating_mul(BYTES_PER_SHAPE);
+    let total = film.saturating_add(textures).saturating_add(structures);
+    if total <= budget {
+        return Ok(());
+    }
+    let bytes = glint_io::format_bytes;
+    Err(Failure::Memory(format!(
+        "the render would need about {} (image {}, textures {}, shapes and their acceleration \
+         structures {}), more than the limit of {}; render a smaller image, or raise the limit \
+         with --max-memory",
+        bytes(total),
+        bytes(film),
+        bytes(textures),
+        bytes(structures),
+        bytes(budget)
+    )))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn memory_estimates_refuse_what_does_not_fit() {
+        let huge = glint_render::RenderSettings {
+            width: 65_535,
+            height: 65_535,
+            ..glint_render::RenderSettings::default()
+        };
+        let film = film_bytes(&huge);
+        assert!(film > 200 << 30, "{film}");
+        let refused = check(film, 0, 0, 8 << 30).unwrap_err();
+        assert_eq!(refused.exit_code(), 2);
+        assert!(refused.to_string().contains("--max-memory"), "{refused}");
+        assert!(check(1 << 20, 1 << 20, 1000, 8 << 30).is_ok());
+        assert!(check(0, 0, u64::MAX, 8 << 30).is_err());
+    }
+}
