@@ -192,9 +192,9 @@ pub(crate) fn prepared(avx2: Avx2, ray: &Ray, magnitude: f32) -> Option<walk::Pr
     unsafe { walk::prepared(ray, magnitude) }
 }
 
-/// The slab test of the binary BVH (`binary::RayInverse::hits`) for eight rays against one node,
-/// the same operations lane by lane: the mask of rays that hit it within [t_min, t_max]. For
-/// the top level's packet traversal (`Bvh::traverse_packet`).
+/// The slab test of the binary BVH (`accel::binary`, `RayInverse::hits`) for eight rays
+/// against one node, the same operations lane by lane: the mask of rays that hit it within
+/// [t_min, t_max]. For the top level's packet traversal (`Bvh::traverse_packet`).
 #[inline]
 pub(crate) fn binary_node_lanes(
     avx2: Avx2,
