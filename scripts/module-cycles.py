@@ -90,7 +90,11 @@ def graph(files: dict) -> dict:
         return parts[0]
 
     def add(module: str, target: str, edges: set) -> None:
-        if target in modules and target != module and not module.startswith(target + "::"):
+        if (
+            target in modules
+            and target != module
+            and not module.startswith(target + "::")
+        ):
             edges.add(target)
 
     edges = {m: set() for m in modules}
@@ -152,7 +156,8 @@ def layer_of(module: str):
     best, best_len = None, -1
     for level, names in enumerate(LAYERS):
         for name in names:
-            if (module == name or module.startswith(name + "::")) and len(name) > best_len:
+            covers = module == name or module.startswith(name + "::")
+            if covers and len(name) > best_len:
                 best, best_len = level, len(name)
     return best
 
@@ -179,7 +184,9 @@ def main() -> int:
             for module in sorted(edges):
                 level = layer_of(module)
                 if level is None:
-                    print(f"{crate}: module {module} is in no layer (scripts/module-cycles.py)")
+                    print(
+                        f"{crate}: module {module} is in no layer (scripts/module-cycles.py)"
+                    )
                     findings += 1
                     continue
                 for target in sorted(edges[module]):
@@ -188,7 +195,9 @@ def main() -> int:
                         print(f"{crate}: upward import: {module} -> {target}")
                         findings += 1
     if findings:
-        print(f"{findings} import circles or upward imports among {total_modules} modules")
+        print(
+            f"{findings} import circles or upward imports among {total_modules} modules"
+        )
         return 1
     print(f"no import circle and no upward import among {total_modules} modules")
     return 0
