@@ -17,10 +17,12 @@
 //! `cornell_matches_mitsuba_1024spp` is the full comparison at 1024 spp, also always (about a
 //! minute on 2 cores); `--nocapture` prints the figures.
 
+mod common;
+
 use std::path::PathBuf;
 
-use glint_render::testing::compare::{judge, scaled, to_pixels, Criterion, Pixel, Reference};
-use glint_render::{IntegratorKind, RenderSettings, Scene};
+use glint_render::testing::compare::{judge, scaled, Criterion, Pixel, Reference};
+use glint_render::Scene;
 
 const SIZE: u32 = 256;
 /// σ²_r, the reference's own noise in relMSE (module docs).
@@ -39,33 +41,11 @@ fn load_cornell() -> Scene {
 }
 
 fn load_reference() -> Vec<Pixel> {
-    let path = cornell_dir().join("mitsuba_256_4096spp.exr");
-    let image = image::open(&path)
-        .unwrap_or_else(|error| panic!("{}: {error}", path.display()))
-        .into_rgb32f();
-    assert_eq!((image.width(), image.height()), (SIZE, SIZE));
-    image
-        .pixels()
-        .map(|p| [p.0[0] as f64, p.0[1] as f64, p.0[2] as f64])
-        .collect()
+    common::read_reference(&cornell_dir().join("mitsuba_256_4096spp.exr"), SIZE)
 }
 
 fn render(scene: &Scene, samples: u32, seed: u64) -> Vec<Pixel> {
-    let settings = RenderSettings {
-        width: SIZE,
-        height: SIZE,
-        samples_per_pixel: samples,
-        seed,
-        integrator: IntegratorKind::Path,
-        ..RenderSettings::default()
-    };
-    let (film, stats) = glint_render::render(scene, &settings, &|_| true).unwrap();
-    assert_eq!(
-        stats.nonfinite_samples, 0,
-        "first at {:?}",
-        stats.first_nonfinite_pixel
-    );
-    to_pixels(&film.pixels)
+    common::render_path(scene, SIZE, samples, seed)
 }
 
 fn compare_with_mitsuba(samples: u32) {

@@ -11,10 +11,12 @@
 //! Negative controls: the same renders without the lens (everything sharp) and 3% darker must
 //! both fail the same criterion, so the test sees the blur and the energy.
 
+mod common;
+
 use std::path::PathBuf;
 
-use glint_render::testing::compare::{judge, scaled, to_pixels, Criterion, Pixel, Reference};
-use glint_render::{IntegratorKind, RenderSettings, Scene, ThinLens};
+use glint_render::testing::compare::{judge, scaled, Criterion, Pixel, Reference};
+use glint_render::{Scene, ThinLens};
 
 const SIZE: u32 = 128;
 /// Must match `bench/thinlens/make_thinlens_ref.py`.
@@ -40,30 +42,15 @@ fn load_cornell(lens: bool) -> Scene {
 }
 
 fn load_reference() -> Vec<Pixel> {
-    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../bench/thinlens/mitsuba_thinlens_128_4096spp.exr");
-    let image = image::open(&path)
-        .unwrap_or_else(|error| panic!("{}: {error}", path.display()))
-        .into_rgb32f();
-    assert_eq!((image.width(), image.height()), (SIZE, SIZE));
-    image
-        .pixels()
-        .map(|p| [p.0[0] as f64, p.0[1] as f64, p.0[2] as f64])
-        .collect()
+    common::read_reference(
+        &PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+            .join("../../bench/thinlens/mitsuba_thinlens_128_4096spp.exr"),
+        SIZE,
+    )
 }
 
 fn render(scene: &Scene, samples: u32, seed: u64) -> Vec<Pixel> {
-    let settings = RenderSettings {
-        width: SIZE,
-        height: SIZE,
-        samples_per_pixel: samples,
-        seed,
-        integrator: IntegratorKind::Path,
-        ..RenderSettings::default()
-    };
-    let (film, stats) = glint_render::render(scene, &settings, &|_| true).unwrap();
-    assert_eq!(stats.nonfinite_samples, 0);
-    to_pixels(&film.pixels)
+    common::render_path(scene, SIZE, samples, seed)
 }
 
 fn compare_with_mitsuba(samples: u32) {

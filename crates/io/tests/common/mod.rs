@@ -56,3 +56,45 @@ fn collect(directory: &Path, found: &mut Vec<PathBuf>) {
         }
     }
 }
+
+/// A reference render (an EXR or any image the `image` crate reads) as linear RGB pixels in
+/// f64, row by row; it must be `size` x `size`.
+pub fn read_reference(path: &Path, size: u32) -> Vec<[f64; 3]> {
+    let image = image::open(path)
+        .unwrap_or_else(|error| panic!("{}: {error}", path.display()))
+        .into_rgb32f();
+    assert_eq!(
+        (image.width(), image.height()),
+        (size, size),
+        "{}",
+        path.display()
+    );
+    image
+        .pixels()
+        .map(|p| [p.0[0] as f64, p.0[1] as f64, p.0[2] as f64])
+        .collect()
+}
+
+/// The path tracer's `size` x `size` render of `scene`, which must have no non-finite sample.
+pub fn render_path(
+    scene: &glint_render::Scene,
+    size: u32,
+    samples: u32,
+    seed: u64,
+) -> Vec<[f64; 3]> {
+    let settings = glint_render::RenderSettings {
+        width: size,
+        height: size,
+        samples_per_pixel: samples,
+        seed,
+        integrator: glint_render::IntegratorKind::Path,
+        ..glint_render::RenderSettings::default()
+    };
+    let (film, stats) = glint_render::render(scene, &settings, &|_| true).unwrap();
+    assert_eq!(
+        stats.nonfinite_samples, 0,
+        "first at {:?}",
+        stats.first_nonfinite_pixel
+    );
+    glint_render::testing::compare::to_pixels(&film.pixels)
+}
