@@ -1,4 +1,4 @@
-//! `glint bench`: measures the ray engine on fixed workloads (issue 3, item 1).
+//! `glint bench`: measures the ray engine on fixed workloads.
 //!
 //! - `glint bench table` prints one table over the shared meshes and the course scenes: BVH
 //!   build time, memory per unique primitive, and millions of rays per second for coherent
