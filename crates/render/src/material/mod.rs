@@ -1,6 +1,7 @@
 //! Materials: the course's shaders as one closed enum.
 
 pub mod bsdf;
+pub mod scatter;
 
 use crate::math::Color;
 use crate::texture::ColorSource;
