@@ -266,6 +266,8 @@ impl FlatScene {
                 images.extend(map.faces.iter());
                 1
             }
+            // Refused by `check_supported`.
+            Background::Environment { .. } => 0,
         };
         let texture_info = tables.len() as u32;
         for image in &images {
@@ -307,7 +309,7 @@ impl FlatScene {
         let camera: &Camera = &parts.camera;
         let background = match &parts.background {
             Background::Color(c) => v4(*c, 0.0),
-            Background::CubeMap(_) => [0.0; 4],
+            Background::CubeMap(_) | Background::Environment { .. } => [0.0; 4],
         };
         let params = Params {
             width: 0,
@@ -453,7 +455,10 @@ fn material_words(parts: &SceneParts, material: &Material) -> [[f32; 4]; MATERIA
     };
     // [kind, exponent, km, roughness] and η.
     let (kind, exponent, km, roughness, eta) = match plain {
-        None | Some(Material::Emissive { .. }) => (BSDF_BLACK, 0.0, 0.0, 0.0, 1.0),
+        // Physical materials are refused by `check_supported`.
+        None | Some(Material::Emissive { .. }) | Some(Material::Physical(_)) => {
+            (BSDF_BLACK, 0.0, 0.0, 0.0, 1.0)
+        }
         Some(
             Material::Lambertian { diffuse }
             | Material::Diffuse { diffuse }
@@ -644,6 +649,8 @@ impl LightTables {
                     w[5] = v4(*intensity, 0.0);
                     triangles_area = total;
                 }
+                // Refused by `check_supported`: they stay zero words, which emit nothing.
+                Light::Spot { .. } | Light::Directional { .. } | Light::Projector { .. } => {}
             }
             words.extend_from_slice(&w);
             power.push(LightSelection::power(light, triangles_area));
@@ -657,6 +664,7 @@ impl LightTables {
                 Some((cube, integral)) => (Some(integral), Some(cube)),
                 None => (None, None),
             },
+            Background::Environment { .. } => (None, None),
         };
         let mut environment = None;
         if let Some(integral) = environment_integral {
@@ -874,6 +882,7 @@ mod tests {
         });
         let count = shapes.len();
         SceneParts {
+            physical: Default::default(),
             camera: Camera::new(Projection::Perspective, Vec3::ZERO, -Vec3::Z, 1.0, 1.0),
             materials: vec![],
             textures: vec![],

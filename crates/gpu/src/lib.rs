@@ -74,6 +74,9 @@ pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<
             "depth of field (-d): the GPU camera is a pinhole".to_owned(),
         ));
     }
+    if let Some(name) = unsupported_feature(parts) {
+        return Err(GpuError::Unsupported(name));
+    }
     if settings.integrator != IntegratorKind::Path {
         return Err(GpuError::Unsupported(format!(
             "the {} integrator (only --integrator path runs on the GPU)",
@@ -81,6 +84,70 @@ pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<
         )));
     }
     settings.validate().map_err(GpuError::Invalid)
+}
+
+/// The first thing in `parts` that the kernel cannot render, named as the scene names it:
+/// the physically based materials, lights and environment maps of Mitsuba scenes.
+fn unsupported_feature(parts: &SceneParts) -> Option<String> {
+    use glint_render::{Background, BsdfNode, Light, Material};
+    for material in &parts.materials {
+        if let Material::Physical(index) = material {
+            let name = match parts.physical.bsdfs.get(*index as usize) {
+                Some(node) => bsdf_name(node),
+                None => "a physically based material",
+            };
+            return Some(format!(
+                "the {name} material (the GPU kernel has the course's materials only)"
+            ));
+        }
+    }
+    for light in &parts.lights {
+        let name = match light {
+            Light::Spot { .. } => "spot",
+            Light::Directional { .. } => "directional",
+            Light::Projector { .. } => "projector",
+            _ => continue,
+        };
+        return Some(format!(
+            "the {name} emitter (the GPU kernel has the course's lights only)"
+        ));
+    }
+    if let Background::Environment { .. } = parts.background {
+        return Some("the envmap emitter (the GPU kernel has cube maps only)".to_owned());
+    }
+    if parts.physical.defaults.filter != glint_render::PixelFilter::Box {
+        return Some(
+            "a tent or gaussian reconstruction filter (the GPU takes box-filtered samples)"
+                .to_owned(),
+        );
+    }
+    fn bsdf_name(node: &BsdfNode) -> &'static str {
+        match node {
+            BsdfNode::Diffuse { .. } => "diffuse",
+            BsdfNode::Conductor {
+                roughness: None, ..
+            } => "conductor",
+            BsdfNode::Conductor { .. } => "roughconductor",
+            BsdfNode::Dielectric {
+                roughness: None, ..
+            } => "dielectric",
+            BsdfNode::Dielectric { .. } => "roughdielectric",
+            BsdfNode::ThinDielectric { .. } => "thindielectric",
+            BsdfNode::Plastic {
+                roughness: None, ..
+            } => "plastic",
+            BsdfNode::Plastic { .. } => "roughplastic",
+            BsdfNode::Principled(_) => "principled",
+            BsdfNode::PrincipledThin(_) => "principledthin",
+            BsdfNode::TwoSided { .. } => "twosided",
+            BsdfNode::NormalMap { .. } => "normalmap",
+            BsdfNode::BumpMap { .. } => "bumpmap",
+            BsdfNode::Mask { .. } => "mask",
+            BsdfNode::Blend { .. } => "blendbsdf",
+            BsdfNode::Null => "null",
+        }
+    }
+    None
 }
 
 /// How many path samples one dispatch traces at most (over the whole image): small enough

@@ -167,6 +167,7 @@ fn shader_scene() -> SceneParts {
         radius: 0.5,
     };
     SceneParts {
+        physical: Default::default(),
         camera: Camera::new(
             Projection::Orthographic,
             Vec3::new(0.0, 2.0, 4.0),
@@ -424,6 +425,7 @@ fn feature_scene() -> SceneParts {
         },
     ];
     SceneParts {
+        physical: Default::default(),
         camera: Camera::new(
             Projection::Perspective,
             Vec3::new(0.0, 1.3, 4.0),

@@ -977,6 +977,7 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             );
         }
         SceneParts {
+            physical: Default::default(),
             camera,
             materials: self.materials,
             textures: self.textures,

@@ -120,6 +120,18 @@ pub fn scene_hash(parts: &SceneParts) -> String {
                 hasher.image(face);
             }
         }
+        Background::Environment {
+            image,
+            scale,
+            to_world,
+        } => {
+            hasher.text("background", &("envmap", scale, to_world));
+            hasher.image(image);
+        }
+    }
+    // Course scenes have no physical parts, and keep the digests earlier builds wrote.
+    if parts.physical != glint_render::PhysicalParts::default() {
+        hasher.text("physical", &parts.physical);
     }
     for geometry in &parts.geometries {
         hasher.ids("geometry", &geometry.materials, geometry.shapes.len());
@@ -150,6 +162,7 @@ mod tests {
 
     fn parts(radius: f32, texel: f32) -> SceneParts {
         SceneParts {
+            physical: Default::default(),
             camera: Camera::new(Projection::Perspective, Vec3::Z, -Vec3::Z, 1.0, 1.0),
             materials: vec![Material::Lambertian {
                 diffuse: Color::splat(0.5).into(),

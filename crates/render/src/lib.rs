@@ -82,11 +82,20 @@ pub use geometry::{Aabb, Shape};
 pub use light::sampler::CubeDistribution;
 pub use light::sampler::LightSelection;
 pub use light::Light;
+pub use material::physical::{
+    BsdfId, BsdfNode, DistributionKind, Param, PrincipledParams, Roughness,
+};
 pub use material::{Material, MaterialId};
 pub use math::{Color, Matrix4, Transform, Vec3};
 pub use ray::Ray;
+pub use scene::physical::{
+    MeshAttributes, PhysicalParts, PixelFilter, RenderDefaults, SceneIntegrator,
+};
 pub use scene::{Background, BvhStats, GeometryDesc, Instance, Scene, SceneOptions, SceneParts};
-pub use texture::{ColorSource, CubeMap, Image, TextureId};
+pub use texture::{
+    ColorSource, CubeMap, Image, MeshAttribute, TexelFilter, TextureId, TextureKind, TextureNode,
+    Wrap, IDENTITY_UV,
+};
 
 // Rendering it.
 pub use film::{Features, Film, SampleSums};

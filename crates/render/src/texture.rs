@@ -323,3 +323,56 @@ mod tests {
         image.square(2, 0, 3, false);
     }
 }
+
+/// How a bitmap texture is read between texels (Mitsuba's `filter_type`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexelFilter {
+    Nearest,
+    Bilinear,
+}
+
+/// What a bitmap texture does outside [0, 1]² (Mitsuba's `wrap_mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    Repeat,
+    Mirror,
+    Clamp,
+}
+
+/// A per-vertex or per-face attribute of a mesh that a `mesh_attribute` texture reads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshAttribute {
+    /// Interpolated with the barycentrics (`vertex_color`).
+    VertexColor,
+    /// Constant over each triangle (`face_color`).
+    FaceColor,
+}
+
+/// One texture of a physically based scene (Mitsuba's `bitmap`, `checkerboard`,
+/// `mesh_attribute`), read at the texture coordinates `to_uv` · uv.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TextureNode {
+    pub kind: TextureKind,
+    /// The 2 x 3 affine map applied to the surface's uv first (Mitsuba's `to_uv`), rows
+    /// (a, b, c) and (d, e, f): u' = a u + b v + c, v' = d u + e v + f.
+    pub to_uv: [[f32; 3]; 2],
+}
+
+/// What a `TextureNode` reads.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TextureKind {
+    /// `SceneParts::textures[image]`, already linear unless the scene asked for `raw` data.
+    /// Row 0 of the image is at v = 1 (Mitsuba's convention after its OBJ reader's flip).
+    Bitmap {
+        image: TextureId,
+        filter: TexelFilter,
+        wrap: Wrap,
+    },
+    /// Alternating squares of `color0` and `color1`, each 1/2 on a side in uv.
+    Checkerboard { color0: Color, color1: Color },
+    /// A mesh's own per-vertex or per-face colour; black on shapes without it.
+    MeshAttribute(MeshAttribute),
+}
+
+/// The identity `to_uv`.
+pub const IDENTITY_UV: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];

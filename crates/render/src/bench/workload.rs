@@ -159,6 +159,7 @@ pub fn mesh_scene_parts(geometry: crate::scene::GeometryDesc) -> crate::scene::S
         framing_camera(bounds)
     };
     SceneParts {
+        physical: Default::default(),
         camera,
         materials: vec![Material::Lambertian {
             diffuse: ColorSource::constant(Vec3::splat(0.5)),

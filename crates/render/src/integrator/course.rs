@@ -403,7 +403,12 @@ fn shade(
     } else {
         si.normal
     };
-    match Material::get(&scene.materials, si.material) {
+    let material = match Material::get(&scene.materials, si.material) {
+        // The course's shading knows no physically based material: the fallback grey.
+        Material::Physical(_) => &crate::material::FALLBACK_MATERIAL,
+        other => other,
+    };
+    match material {
         Material::Lambertian { diffuse } => {
             let kd = diffuse.resolve(&scene.textures, si.uv);
             direct(scene, &si, ctx, ahead, |l| kd * n.dot(l).max(0.0))
@@ -480,6 +485,8 @@ fn shade(
             let kd = diffuse.resolve(&scene.textures, si.uv);
             diffuse_surface(scene, &si, n, kd, depth, ctx)
         }
+        // Replaced by the fallback above.
+        Material::Physical(_) => Color::ZERO,
         Material::Emissive {
             radiance, light, ..
         } => {
@@ -742,6 +749,10 @@ fn cool_to_warm(scene: &Scene, si: &SurfaceInteraction, n: Vec3, kd: Color) -> C
             Light::Triangles { triangles, .. } => triangles
                 .first()
                 .map_or(si.point, |t| (t[0] + t[1] + t[2]) / 3.0),
+            Light::Spot { to_world, .. } | Light::Projector { to_world, .. } => {
+                to_world.point_to_world(Vec3::ZERO)
+            }
+            Light::Directional { direction, .. } => si.point - *direction,
         };
         let l = (position - si.point).normalized();
         let kw = 0.5 * (1.0 + n.dot(l));

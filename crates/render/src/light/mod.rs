@@ -2,7 +2,7 @@
 
 pub mod sampler;
 
-use crate::math::{Color, Frame, Vec3};
+use crate::math::{Color, Frame, Transform, Vec3};
 
 /// A light source. Emitters that are also visible geometry (shape lights, visible area lights)
 /// additionally appear in the scene as shapes with `Material::Emissive`.
@@ -32,6 +32,29 @@ pub enum Light {
         triangles: Vec<[Vec3; 3]>,
         intensity: Color,
     },
+    /// Mitsuba's `spot`: at the origin of `to_world` (a rigid transform), shining along its
+    /// +z; full `intensity` inside `beam_width`, falling off smoothly to zero at
+    /// `cutoff_angle` (both in degrees, half-angles), optionally modulated by a texture
+    /// (`PhysicalParts::textures`) over the cone.
+    Spot {
+        to_world: Transform,
+        intensity: Color,
+        cutoff_angle: f32,
+        beam_width: f32,
+        texture: Option<u32>,
+    },
+    /// Mitsuba's `directional`: light arriving from infinitely far along `direction` (unit,
+    /// the way the light travels) with `irradiance` on a surface facing it.
+    Directional { direction: Vec3, irradiance: Color },
+    /// Mitsuba's `projector`: a texture projected from the origin of `to_world` along its
+    /// +z through a pinhole of horizontal field of view `fov` (degrees), its `irradiance`
+    /// (a texture of `PhysicalParts::textures`) times `scale` at unit distance.
+    Projector {
+        to_world: Transform,
+        irradiance: u32,
+        scale: f32,
+        fov: f32,
+    },
 }
 
 impl Light {
@@ -46,7 +69,10 @@ impl Light {
             Light::Point { intensity, .. }
             | Light::Area { intensity, .. }
             | Light::Sphere { intensity, .. }
-            | Light::Triangles { intensity, .. } => *intensity,
+            | Light::Triangles { intensity, .. }
+            | Light::Spot { intensity, .. } => *intensity,
+            Light::Directional { irradiance, .. } => *irradiance,
+            Light::Projector { scale, .. } => Color::splat(*scale),
         }
     }
 }

@@ -83,6 +83,18 @@ pub(crate) fn course_light_point(
             normal: None,
             pdf_area: 1.0,
         },
+        // Mitsuba's lights have no course counterpart: the course integrator treats them as
+        // points at their origin (a directional light as a point far against its direction).
+        Light::Spot { to_world, .. } | Light::Projector { to_world, .. } => LightPoint {
+            position: to_world.point_to_world(Vec3::ZERO),
+            normal: None,
+            pdf_area: 1.0,
+        },
+        Light::Directional { direction, .. } => LightPoint {
+            position: p - *direction * 1.0e6,
+            normal: None,
+            pdf_area: 1.0,
+        },
         Light::Area {
             position,
             normal,
@@ -296,6 +308,17 @@ impl LightSampler {
                         radiance: *intensity,
                     }
                 }
+                // TODO(emitters): sampled as Mitsuba does; until then they emit nothing.
+                Light::Spot { to_world, .. } | Light::Projector { to_world, .. } => {
+                    PreparedLight::Point {
+                        position: to_world.point_to_world(Vec3::ZERO),
+                        intensity: Color::ZERO,
+                    }
+                }
+                Light::Directional { .. } => PreparedLight::Point {
+                    position: Vec3::ZERO,
+                    intensity: Color::ZERO,
+                },
             };
             lights.push(prepared);
             power.push(LightSelection::power(light, triangles_area));
@@ -722,6 +745,8 @@ impl LightSelection {
     pub fn power(light: &Light, triangles_area: f64) -> f32 {
         let phi = match light {
             Light::Point { intensity, .. } => 4.0 * PI * mean(*intensity),
+            // TODO(emitters): their power.
+            Light::Spot { .. } | Light::Directional { .. } | Light::Projector { .. } => 0.0,
             Light::Area {
                 normal,
                 width,
@@ -920,6 +945,8 @@ impl EnvironmentDistribution {
                     cube: Some(cube),
                 })
             }
+            // TODO(emitters): importance-sampled by luminance.
+            Background::Environment { .. } => None,
         }
     }
 

@@ -265,6 +265,9 @@ impl Bsdf {
                 Bsdf::new(&[(Lobe::Dielectric { eta }, Color::ONE)])
             }
             Material::Emissive { .. } => Bsdf::BLACK,
+            // The path tracer builds physically based BSDFs itself (`scatter.rs`); the course's
+            // lobes cannot express them.
+            Material::Physical(_) => Bsdf::BLACK,
         }
     }
 

@@ -1,6 +1,7 @@
 //! Materials: the course's shaders as one closed enum.
 
 pub mod bsdf;
+pub mod physical;
 pub mod scatter;
 
 use crate::math::Color;
@@ -70,6 +71,9 @@ pub enum Material {
         surface: Option<MaterialId>,
         light: Option<u32>,
     },
+    /// A physically based material (a Mitsuba BSDF tree): `PhysicalParts::bsdfs[i]`. Only the
+    /// path tracer renders it; the course integrator shows it as the fallback grey.
+    Physical(u32),
 }
 
 impl Material {
@@ -108,6 +112,8 @@ impl Material {
             Material::Mirror { .. } | Material::Dielectric { .. } | Material::Emissive { .. } => {
                 false
             }
+            // Its textures are the physical parts' own; the path tracer resolves them.
+            Material::Physical(_) => true,
         }
     }
 

@@ -13,11 +13,15 @@ use crate::camera::Camera;
 use crate::geometry::{Aabb, PrimitiveHit};
 use crate::light::Light;
 use crate::material::{Material, MaterialId};
-use crate::math::{Color, Vec3};
+use crate::math::{Color, Transform, Vec3};
 use crate::ray::Ray;
 use crate::texture::{CubeMap, Image};
 
 pub use crate::accel::instances::{GeometryDesc, Instance};
+
+pub mod physical;
+
+use physical::PhysicalParts;
 
 /// What rays that leave the scene see.
 #[derive(Clone, Debug, PartialEq)]
@@ -26,6 +30,14 @@ pub enum Background {
     Color(Color),
     /// An environment cube map (`envMapPrefix`, or `envMapVertCross` cut into faces).
     CubeMap(Box<CubeMap>),
+    /// Mitsuba's `envmap`: a latitude-longitude image times `scale`, turned by `to_world`
+    /// (a rotation). In the map's own frame +y is up, and u = 0.5 looks along +z... as
+    /// Mitsuba's `envmap` maps directions to the image.
+    Environment {
+        image: Box<Image>,
+        scale: f32,
+        to_world: Transform,
+    },
 }
 
 /// Everything the loader hands the renderer: plain data, already validated.
@@ -38,6 +50,8 @@ pub struct SceneParts {
     pub background: Background,
     pub geometries: Vec<GeometryDesc>,
     pub instances: Vec<Instance>,
+    /// What Mitsuba scenes and glTF models add; empty for the course's.
+    pub physical: PhysicalParts,
 }
 
 /// How `Scene::with_options` builds the acceleration structures.
@@ -77,6 +91,9 @@ pub struct Scene {
     pub textures: Vec<Image>,
     pub lights: Vec<Light>,
     pub background: Background,
+    /// BSDF trees, textures and the scene's render defaults (mesh attributes are moved into
+    /// the acceleration structure's geometries).
+    pub physical: PhysicalParts,
     pub(crate) accel: Instances,
     split: SplitMethod,
     build_time: Duration,
@@ -166,6 +183,7 @@ impl Scene {
             background,
             geometries,
             instances,
+            physical,
         } = parts;
         let start = Instant::now();
         let accel = Instances::build(geometries, instances, accel, split);
@@ -175,6 +193,7 @@ impl Scene {
             textures,
             lights,
             background,
+            physical,
             accel,
             split,
             build_time: start.elapsed(),
@@ -313,6 +332,8 @@ impl Scene {
         match &self.background {
             Background::Color(c) => *c,
             Background::CubeMap(map) => map.lookup(direction),
+            // Filled in with the environment's sampling (light/sampler.rs).
+            Background::Environment { .. } => Color::ZERO,
         }
     }
 }

@@ -1004,6 +1004,7 @@ fn scene_with(lights: Vec<Light>, background: Background) -> Scene {
     // The light sampler reads only lights, materials and background; one far sphere keeps the
     // acceleration structure non-empty.
     Scene::new(SceneParts {
+        physical: Default::default(),
         camera: Camera::new(Projection::Perspective, Vec3::ZERO, -Vec3::Z, 1.0, 1.0),
         materials: vec![Material::Diffuse {
             diffuse: Color::splat(0.5).into(),

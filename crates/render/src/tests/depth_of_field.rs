@@ -82,6 +82,7 @@ fn checkerboard(distance: f32, lens: Option<ThinLens>) -> Scene {
         diffuse: Color::splat(c).into(),
     };
     Scene::new(SceneParts {
+        physical: Default::default(),
         camera,
         materials: vec![lambertian(0.9), lambertian(0.1)],
         textures: vec![],

@@ -112,6 +112,7 @@ fn any_camera() -> Camera {
 
 fn scene_from(geometries: Vec<GeometryDesc>, instances: Vec<Instance>) -> Scene {
     Scene::new(SceneParts {
+        physical: Default::default(),
         camera: any_camera(),
         materials: vec![Material::fallback()],
         textures: vec![],

@@ -34,6 +34,7 @@ fn camera_looking_at_origin(distance: f32) -> Camera {
 /// A unit sphere of `material` at the origin inside a uniform environment of radiance 1.
 fn furnace(material: Material) -> Scene {
     Scene::new(SceneParts {
+        physical: Default::default(),
         camera: camera_looking_at_origin(3.0),
         materials: vec![material],
         textures: vec![],
@@ -164,6 +165,7 @@ fn floor_furnace(material: Material) -> (f64, f64) {
         corner(-10.0, 10.0),
     );
     let scene = Scene::new(SceneParts {
+        physical: Default::default(),
         camera: Camera::new(
             Projection::Orthographic,
             Vec3::new(0.0, 0.0, 3.0),
@@ -301,6 +303,7 @@ fn point_light_direct_lighting_is_exact() {
     let light_position = Vec3::new(0.3, 0.2, 1.5);
     let (geometry, material) = floor(albedo);
     let scene = Scene::new(SceneParts {
+        physical: Default::default(),
         camera: camera_looking_at_origin(3.0),
         materials: vec![material],
         textures: vec![],
@@ -353,6 +356,7 @@ fn floor_under(light: Light, emitter_shapes: Vec<Shape>, casts_shadow: bool) -> 
     let radiance = light.intensity();
     let emitter_count = emitter_shapes.len();
     Scene::new(SceneParts {
+        physical: Default::default(),
         camera: camera_looking_at_origin(3.0),
         materials: vec![
             material,
@@ -545,6 +549,7 @@ fn denoiser_features() {
     // escapes. The floor's edge is out of view.
     let (geometry, _) = floor(0.5);
     let scene = Scene::new(SceneParts {
+        physical: Default::default(),
         camera: Camera::new(
             Projection::Perspective,
             Vec3::new(0.0, 0.0, 2.0),

@@ -137,6 +137,7 @@ fn every_feature_scene() -> Scene {
         Vec3::new(0.0, 1.5, 0.5),
     ];
     Scene::new(SceneParts {
+        physical: Default::default(),
         camera: Camera::new(
             Projection::Perspective,
             Vec3::new(0.0, 0.5, 4.0),

@@ -49,6 +49,7 @@ fn scene(instances: usize, accel: AccelKind) -> Scene {
     };
     Scene::with_accel(
         SceneParts {
+            physical: Default::default(),
             camera: Camera::new(Projection::Perspective, Vec3::Z * 4.0, -Vec3::Z, 1.0, 1.0),
             materials: vec![],
             textures: vec![],
@@ -156,6 +157,7 @@ fn textured_scene(materials: Vec<Material>, textures: Vec<Image>, material: u32)
         Vec3::new(-4.0, 4.0, 0.0),
     );
     Scene::new(SceneParts {
+        physical: Default::default(),
         camera: Camera::new(Projection::Perspective, Vec3::Z * 3.0, -Vec3::Z, 1.0, 1.0),
         materials,
         textures,

@@ -11,6 +11,7 @@ use crate::{
 /// A red Lambertian sphere on a grey floor, a point light, a grey background.
 fn scene(sphere: Material) -> Scene {
     Scene::new(SceneParts {
+        physical: Default::default(),
         camera: Camera::new(
             Projection::Perspective,
             Vec3::new(0.0, 0.5, 4.0),

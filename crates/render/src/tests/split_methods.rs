@@ -200,6 +200,7 @@ fn the_build_phases_shown_are_the_largest_trees() {
         }
     };
     let scene = Scene::new(SceneParts {
+        physical: Default::default(),
         camera: Camera::new(Projection::Perspective, Vec3::Z, -Vec3::Z, 1.0, 1.0),
         materials: vec![Material::Lambertian {
             diffuse: ColorSource::constant(Vec3::splat(0.5)),
