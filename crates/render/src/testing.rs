@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 pub mod compare;
+pub mod mitsuba_rule;
 
 use crate::accel::binary::Bvh;
 use crate::accel::triangle::{self, WoopRay};

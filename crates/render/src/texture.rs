@@ -421,6 +421,53 @@ impl TextureNode {
     }
 }
 
+impl TextureNode {
+    /// The gradient of the texture's luminance with respect to the surface's (u, v), as
+    /// Mitsuba's `eval_1_grad`: that of the bilinear interpolant for a bilinear bitmap,
+    /// through `to_uv`; zero for nearest lookups and the other kinds (piecewise constant).
+    pub fn gradient(&self, images: &[Image], at: &TexturePoint) -> (f32, f32) {
+        let TextureKind::Bitmap {
+            image,
+            filter: TexelFilter::Bilinear,
+            wrap,
+        } = &self.kind
+        else {
+            return (0.0, 0.0);
+        };
+        let Some(image) = images.get(*image as usize).filter(|i| !i.texels.is_empty()) else {
+            return (0.0, 0.0);
+        };
+        let [[a, b, c], [d, e, f]] = self.to_uv;
+        let (u0, v0) = at.uv;
+        let (u, v) = (a * u0 + b * v0 + c, d * u0 + e * v0 + f);
+        let (w, h) = (image.width, image.height);
+        let limit = 1.0e9;
+        let x = (u * w as f32).clamp(-limit, limit) - 0.5;
+        let y = (v * h as f32).clamp(-limit, limit) - 0.5;
+        if !(x.is_finite() && y.is_finite()) {
+            return (0.0, 0.0);
+        }
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        let lum = |x: i64, y: i64| {
+            let (x, y) = (wrap_texel(x, w, *wrap), wrap_texel(y, h, *wrap));
+            image.texels[(y as usize) * (w as usize) + x as usize].luminance()
+        };
+        let (f00, f10, f01, f11) = (
+            lum(x0, y0),
+            lum(x0 + 1, y0),
+            lum(x0, y0 + 1),
+            lum(x0 + 1, y0 + 1),
+        );
+        // Per texel along x and y, then per unit of the transformed uv, then through the
+        // transpose of `to_uv`'s linear part.
+        let dfx = ((1.0 - fy) * (f10 - f00) + fy * (f11 - f01)) * w as f32;
+        let dfy = ((1.0 - fx) * (f01 - f00) + fx * (f11 - f10)) * h as f32;
+        (a * dfx + d * dfy, b * dfx + e * dfy)
+    }
+}
+
 /// Texel coordinate `x` of an axis of `size` texels, brought inside by `wrap`.
 #[inline]
 fn wrap_texel(x: i64, size: u32, wrap: Wrap) -> u32 {

@@ -283,8 +283,8 @@ impl Geometry {
         }
     }
 
-    #[cfg(feature = "bench")]
-    fn source_index(&self, primitive: u32) -> u32 {
+    /// The index in `GeometryDesc::shapes` of the shape in slot `primitive`.
+    pub(crate) fn source_index(&self, primitive: u32) -> u32 {
         match &self.blas {
             Blas::Wide(bvh) => bvh.source_index(primitive),
             Blas::Binary { source, .. } => source[primitive as usize],

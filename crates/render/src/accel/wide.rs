@@ -220,7 +220,6 @@ impl WideBvh {
         self.isa = isa;
     }
     /// The index in the geometry as given of primitive `primitive`.
-    #[cfg(any(test, feature = "bench"))]
     pub fn source_index(&self, primitive: u32) -> u32 {
         self.source[primitive as usize]
     }

@@ -10,18 +10,19 @@ use crate::accel::instances::{AccelKind, AccelStats, Geometry, Hit, Instances, P
 use crate::accel::wide::WalkCounts;
 use crate::accel::PACKET;
 use crate::camera::Camera;
+use crate::geometry::Shape;
 use crate::geometry::{Aabb, PrimitiveHit};
 use crate::light::Light;
 use crate::material::{Material, MaterialId};
 use crate::math::{Color, Transform, Vec3};
 use crate::ray::Ray;
-use crate::texture::{CubeMap, Image};
+use crate::texture::{CubeMap, Image, TexturePoint};
 
 pub use crate::accel::instances::{GeometryDesc, Instance};
 
 pub mod physical;
 
-use physical::PhysicalParts;
+use physical::{PhysicalParts, PhysicalSurface};
 
 /// What rays that leave the scene see.
 #[derive(Clone, Debug, PartialEq)]
@@ -327,6 +328,130 @@ impl Scene {
         }
     }
 
+    /// Shading data of a hit as Mitsuba computes it for its BSDFs: texture coordinates from the
+    /// mesh's own (or the barycentrics), the interpolated shading normal, ∂p/∂u and ∂p/∂v, and
+    /// the mesh's colours, all from `physical.attributes`.
+    pub fn physical_surface(&self, ray: &Ray, hit: &impl AnyHit) -> PhysicalSurface {
+        let prelim = hit.preliminary();
+        let inst = &self.accel.instances[prelim.instance as usize];
+        let geom = &self.accel.geometries[inst.geometry as usize];
+        let point = ray.at(prelim.t);
+        let local_point = match &inst.transform {
+            Some(xf) => xf.point_to_object(point),
+            None => point,
+        };
+        let normal = normal_at(inst, geom, prelim.primitive, local_point);
+        let attributes = self
+            .physical
+            .attributes
+            .get(inst.geometry as usize)
+            .and_then(Option::as_ref);
+        let shape = geom.shape(prelim.primitive);
+        let mut texture = TexturePoint::default();
+        // Object-space derivatives and shading normal; None: the geometric normal.
+        let (dp_du, dp_dv, shading) = match shape {
+            Shape::Triangle {
+                vertices: [p0, p1, p2],
+            } => {
+                let (b1, b2) = hit
+                    .barycentrics()
+                    .unwrap_or_else(|| self.accel.barycentrics(ray, &prelim));
+                let b0 = 1.0 - b1 - b2;
+                let source = geom.source_index(prelim.primitive) as usize;
+                let corner = |v: Option<&Vec<[Vec3; 3]>>| {
+                    v.and_then(|v| v.get(source))
+                        .map(|[a, b, c]| *a * b0 + *b * b1 + *c * b2)
+                };
+                let (e1, e2) = (p1 - p0, p2 - p0);
+                let mut derivatives = (e1, e2);
+                texture.uv = (b1, b2);
+                if let Some([uv0, uv1, uv2]) = attributes
+                    .and_then(|a| a.uvs.as_ref())
+                    .and_then(|uvs| uvs.get(source))
+                {
+                    texture.uv = (
+                        uv0.0 * b0 + uv1.0 * b1 + uv2.0 * b2,
+                        uv0.1 * b0 + uv1.1 * b1 + uv2.1 * b2,
+                    );
+                    let (du0, dv0) = (uv1.0 - uv0.0, uv1.1 - uv0.1);
+                    let (du1, dv1) = (uv2.0 - uv0.0, uv2.1 - uv0.1);
+                    let det = du0 * dv1 - dv0 * du1;
+                    derivatives = if det != 0.0 {
+                        let inv = 1.0 / det;
+                        ((e1 * dv1 - e2 * dv0) * inv, (e2 * du0 - e1 * du1) * inv)
+                    } else {
+                        // A degenerate parameterisation: any tangent basis.
+                        let frame = crate::math::Frame::from_normal(
+                            geom.shape(prelim.primitive)
+                                .normal(local_point, &unused_hit()),
+                        );
+                        (frame.u, frame.v)
+                    };
+                }
+                if let Some(a) = attributes {
+                    texture.vertex_color = corner(a.vertex_colors.as_ref()).unwrap_or(Color::ZERO);
+                    texture.face_color = a
+                        .face_colors
+                        .as_ref()
+                        .and_then(|c| c.get(source))
+                        .copied()
+                        .unwrap_or(Color::ZERO);
+                }
+                let shading = corner(attributes.and_then(|a| a.normals.as_ref()));
+                (derivatives.0, derivatives.1, shading)
+            }
+            Shape::Sphere { center, radius } if attributes.is_some_and(|a| a.mitsuba_sphere_uv) => {
+                // Mitsuba's sphere: u the azimuth around +z from +x, v the polar angle from +z.
+                let d = (local_point - center) / radius;
+                let cos_theta = d.z.clamp(-1.0, 1.0);
+                let theta = cos_theta.acos();
+                let mut phi = d.y.atan2(d.x);
+                if phi < 0.0 {
+                    phi += std::f32::consts::TAU;
+                }
+                texture.uv = (
+                    phi * (0.5 * std::f32::consts::FRAC_1_PI),
+                    theta * std::f32::consts::FRAC_1_PI,
+                );
+                let (sin_phi, cos_phi) = phi.sin_cos();
+                let dp_du = Vec3::new(-d.y, d.x, 0.0) * (std::f32::consts::TAU * radius);
+                let dp_dv = Vec3::new(
+                    d.z * cos_phi,
+                    d.z * sin_phi,
+                    -(1.0 - cos_theta * cos_theta).max(0.0).sqrt(),
+                ) * (std::f32::consts::PI * radius);
+                (dp_du, dp_dv, None)
+            }
+            other => {
+                let needs = SurfaceNeeds::Uv;
+                texture.uv = self.surface(ray, hit, needs).uv;
+                let frame =
+                    crate::math::Frame::from_normal(other.normal(local_point, &unused_hit()));
+                (frame.u, frame.v, None)
+            }
+        };
+        let (dp_du, dp_dv, shading_normal) = match &inst.transform {
+            Some(xf) => (
+                xf.vector_to_world(dp_du),
+                xf.vector_to_world(dp_dv),
+                shading.map(|n| xf.normal_to_world(n)),
+            ),
+            None => (dp_du, dp_dv, shading),
+        };
+        let shading_normal = shading_normal
+            .map(Vec3::normalized)
+            .filter(|n| n.is_finite() && *n != Vec3::ZERO)
+            .unwrap_or(normal);
+        PhysicalSurface {
+            point,
+            normal,
+            frame: PhysicalSurface::shading_frame(shading_normal, dp_du),
+            dp_du,
+            dp_dv,
+            texture,
+        }
+    }
+
     /// Radiance seen along a direction that leaves the scene.
     pub fn background_radiance(&self, direction: Vec3) -> Color {
         match &self.background {
@@ -335,6 +460,15 @@ impl Scene {
             // Filled in with the environment's sampling (light/sampler.rs).
             Background::Environment { .. } => Color::ZERO,
         }
+    }
+}
+
+/// A hit whose t and barycentrics are not read (spheres' and boxes' normals ignore them).
+fn unused_hit() -> PrimitiveHit {
+    PrimitiveHit {
+        t: 0.0,
+        b1: 0.0,
+        b2: 0.0,
     }
 }
 
