@@ -130,7 +130,7 @@ mod tests {
         // Per-sample variance of XYZ-independent RGB noise; the rule converts it to XYZ as
         // Mitsuba does (a linear map of variances), so the noise is drawn in XYZ terms: small
         // enough that the RGB noise's XYZ variance stays below the converted variance.
-        let variance: Vec<Pixel> = reference.iter().map(|p| p.map(|v| 0.5 * v)).collect();
+        let variance: Vec<Pixel> = reference.iter().map(|p| p.map(|v| 0.01 * v)).collect();
         let gauss = |rng: &mut Rng| {
             let (u1, u2) = (rng.next_f32().max(1e-7) as f64, rng.next_f32() as f64);
             (-2.0 * u1.ln()).sqrt() * (std::f64::consts::TAU * u2).cos()
