@@ -336,7 +336,7 @@ fn render_on_current_pool(
         IntegratorKind::Path => render_with(
             scene,
             settings,
-            &PathIntegrator::new(scene, PathSettings::with_max_depth(settings.max_depth())),
+            &PathIntegrator::new(scene, PathSettings::for_scene(scene, settings.max_depth())),
             progress,
         ),
         IntegratorKind::Normals => render_with(

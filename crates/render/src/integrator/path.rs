@@ -24,13 +24,17 @@ use std::ops::Range;
 use crate::accel::instances::PreliminaryHit;
 use crate::accel::PACKET;
 use crate::integrator::{camera_ray_packets, FirstHit, Integrator, PixelContext, Sample};
+use crate::light::sampler::LightSample;
 use crate::light::sampler::LightSampler;
 use crate::material::bsdf::Bsdf;
+use crate::material::physical::BsdfId;
+use crate::material::surface::SurfaceBsdf;
 use crate::material::{Material, MaterialId};
 use crate::math::Color;
 use crate::math::Frame;
 use crate::ray::Ray;
 use crate::sampling::sobol::{PathSampler, SobolPixel};
+use crate::scene::physical::PixelFilter;
 use crate::scene::{AnyHit, Scene, SurfaceNeeds};
 
 /// Path-length controls of the path tracer.
@@ -43,6 +47,9 @@ pub struct PathSettings {
     pub max_depth: u32,
     /// Russian roulette starts once a path has this many bounces (Mitsuba 3's `rr_depth`).
     pub russian_roulette_depth: u32,
+    /// Camera rays pass through emitters and see no environment (Mitsuba's
+    /// `hide_emitters`).
+    pub hide_emitters: bool,
 }
 
 /// The path tracer's depth cap when `-k` is not given.
@@ -53,6 +60,7 @@ impl Default for PathSettings {
         PathSettings {
             max_depth: DEFAULT_MAX_DEPTH,
             russian_roulette_depth: 5,
+            hide_emitters: false,
         }
     }
 }
@@ -65,6 +73,20 @@ impl PathSettings {
             ..PathSettings::default()
         }
     }
+
+    /// `with_max_depth`, with what the scene file asks of the path tracer (Russian
+    /// roulette's start, hidden emitters).
+    pub fn for_scene(scene: &Scene, max_depth: u32) -> PathSettings {
+        let defaults = &scene.physical.defaults;
+        let plain = PathSettings::with_max_depth(max_depth);
+        PathSettings {
+            russian_roulette_depth: defaults
+                .russian_roulette_depth
+                .unwrap_or(plain.russian_roulette_depth),
+            hide_emitters: defaults.hide_emitters,
+            ..plain
+        }
+    }
 }
 
 /// The path tracer with its per-render preprocessing (light selection by power, triangle and
@@ -75,6 +97,8 @@ pub struct PathIntegrator {
     settings: PathSettings,
     /// By material id, then one more entry for ids out of range (the fallback material).
     materials: Vec<PreparedMaterial>,
+    /// Where a sample lands in its pixel: the scene's reconstruction filter.
+    filter: FilterSampler,
 }
 
 /// What the path tracer needs of one material at every hit, worked out once per render so
@@ -87,6 +111,9 @@ struct PreparedMaterial {
     emitter: Emitter,
     /// A dielectric's attenuation per unit distance (Beer's law for segments inside it).
     attenuation: Option<Color>,
+    /// The physically based BSDF tree that scatters here (built per hit: `SurfaceBsdf`);
+    /// `bsdf` is then unused.
+    physical: Option<BsdfId>,
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -96,6 +123,12 @@ enum Emitter {
     Light(usize),
     /// Emits `radiance` on the side of its geometric normal; no light samples it.
     Unsampled(Color),
+}
+
+impl Emitter {
+    fn is_some(&self) -> bool {
+        !matches!(self, Emitter::None)
+    }
 }
 
 impl PreparedMaterial {
@@ -119,10 +152,22 @@ impl PreparedMaterial {
             Some(Material::Dielectric { attenuation, .. }) => Some(*attenuation),
             _ => None,
         };
+        let physical = match material {
+            Some(Material::Physical(bsdf)) => Some(*bsdf),
+            Some(Material::Emissive {
+                surface: Some(surface),
+                ..
+            }) => match scene.materials.get(*surface as usize) {
+                Some(Material::Physical(bsdf)) => Some(*bsdf),
+                _ => None,
+            },
+            _ => None,
+        };
         PreparedMaterial {
             bsdf,
             emitter,
             attenuation,
+            physical,
         }
     }
 }
@@ -151,6 +196,7 @@ impl PathIntegrator {
             materials: (0..=count)
                 .map(|id| PreparedMaterial::new(scene, id))
                 .collect(),
+            filter: FilterSampler::new(scene.physical.defaults.filter),
         }
     }
 
@@ -221,7 +267,11 @@ impl PathIntegrator {
                 None => scene.intersect_preliminary(&ray),
             };
             let Some(hit) = found else {
-                let background = scene.background_radiance(ray.direction);
+                let background = if depth == 0 && self.settings.hide_emitters {
+                    Color::ZERO
+                } else {
+                    scene.background_radiance(ray.direction)
+                };
                 if depth == 0 {
                     first_hit.albedo = background.clamp01();
                 }
@@ -237,6 +287,11 @@ impl PathIntegrator {
             };
             let si = scene.surface(&ray, &hit, SurfaceNeeds::Geometry);
             let material = self.material(si.material);
+            if depth == 0 && self.settings.hide_emitters && material.emitter.is_some() {
+                // Hidden emitters are not there for camera rays (Mitsuba skips them).
+                ray = Ray::spawn(si.point, ray.direction);
+                continue;
+            }
 
             // Light emitted by the surface towards the ray's origin. Emitters are one-sided, and
             // their back reflects nothing either: the surface material of an emitter only
@@ -287,6 +342,65 @@ impl PathIntegrator {
                 }
             }
 
+            if let (Some(id), false) = (material.physical, behind_emitter) {
+                // A physically based material: its tree resolved at this point, in world
+                // directions.
+                let surface = scene.physical_surface(&ray, &hit);
+                let wo = -ray.direction;
+                let bsdf = SurfaceBsdf::new(&scene.physical, &scene.textures, id, &surface, wo);
+                if depth == 0 {
+                    let n = surface.frame.w;
+                    first_hit.normal = if n.dot(wo) < 0.0 { -n } else { n };
+                    first_hit.depth = hit.t;
+                    if !bsdf.is_black() {
+                        first_hit.albedo = bsdf.albedo();
+                    }
+                }
+                if depth >= self.settings.max_depth || bsdf.is_black() {
+                    break;
+                }
+                let [u_direction, u_light] = sampler.sample_4d(dimension);
+                let u_lobe = sampler.sample_1d(dimension + 4);
+                let continuation = bsdf.sample(wo, u_lobe, u_direction);
+                if bsdf.has_non_delta() {
+                    if let Some(sample) = self.lights.sample(scene, surface.point, u_light) {
+                        let (f, scattering_pdf) = bsdf.eval_pdf(wo, sample.direction);
+                        if f != Color::ZERO
+                            && sample.radiance != Color::ZERO
+                            && unoccluded(scene, surface.point, &sample, rays)
+                        {
+                            let weight = if sample.is_delta || !sample.reachable_by_bsdf {
+                                1.0
+                            } else {
+                                power_heuristic(sample.pdf, scattering_pdf)
+                            };
+                            radiance += throughput.mul_elem(f).mul_elem(sample.radiance)
+                                * (weight / sample.pdf);
+                        }
+                    }
+                }
+                let Some(sample) = continuation else {
+                    break;
+                };
+                throughput = throughput.mul_elem(sample.weight);
+                if throughput == Color::ZERO || !throughput.is_finite() {
+                    break;
+                }
+                specular_bounce = sample.is_specular;
+                bsdf_pdf = sample.pdf;
+                eta_scale *= sample.eta * sample.eta;
+                ray = Ray::spawn(surface.point, sample.wi);
+                depth += 1;
+                if depth >= self.settings.russian_roulette_depth {
+                    let survival = ((throughput * eta_scale).max_component()).min(0.95);
+                    if sampler.sample_1d(dimension + 5) >= survival {
+                        break;
+                    }
+                    throughput = throughput / survival;
+                }
+                continue;
+            }
+
             let frame = Frame::from_normal(si.normal);
             let wo = frame.to_local(-ray.direction);
             let textured;
@@ -333,13 +447,7 @@ impl PathIntegrator {
                     let wi = frame.to_local(sample.direction);
                     let (f, scattering_pdf) = bsdf.eval_and_pdf(wo, wi);
                     if f != Color::ZERO && sample.radiance != Color::ZERO {
-                        let shadow = if sample.distance.is_infinite() {
-                            Ray::spawn(si.point, sample.direction)
-                        } else {
-                            Ray::spawn_to(si.point, sample.position)
-                        };
-                        *rays += 1;
-                        if !scene.occluded(&shadow) {
+                        if unoccluded(scene, si.point, &sample, rays) {
                             let weight = if sample.is_delta || !sample.reachable_by_bsdf {
                                 1.0
                             } else {
@@ -394,7 +502,7 @@ impl Integrator for PathIntegrator {
         // look-ahead started.
         let camera_sample = |s: u32| {
             let mut sampler = sobol.sampler(s);
-            let (ox, oy) = sampler.sample_2d(0);
+            let (ox, oy) = self.filter.offset(sampler.sample_2d(0));
             let lens = match scene.camera.lens {
                 Some(_) => sampler.sample_2d(LENS_DIMENSION),
                 None => (0.5, 0.5),
@@ -436,6 +544,101 @@ impl Integrator for PathIntegrator {
                 emit(radiance, first_hit);
             },
         );
+    }
+}
+
+/// Whether the shadow ray from `point` to the light sample reaches it (counted in `rays`).
+#[inline(always)]
+fn unoccluded(
+    scene: &Scene,
+    point: crate::math::Vec3,
+    sample: &LightSample,
+    rays: &mut u64,
+) -> bool {
+    let shadow = if sample.distance.is_infinite() {
+        Ray::spawn(point, sample.direction)
+    } else {
+        Ray::spawn_to(point, sample.position)
+    };
+    *rays += 1;
+    !scene.occluded(&shadow)
+}
+
+/// Places a camera sample in its pixel by importance-sampling the reconstruction filter, one
+/// axis at a time (the filters are separable), so that a pixel's mean is the filter-weighted
+/// mean of the radiance around its centre, as Mitsuba's film computes it.
+#[derive(Clone, Debug)]
+struct FilterSampler {
+    /// Half-width in pixels; 0 for the box, whose offsets are the uniform numbers themselves.
+    radius: f32,
+    /// The filter's cumulative distribution over `BINS` equal bins of [−radius, radius].
+    cdf: Vec<f32>,
+}
+
+impl FilterSampler {
+    const BINS: usize = 1024;
+
+    fn new(filter: PixelFilter) -> FilterSampler {
+        let (radius, weight): (f32, Box<dyn Fn(f32) -> f64>) = match filter {
+            PixelFilter::Box => {
+                return FilterSampler {
+                    radius: 0.0,
+                    cdf: Vec::new(),
+                }
+            }
+            PixelFilter::Tent { radius } => {
+                let r = radius.max(1e-3);
+                (
+                    r,
+                    Box::new(move |x: f32| (1.0 - (x / r).abs()).max(0.0) as f64),
+                )
+            }
+            PixelFilter::Gaussian { stddev } => {
+                let s = stddev.max(1e-3) as f64;
+                let r = 4.0 * s;
+                let g = move |x: f64| (-x * x / (2.0 * s * s)).exp();
+                let floor = g(r);
+                (
+                    r as f32,
+                    Box::new(move |x: f32| (g(x as f64) - floor).max(0.0)),
+                )
+            }
+        };
+        // Each bin's weight by the midpoint rule at 8 points.
+        let width = 2.0 * radius / Self::BINS as f32;
+        let mut cdf = Vec::with_capacity(Self::BINS + 1);
+        let mut total = 0.0f64;
+        cdf.push(0.0);
+        for bin in 0..Self::BINS {
+            let start = -radius + bin as f32 * width;
+            total += (0..8)
+                .map(|k| weight(start + (k as f32 + 0.5) / 8.0 * width))
+                .sum::<f64>();
+            cdf.push(total as f32);
+        }
+        for c in &mut cdf {
+            *c /= total as f32;
+        }
+        FilterSampler { radius, cdf }
+    }
+
+    /// The offset in [0, 1)² of the pixel's corner (outside it for wide filters) for the
+    /// uniform numbers `u`.
+    #[inline]
+    fn offset(&self, u: (f32, f32)) -> (f32, f32) {
+        if self.cdf.is_empty() {
+            return u;
+        }
+        (0.5 + self.sample(u.0), 0.5 + self.sample(u.1))
+    }
+
+    #[inline]
+    fn sample(&self, u: f32) -> f32 {
+        let bin = self.cdf.partition_point(|&c| c <= u).clamp(1, Self::BINS) - 1;
+        let (lo, hi) = (self.cdf[bin], self.cdf[bin + 1]);
+        let within = if hi > lo { (u - lo) / (hi - lo) } else { 0.5 };
+        let width = 2.0 * self.radius / Self::BINS as f32;
+        -self.radius + (bin as f32 + within) * width
     }
 }
 

@@ -12,6 +12,7 @@ pub mod microfacet;
 pub mod physical;
 #[allow(dead_code)]
 pub mod scatter;
+pub mod surface;
 
 use crate::math::Color;
 use crate::texture::ColorSource;

@@ -1,0 +1,444 @@
+//! The BSDF of a physically based material at one hit: the material's tree of `BsdfNode`s
+//! resolved for this point and this viewing direction into at most `MAX_LEAVES` weighted
+//! leaves, each a BSDF family of `scatter.rs` in its own shading frame.
+//!
+//! Resolving the tree once per hit is what makes the wrappers cheap:
+//! - `twosided` picks its front or back BSDF by the side ωo (the direction towards the
+//!   viewer, fixed for the hit) lies on, and flips the frame for the back;
+//! - `normalmap` and `bumpmap` tilt the frame of everything below them, and remember the frame
+//!   they tilted, because Mitsuba rejects directions on different sides of the two frames and
+//!   scales the response by the shadowing term of Estevez et al. (2019);
+//! - `blendbsdf` and `mask` weigh their children (a mask's transparent part is a `Null` leaf,
+//!   light passing straight on).
+//!
+//! The leaves' weights sum to one, and a leaf is sampled with the probability of its weight,
+//! as Mitsuba's `blendbsdf` and `mask` choose; a continuous sample is then weighed against
+//! every leaf's density (one-sample multiple importance sampling, as `blendbsdf` does), a
+//! delta sample by its own probability.
+
+use crate::material::bsdf::BsdfSample;
+use crate::material::diffuse::Diffuse;
+use crate::material::microfacet::{Distribution, Microfacet};
+use crate::material::physical::{BsdfId, BsdfNode, DistributionKind, Param, Roughness};
+use crate::material::scatter::Scatter;
+use crate::math::{Color, Frame, Vec3};
+use crate::scene::physical::{PhysicalParts, PhysicalSurface};
+use crate::texture::Image;
+
+/// The most leaves a resolved tree keeps; deeper mixtures drop their lightest leaves.
+pub const MAX_LEAVES: usize = 4;
+/// How deep wrappers may nest before the tree is cut (the loader refuses cycles; this bounds
+/// the recursion on any tree).
+const MAX_NESTING: u32 = 16;
+
+/// One BSDF family with its parameters resolved.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Family {
+    Diffuse(Diffuse),
+    /// Light passes straight on (a mask's transparent part, `null`).
+    Null,
+}
+
+macro_rules! each_family {
+    ($family:expr, $f:ident => $body:expr, $null:expr) => {
+        match $family {
+            Family::Diffuse($f) => $body,
+            Family::Null => $null,
+        }
+    };
+}
+
+/// A tilted frame's record: the frame it tilted and the tilted normal in that frame's
+/// coordinates.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Tilt {
+    parent: Frame,
+    normal: Vec3,
+}
+
+impl Tilt {
+    /// Estevez et al.'s shadowing term for `d` (world) in the parent frame.
+    #[inline]
+    fn shadowing(&self, d_parent: Vec3) -> f32 {
+        let alpha2 = (0.125 * tan2(self.normal)).min(1.0);
+        2.0 / (1.0 + (1.0 + alpha2 * tan2(d_parent)).sqrt())
+    }
+}
+
+#[inline]
+fn tan2(v: Vec3) -> f32 {
+    let cos2 = v.z * v.z;
+    ((1.0 - cos2).max(0.0) / cos2).max(0.0)
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Leaf {
+    family: Family,
+    weight: f32,
+    /// The leaf's shading frame in world space (its `w` negated on a two-sided BSDF's back).
+    frame: Frame,
+    tilt: Option<Tilt>,
+}
+
+impl Leaf {
+    /// f·cos and the density of the leaf for directions in world space, with a tilt's
+    /// orientation test and shadowing.
+    #[inline]
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
+        let (lo, li) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        let mut shadow = 1.0;
+        if let Some(tilt) = &self.tilt {
+            let parent_wi = tilt.parent.to_local(wi);
+            if parent_wi.z * li.z <= 0.0 {
+                return (Color::ZERO, 0.0);
+            }
+            shadow = tilt.shadowing(parent_wi);
+        }
+        let (f, pdf) = each_family!(&self.family, s => s.eval_pdf(lo, li), (Color::ZERO, 0.0));
+        (f * shadow, pdf)
+    }
+
+    #[inline]
+    fn sample(&self, wo: Vec3, u_lobe: f32, u: (f32, f32)) -> Option<BsdfSample> {
+        let lo = self.frame.to_local(wo);
+        let mut sample = match &self.family {
+            Family::Null => BsdfSample {
+                wi: -lo,
+                weight: Color::ONE,
+                pdf: 1.0,
+                is_specular: true,
+                eta: 1.0,
+            },
+            family => each_family!(family, s => s.sample(lo, u_lobe, u), None)?,
+        };
+        let wi = self.frame.to_world(sample.wi);
+        if let Some(tilt) = &self.tilt {
+            let parent_wi = tilt.parent.to_local(wi);
+            if parent_wi.z * sample.wi.z <= 0.0 {
+                return None;
+            }
+            sample.weight = sample.weight * tilt.shadowing(parent_wi);
+        }
+        sample.wi = wi;
+        Some(sample)
+    }
+
+    fn has_non_delta(&self) -> bool {
+        each_family!(&self.family, s => s.has_non_delta(), false)
+    }
+
+    fn albedo(&self) -> Color {
+        each_family!(&self.family, s => s.albedo(), Color::ZERO)
+    }
+}
+
+/// A physically based material's BSDF at one hit, for directions in world space.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceBsdf {
+    leaves: [Leaf; MAX_LEAVES],
+    count: usize,
+}
+
+/// What resolving a tree reads.
+struct Resolver<'a> {
+    parts: &'a PhysicalParts,
+    images: &'a [Image],
+    surface: &'a PhysicalSurface,
+    /// Towards the viewer, world space.
+    wo: Vec3,
+}
+
+impl SurfaceBsdf {
+    /// The BSDF of tree `id` at `surface`, seen from world direction `wo`.
+    pub fn new(
+        parts: &PhysicalParts,
+        images: &[Image],
+        id: BsdfId,
+        surface: &PhysicalSurface,
+        wo: Vec3,
+    ) -> SurfaceBsdf {
+        let mut bsdf = SurfaceBsdf {
+            leaves: [Leaf {
+                family: Family::Null,
+                weight: 0.0,
+                frame: surface.frame,
+                tilt: None,
+            }; MAX_LEAVES],
+            count: 0,
+        };
+        let resolver = Resolver {
+            parts,
+            images,
+            surface,
+            wo,
+        };
+        resolver.add(&mut bsdf, id, 1.0, surface.frame, None, 0);
+        // Leaves dropped for lack of room leave weights summing to less than one: make the
+        // kept ones a distribution again.
+        let total: f32 = bsdf.leaves[..bsdf.count].iter().map(|l| l.weight).sum();
+        if total > 0.0 && (total - 1.0).abs() > 1e-6 {
+            for leaf in &mut bsdf.leaves[..bsdf.count] {
+                leaf.weight /= total;
+            }
+        }
+        bsdf
+    }
+
+    /// True when the BSDF scatters nothing.
+    pub fn is_black(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Whether light sampling can find some leaf (Mitsuba's `Smooth` flag).
+    pub fn has_non_delta(&self) -> bool {
+        self.leaves[..self.count].iter().any(Leaf::has_non_delta)
+    }
+
+    /// The weighted mean of the leaves' albedos (the denoiser's feature).
+    pub fn albedo(&self) -> Color {
+        self.leaves[..self.count]
+            .iter()
+            .fold(Color::ZERO, |sum, leaf| sum + leaf.albedo() * leaf.weight)
+            .clamp01()
+    }
+
+    /// f·|cos θi| and the sampling density for world directions `wo` (towards the viewer)
+    /// and `wi` (towards the light).
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
+        let mut f = Color::ZERO;
+        let mut pdf = 0.0;
+        for leaf in &self.leaves[..self.count] {
+            let (leaf_f, leaf_pdf) = leaf.eval_pdf(wo, wi);
+            f += leaf_f * leaf.weight;
+            pdf += leaf_pdf * leaf.weight;
+        }
+        (f, pdf)
+    }
+
+    /// Draws a world direction ωi for `wo`; `BsdfSample::wi` is in world space.
+    pub fn sample(&self, wo: Vec3, u_lobe: f32, u: (f32, f32)) -> Option<BsdfSample> {
+        if self.count == 1 {
+            return self.leaves[0].sample(wo, u_lobe, u);
+        }
+        let mut start = 0.0;
+        let mut chosen = self.count.checked_sub(1)?;
+        for (index, leaf) in self.leaves[..self.count].iter().enumerate() {
+            if u_lobe < start + leaf.weight {
+                chosen = index;
+                break;
+            }
+            start += leaf.weight;
+        }
+        let leaf = &self.leaves[chosen];
+        if leaf.weight <= 0.0 {
+            return None;
+        }
+        let u_leaf = ((u_lobe - start) / leaf.weight).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        let mut sample = leaf.sample(wo, u_leaf, u)?;
+        if sample.is_specular {
+            // A delta is not in the other leaves' densities: its weight stands, and its
+            // probability includes the choice of the leaf.
+            sample.pdf *= leaf.weight;
+            return Some(sample);
+        }
+        let (f, pdf) = self.eval_pdf(wo, sample.wi);
+        if pdf <= 0.0 {
+            return None;
+        }
+        sample.weight = f / pdf;
+        sample.pdf = pdf;
+        Some(sample)
+    }
+}
+
+impl Resolver<'_> {
+    fn float(&self, p: &Param) -> f32 {
+        p.eval_float(&self.parts.textures, self.images, &self.surface.texture)
+    }
+
+    fn color(&self, p: &Param) -> Color {
+        p.eval(&self.parts.textures, self.images, &self.surface.texture)
+    }
+
+    fn microfacet(&self, r: &Roughness) -> Microfacet {
+        let distribution = match r.distribution {
+            DistributionKind::Beckmann => Distribution::Beckmann,
+            DistributionKind::Ggx => Distribution::Ggx,
+        };
+        Microfacet::new(
+            distribution,
+            self.float(&r.alpha_u),
+            self.float(&r.alpha_v),
+            r.sample_visible,
+        )
+    }
+
+    fn push(&self, bsdf: &mut SurfaceBsdf, leaf: Leaf) {
+        if leaf.weight <= 0.0 {
+            return;
+        }
+        if bsdf.count < MAX_LEAVES {
+            bsdf.leaves[bsdf.count] = leaf;
+            bsdf.count += 1;
+        } else if let Some(lightest) = bsdf.leaves.iter_mut().min_by(|a, b| {
+            a.weight
+                .partial_cmp(&b.weight)
+                .unwrap_or(std::cmp::Ordering::Equal)
+        }) {
+            if lightest.weight < leaf.weight {
+                *lightest = leaf;
+            }
+        }
+    }
+
+    /// Adds the leaves of node `id` with mixture weight `weight` in `frame`.
+    fn add(
+        &self,
+        bsdf: &mut SurfaceBsdf,
+        id: BsdfId,
+        weight: f32,
+        frame: Frame,
+        tilt: Option<Tilt>,
+        depth: u32,
+    ) {
+        let Some(node) = self.parts.bsdfs.get(id as usize) else {
+            return;
+        };
+        if depth > MAX_NESTING || weight <= 0.0 {
+            return;
+        }
+        let leaf = |family: Family| Leaf {
+            family,
+            weight,
+            frame,
+            tilt,
+        };
+        match node {
+            BsdfNode::Diffuse { reflectance } => self.push(
+                bsdf,
+                leaf(Family::Diffuse(Diffuse {
+                    reflectance: self.color(reflectance),
+                })),
+            ),
+            // TODO(bsdf families): wired as they land.
+            BsdfNode::Conductor { .. }
+            | BsdfNode::Dielectric { .. }
+            | BsdfNode::ThinDielectric { .. }
+            | BsdfNode::Plastic { .. }
+            | BsdfNode::Principled(_)
+            | BsdfNode::PrincipledThin(_) => {}
+            BsdfNode::Null => self.push(bsdf, leaf(Family::Null)),
+            BsdfNode::TwoSided { front, back } => {
+                if frame.to_local(self.wo).z >= 0.0 {
+                    self.add(bsdf, *front, weight, frame, tilt, depth + 1);
+                } else {
+                    let flipped = Frame {
+                        u: frame.u,
+                        v: frame.v,
+                        w: -frame.w,
+                    };
+                    self.add(bsdf, *back, weight, flipped, tilt, depth + 1);
+                }
+            }
+            BsdfNode::Mask { opacity, nested } => {
+                let opacity = self.float(opacity).clamp(0.0, 1.0);
+                self.add(bsdf, *nested, weight * opacity, frame, tilt, depth + 1);
+                self.push(
+                    bsdf,
+                    Leaf {
+                        family: Family::Null,
+                        weight: weight * (1.0 - opacity),
+                        frame,
+                        tilt,
+                    },
+                );
+            }
+            BsdfNode::Blend {
+                weight: blend,
+                first,
+                second,
+            } => {
+                let w = self.float(blend).clamp(0.0, 1.0);
+                self.add(bsdf, *first, weight * (1.0 - w), frame, tilt, depth + 1);
+                self.add(bsdf, *second, weight * w, frame, tilt, depth + 1);
+            }
+            BsdfNode::NormalMap { normals, nested } => {
+                let texel = self
+                    .parts
+                    .textures
+                    .get(*normals as usize)
+                    .map_or(Vec3::new(0.5, 0.5, 1.0), |node| {
+                        node.eval(self.images, &self.surface.texture)
+                    });
+                let mut n = texel * 2.0 - Vec3::ONE;
+                // Shading normals face the viewer (Mitsuba's `flip_invalid_normals`).
+                let wo_local = frame.to_local(self.wo);
+                if wo_local.z * wo_local.dot(n) <= 0.0 {
+                    n = Vec3::new(-n.x, -n.y, n.z);
+                }
+                let n = n.normalized();
+                if !n.is_finite() {
+                    return;
+                }
+                let s = (Vec3::X - n * n.x).normalized();
+                let local = Frame {
+                    u: s,
+                    v: n.cross(s),
+                    w: n,
+                };
+                let tilted = Frame {
+                    u: frame.to_world(local.u),
+                    v: frame.to_world(local.v),
+                    w: frame.to_world(local.w),
+                };
+                let tilt = Some(Tilt {
+                    parent: frame,
+                    normal: n,
+                });
+                self.add(bsdf, *nested, weight, tilted, tilt, depth + 1);
+            }
+            BsdfNode::BumpMap {
+                height,
+                scale,
+                nested,
+            } => {
+                let Some(node) = self.parts.textures.get(*height as usize) else {
+                    return;
+                };
+                let (gu, gv) = node.gradient(self.images, &self.surface.texture);
+                let (gu, gv) = (gu * scale, gv * scale);
+                let n = frame.w;
+                let dp_du = self.surface.dp_du + n * (gu - n.dot(self.surface.dp_du));
+                let dp_dv = self.surface.dp_dv + n * (gv - n.dot(self.surface.dp_dv));
+                let mut bumped = dp_du.cross(dp_dv).normalized();
+                if !bumped.is_finite() {
+                    return;
+                }
+                if self.surface.normal.dot(bumped) < 0.0 {
+                    bumped = -bumped;
+                }
+                let mut local_n = frame.to_local(bumped);
+                let wo_local = frame.to_local(self.wo);
+                if wo_local.z * self.wo.dot(bumped) <= 0.0 {
+                    local_n = Vec3::new(-local_n.x, -local_n.y, local_n.z);
+                }
+                let world_n = frame.to_world(local_n);
+                let s =
+                    (self.surface.dp_du - world_n * world_n.dot(self.surface.dp_du)).normalized();
+                if !s.is_finite() {
+                    return;
+                }
+                let tilted = Frame {
+                    u: s,
+                    v: world_n.cross(s),
+                    w: world_n,
+                };
+                let tilt = Some(Tilt {
+                    parent: frame,
+                    normal: local_n,
+                });
+                self.add(bsdf, *nested, weight, tilted, tilt, depth + 1);
+            }
+        }
+    }
+}
