@@ -1,0 +1,1 @@
+//! Mitsuba 3's `sdfgrid` shape and its `.vol` grid files.
