@@ -6,6 +6,7 @@
 use std::f64::consts::PI;
 
 use glint_io::mitsuba_shapes::*;
+use glint_io::Limits;
 use glint_render::Vec3;
 
 /// The triangle's geometric normal (unnormalised), from its winding.
@@ -200,5 +201,326 @@ fn the_cube_is_mitsubas_24_vertex_cube() {
         let first = if flip { [2, 1, 0] } else { [0, 1, 2] };
         assert_eq!(mesh.triangles[0], first);
         assert_eq!(mesh.positions[0], Vec3::new(1.0, -1.0, -1.0));
+    }
+}
+
+// ---- .serialized ----
+
+/// What a test shape holds, written by [`encode_serialized`] from the format's description.
+#[derive(Clone)]
+struct Raw {
+    flags: u32,
+    name: &'static str,
+    positions: Vec<[f64; 3]>,
+    normals: Vec<[f64; 3]>,
+    uvs: Vec<[f64; 2]>,
+    colors: Vec<[f64; 3]>,
+    triangles: Vec<[u32; 3]>,
+    /// Overrides the vertex and triangle counts written (lies).
+    counts: Option<(u64, u64)>,
+}
+
+const NORMALS: u32 = 0x1;
+const UVS: u32 = 0x2;
+const COLORS: u32 = 0x8;
+const FACE_NORMALS: u32 = 0x10;
+const DOUBLE: u32 = 0x2000;
+
+fn raw_shape(flags: u32, shift: f64) -> Raw {
+    let positions = vec![
+        [0.0 + shift, 0.0, 0.0],
+        [1.0, 0.0 + shift, 0.0],
+        [0.0, 1.0, 0.5],
+        [1.0, 1.0, 0.25 + shift],
+    ];
+    Raw {
+        flags,
+        name: "quad",
+        normals: vec![
+            [0.0, 0.0, 2.0],
+            [0.0, 0.6, 0.8],
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 0.0],
+        ],
+        uvs: vec![[0.0, 0.0], [1.0, 0.0], [0.0, 1.0], [0.1, 0.9]],
+        colors: vec![
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.5, 0.5, 0.5],
+        ],
+        triangles: vec![[0, 1, 2], [2, 1, 3]],
+        positions,
+        counts: None,
+    }
+}
+
+/// The uncompressed content of one shape's stream.
+fn shape_content(version: u16, raw: &Raw) -> Vec<u8> {
+    let mut out = Vec::new();
+    out.extend(raw.flags.to_le_bytes());
+    if version == 4 {
+        out.extend(raw.name.as_bytes());
+        out.push(0);
+    }
+    let (v, f) = raw
+        .counts
+        .unwrap_or((raw.positions.len() as u64, raw.triangles.len() as u64));
+    out.extend(v.to_le_bytes());
+    out.extend(f.to_le_bytes());
+    let double = raw.flags & DOUBLE != 0;
+    let mut floats = |values: &mut dyn Iterator<Item = f64>| {
+        for x in values {
+            if double {
+                out.extend(x.to_le_bytes());
+            } else {
+                out.extend((x as f32).to_le_bytes());
+            }
+        }
+    };
+    floats(&mut raw.positions.iter().flatten().copied());
+    if raw.flags & NORMALS != 0 {
+        floats(&mut raw.normals.iter().flatten().copied());
+    }
+    if raw.flags & UVS != 0 {
+        floats(&mut raw.uvs.iter().flatten().copied());
+    }
+    if raw.flags & COLORS != 0 {
+        floats(&mut raw.colors.iter().flatten().copied());
+    }
+    for t in &raw.triangles {
+        for i in t {
+            out.extend(i.to_le_bytes());
+        }
+    }
+    out
+}
+
+fn zlib(content: &[u8]) -> Vec<u8> {
+    use std::io::Write;
+    let mut encoder = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+    encoder.write_all(content).unwrap();
+    encoder.finish().unwrap()
+}
+
+/// A whole file: each shape's header and zlib stream, then the dictionary of offsets.
+fn encode_serialized(version: u16, shapes: &[Raw]) -> Vec<u8> {
+    let mut out = Vec::new();
+    let mut offsets = Vec::new();
+    for raw in shapes {
+        offsets.push(out.len() as u64);
+        out.extend(0x041Cu16.to_le_bytes());
+        out.extend(version.to_le_bytes());
+        out.extend(zlib(&shape_content(version, raw)));
+    }
+    for offset in offsets {
+        if version == 4 {
+            out.extend(offset.to_le_bytes());
+        } else {
+            out.extend((offset as u32).to_le_bytes());
+        }
+    }
+    out.extend((shapes.len() as u32).to_le_bytes());
+    out
+}
+
+fn assert_matches(shape: &SerializedShape, raw: &Raw, version: u16) {
+    let mesh = &shape.mesh;
+    assert_consistent(mesh);
+    assert_eq!(shape.name, if version == 4 { raw.name } else { "" });
+    assert_eq!(shape.face_normals, raw.flags & FACE_NORMALS != 0);
+    let v3 = |a: &[f64; 3]| Vec3::new(a[0] as f32, a[1] as f32, a[2] as f32);
+    let positions: Vec<_> = raw.positions.iter().map(v3).collect();
+    assert_eq!(mesh.positions, positions);
+    assert_eq!(mesh.triangles, raw.triangles);
+    match &mesh.normals {
+        Some(normals) => {
+            assert!(raw.flags & NORMALS != 0);
+            for (n, r) in normals.iter().zip(&raw.normals) {
+                assert!((*n - v3(r).normalized()).length() < 1e-6);
+            }
+        }
+        None => assert_eq!(raw.flags & NORMALS, 0),
+    }
+    let uvs: Option<Vec<_>> = (raw.flags & UVS != 0)
+        .then(|| raw.uvs.iter().map(|a| (a[0] as f32, a[1] as f32)).collect());
+    assert_eq!(mesh.uvs, uvs);
+    let colors: Option<Vec<_>> =
+        (raw.flags & COLORS != 0).then(|| raw.colors.iter().map(v3).collect());
+    assert_eq!(mesh.colors, colors);
+}
+
+#[test]
+fn serialized_files_round_trip_with_every_flag_combination() {
+    let limits = Limits::default();
+    for version in [3u16, 4] {
+        for bits in 0..32u32 {
+            let flag_of = [NORMALS, UVS, COLORS, FACE_NORMALS, DOUBLE];
+            let flags = flag_of
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| bits & (1 << k) != 0)
+                .fold(0, |acc, (_, f)| acc | f);
+            let first = raw_shape(flags, 0.0);
+            let second = raw_shape(flags ^ (NORMALS | UVS), 3.0);
+            let file = encode_serialized(version, &[first.clone(), second.clone()]);
+            assert_eq!(serialized_shape_count(&file).unwrap(), 2);
+            let shape = read_serialized(&file, 0, &limits).unwrap();
+            assert_matches(&shape, &first, version);
+            let shape = read_serialized(&file, 1, &limits).unwrap();
+            assert_matches(&shape, &second, version);
+        }
+    }
+}
+
+fn assert_refused(file: &[u8], index: u32, limits: &Limits, words: &str) -> ShapeError {
+    match read_serialized(file, index, limits) {
+        Ok(_) => panic!("accepted a file that should fail with '{words}'"),
+        Err(error) => {
+            let text = error.to_string();
+            assert!(text.contains(words), "'{text}' does not say '{words}'");
+            assert!(error.offset.is_some(), "'{text}' has no offset");
+            error
+        }
+    }
+}
+
+#[test]
+fn a_wrong_magic_or_version_is_refused() {
+    let limits = Limits::default();
+    let mut file = encode_serialized(4, &[raw_shape(NORMALS, 0.0)]);
+    file[0] = 0x1D;
+    let error = assert_refused(&file, 0, &limits, "magic");
+    assert_eq!(error.offset, Some(0));
+    for version in [0u16, 2, 5, 6, 0xFFFF] {
+        let mut file = encode_serialized(4, &[raw_shape(NORMALS, 0.0)]);
+        file[2..4].copy_from_slice(&version.to_le_bytes());
+        let error = assert_refused(&file, 0, &limits, "version");
+        assert_eq!(error.offset, Some(2));
+    }
+    assert_refused(&[0x1C], 0, &limits, "header");
+    assert_refused(&[], 0, &limits, "header");
+}
+
+#[test]
+fn corrupt_zlib_data_is_refused() {
+    let limits = Limits::default();
+    let file = encode_serialized(4, &[raw_shape(NORMALS | UVS, 0.0)]);
+    let stream_end = file.len() - 12;
+    // Garbage in the middle of the stream.
+    let mut garbage = file.clone();
+    for byte in &mut garbage[6..stream_end - 6] {
+        *byte = 0xFF;
+    }
+    assert_refused(&garbage, 0, &limits, "corrupt");
+    // A bad zlib header.
+    let mut header = file.clone();
+    header[4] = 0x00;
+    assert_refused(&header, 0, &limits, "corrupt");
+    // Only the checksum is wrong: the content parses, the stream does not end well.
+    let mut checksum = file.clone();
+    checksum[stream_end - 1] ^= 0x55;
+    assert_refused(&checksum, 0, &limits, "corrupt");
+}
+
+#[test]
+fn truncated_files_are_refused_at_every_length() {
+    let limits = Limits::default();
+    let file = encode_serialized(4, &[raw_shape(NORMALS, 0.0), raw_shape(UVS | COLORS, 1.0)]);
+    let first_stream_end = {
+        let one = encode_serialized(4, &[raw_shape(NORMALS, 0.0)]);
+        one.len() - 12
+    };
+    for len in 0..file.len() {
+        let cut = &file[..len];
+        // Shape 0 needs its own bytes only (Mitsuba reads it without the dictionary).
+        if len < first_stream_end {
+            assert!(
+                read_serialized(cut, 0, &limits).is_err(),
+                "shape 0 read from {len} bytes"
+            );
+        }
+        assert!(
+            read_serialized(cut, 1, &limits).is_err(),
+            "shape 1 read from {len} bytes"
+        );
+    }
+}
+
+#[test]
+fn lying_counts_and_indices_are_refused() {
+    let limits = Limits::default();
+    let lie = |v: u64, f: u64| {
+        // No normals: a normal read from the wrong bytes would be refused for its own sake.
+        let mut raw = raw_shape(0, 0.0);
+        raw.counts = Some((v, f));
+        encode_serialized(4, &[raw])
+    };
+    // One vertex or triangle more than the data: the stream ends early.
+    assert_refused(&lie(5, 2), 0, &limits, "ends");
+    assert_refused(&lie(4, 3), 0, &limits, "ends");
+    // Far more than the compressed bytes could hold, refused before allocating: with no
+    // limits at all, 2^32 - 1 vertices would be 80 GB.
+    assert_refused(
+        &lie(u32::MAX as u64, 2),
+        0,
+        &Limits::none(),
+        "compressed bytes",
+    );
+    assert_refused(&lie(4, 1 << 40), 0, &Limits::none(), "compressed bytes");
+    assert_refused(&lie(u64::MAX, u64::MAX), 0, &Limits::none(), "vertices");
+    // Over the limits.
+    let small = Limits {
+        max_triangles: 1,
+        ..Limits::default()
+    };
+    assert_refused(&lie(4, 2), 0, &small, "over the limit");
+    let tiny_file = Limits {
+        max_file_bytes: 10,
+        ..Limits::default()
+    };
+    assert!(read_serialized(&lie(4, 2), 0, &tiny_file).is_err());
+    // An index past the vertices.
+    let mut raw = raw_shape(0, 0.0);
+    raw.triangles[1] = [2, 1, 4];
+    assert_refused(&encode_serialized(4, &[raw]), 0, &limits, "vertex 4");
+}
+
+#[test]
+fn non_finite_values_are_refused() {
+    let limits = Limits::default();
+    for double in [0, DOUBLE] {
+        let mut raw = raw_shape(NORMALS | double, 0.0);
+        raw.positions[2][1] = f64::NAN;
+        assert_refused(&encode_serialized(4, &[raw]), 0, &limits, "NaN");
+        let mut raw = raw_shape(UVS | double, 0.0);
+        raw.uvs[1][0] = f64::INFINITY;
+        assert_refused(&encode_serialized(4, &[raw]), 0, &limits, "inf");
+        let mut raw = raw_shape(NORMALS | double, 0.0);
+        raw.normals[3] = [0.0, 0.0, 0.0];
+        assert_refused(&encode_serialized(4, &[raw]), 0, &limits, "normal");
+    }
+}
+
+#[test]
+fn the_dictionary_is_checked() {
+    let limits = Limits::default();
+    for version in [3u16, 4] {
+        let file = encode_serialized(version, &[raw_shape(0, 0.0), raw_shape(0, 1.0)]);
+        assert_refused(&file, 2, &limits, "out of range");
+        // A count larger than the file.
+        let mut count = file.clone();
+        let n = count.len();
+        count[n - 4..].copy_from_slice(&u32::MAX.to_le_bytes());
+        assert_refused(&count, 1, &limits, "dictionary");
+        // An offset past the shapes.
+        let mut offset = file.clone();
+        let entry = if version == 4 { n - 12 } else { n - 8 };
+        offset[entry..entry + 4].copy_from_slice(&0x7FFF_FFFFu32.to_le_bytes());
+        assert_refused(&offset, 1, &limits, "outside");
+        // An offset into the middle of shape 0.
+        let mut middle = file.clone();
+        middle[entry..entry + 4].copy_from_slice(&7u32.to_le_bytes());
+        assert!(read_serialized(&middle, 1, &limits).is_err());
     }
 }
