@@ -89,6 +89,7 @@ pub use scene_hash::scene_hash;
 /// reach them; not part of the API, which is `load_scene`.
 #[doc(hidden)]
 pub mod mitsuba_shapes {
+    pub use crate::mitsuba::sdfgrid::*;
     pub use crate::mitsuba::serialized::*;
     pub use crate::mitsuba::shapes::*;
 }

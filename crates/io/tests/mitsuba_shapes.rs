@@ -524,3 +524,204 @@ fn the_dictionary_is_checked() {
         assert!(read_serialized(&middle, 1, &limits).is_err());
     }
 }
+
+// ---- sdfgrid and .vol ----
+
+/// A `.vol` file from the format's description.
+fn encode_vol(size: [i32; 3], channels: i32, data: &[f32]) -> Vec<u8> {
+    let mut out = b"VOL".to_vec();
+    out.push(3);
+    out.extend(1i32.to_le_bytes());
+    for n in size {
+        out.extend(n.to_le_bytes());
+    }
+    out.extend(channels.to_le_bytes());
+    for b in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0] {
+        out.extend(b.to_le_bytes());
+    }
+    for v in data {
+        out.extend(v.to_le_bytes());
+    }
+    out
+}
+
+/// The exact distance to a sphere of radius `r` centred in the unit cube, sampled at Mitsuba's
+/// grid points `i / (n - 1)`.
+fn sphere_grid(n: usize, r: f64) -> Vec<f32> {
+    let mut data = Vec::with_capacity(n * n * n);
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let p = [i, j, k].map(|c| c as f64 / (n - 1) as f64 - 0.5);
+                data.push(((p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt() - r) as f32);
+            }
+        }
+    }
+    data
+}
+
+#[test]
+fn a_sphere_sdf_becomes_a_closed_sphere_mesh() {
+    let (n, r) = (40usize, 0.3);
+    let file = encode_vol([n as i32; 3], 1, &sphere_grid(n, r));
+    let mesh = read_sdfgrid(&file, &Limits::default()).unwrap();
+    assert_consistent(&mesh);
+    assert!(mesh.triangles.len() > 1000);
+    let analytic = 4.0 * PI * r * r;
+    let area = mesh.area();
+    assert!(
+        (area - analytic).abs() / analytic < 0.01,
+        "area {area} vs {analytic}"
+    );
+    let cell = 1.0 / (n - 1) as f64;
+    let normals = mesh.normals.as_ref().unwrap();
+    for (p, normal) in mesh.positions.iter().zip(normals) {
+        let d = *p - Vec3::splat(0.5);
+        let distance = (d.length() as f64 - r).abs();
+        assert!(
+            distance < cell,
+            "vertex {p:?} is {distance} from the sphere"
+        );
+        assert!(
+            normal.dot(d.normalized()) > 0.99,
+            "normal {normal:?} at {p:?}"
+        );
+    }
+    // Every triangle faces outwards, the way the gradient points.
+    for &t in &mesh.triangles {
+        let centre = (0..3).fold(Vec3::ZERO, |acc, k| acc + mesh.positions[t[k] as usize]) / 3.0;
+        assert!(
+            face_normal(&mesh, t).dot(centre - Vec3::splat(0.5)) > 0.0,
+            "{t:?} faces in"
+        );
+    }
+    // Closed: every edge is shared by exactly two triangles, in opposite directions.
+    let mut edges = std::collections::HashMap::new();
+    for &[a, b, c] in &mesh.triangles {
+        for (u, v) in [(a, b), (b, c), (c, a)] {
+            *edges.entry((u, v)).or_insert(0) += 1;
+        }
+    }
+    for (&(u, v), &count) in &edges {
+        assert_eq!(count, 1, "edge {u}-{v} used {count} times in one direction");
+        assert!(edges.contains_key(&(v, u)), "edge {u}-{v} is on a crack");
+    }
+}
+
+#[test]
+fn ambiguous_faces_stay_crack_free() {
+    // Random values: most cells and faces ambiguous somewhere. The surface may reach the grid's
+    // border, so only interior edges must pair up.
+    let n = 12usize;
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let data: Vec<f32> = (0..n * n * n)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        })
+        .collect();
+    let mesh = read_sdfgrid(&encode_vol([n as i32; 3], 1, &data), &Limits::default()).unwrap();
+    assert_consistent(&mesh);
+    let on_border = |p: Vec3| p.to_array().iter().any(|&c| c == 0.0 || c == 1.0);
+    let mut edges = std::collections::HashMap::new();
+    for &[a, b, c] in &mesh.triangles {
+        for (u, v) in [(a, b), (b, c), (c, a)] {
+            *edges.entry((u, v)).or_insert(0) += 1;
+        }
+    }
+    // Fan diagonals of two loops can coincide, so an edge may serve four triangles; a crack
+    // would leave an edge without as many uses the other way.
+    for (&(u, v), &count) in &edges {
+        let both_border =
+            on_border(mesh.positions[u as usize]) && on_border(mesh.positions[v as usize]);
+        let back = edges.get(&(v, u)).copied().unwrap_or(0);
+        assert!(
+            both_border || back == count,
+            "edge {u}-{v}: {count} uses, {back} back"
+        );
+    }
+}
+
+#[test]
+fn vol_files_read_back() {
+    let data: Vec<f32> = (0..2 * 3 * 4 * 2).map(|v| v as f32 - 10.0).collect();
+    let grid = read_vol(&encode_vol([2, 3, 4], 2, &data), &Limits::default()).unwrap();
+    assert_eq!(grid.size, [2, 3, 4]);
+    assert_eq!(grid.channels, 2);
+    assert_eq!(grid.data, data);
+    assert_eq!(grid.bbox_max, Vec3::ONE);
+}
+
+#[test]
+fn lying_vol_headers_are_refused_without_allocating() {
+    let limits = Limits::default();
+    let good = encode_vol([3, 3, 3], 1, &sphere_grid(3, 0.3));
+    assert!(read_sdfgrid(&good, &limits).is_ok());
+    let refuse = |file: &[u8], words: &str| {
+        let error = read_sdfgrid(file, &limits).expect_err(words);
+        assert!(
+            error.to_string().contains(words),
+            "'{error}' does not say '{words}'"
+        );
+    };
+    // 2^40 samples (4 TiB) claimed over 27 floats: refused from the header alone. With no
+    // size check this would try to allocate 4 TiB and abort, so passing is the proof.
+    let mut huge = good.clone();
+    for (k, n) in [1i32 << 14, 1 << 13, 1 << 13].iter().enumerate() {
+        huge[8 + 4 * k..12 + 4 * k].copy_from_slice(&n.to_le_bytes());
+    }
+    refuse(&huge, "promises");
+    // Products past 2^64.
+    let mut overflow = good.clone();
+    for k in 0..4 {
+        overflow[8 + 4 * k..12 + 4 * k].copy_from_slice(&i32::MAX.to_le_bytes());
+    }
+    refuse(&overflow, "2^64");
+    // One float short, one too many.
+    refuse(&good[..good.len() - 4], "promises");
+    let mut long = good.clone();
+    long.extend(0f32.to_le_bytes());
+    refuse(&long, "promises");
+    // Negative and zero sizes, channels.
+    let mut negative = good.clone();
+    negative[12..16].copy_from_slice(&(-3i32).to_le_bytes());
+    refuse(&negative, "at least 1");
+    let mut zero = good.clone();
+    zero[20..24].copy_from_slice(&0i32.to_le_bytes());
+    refuse(&zero, "at least 1");
+    // Magic, version, encoding, short header.
+    let mut magic = good.clone();
+    magic[0] = b'X';
+    refuse(&magic, "VOL");
+    let mut version = good.clone();
+    version[3] = 4;
+    refuse(&version, "version");
+    let mut encoding = good.clone();
+    encoding[4] = 2;
+    refuse(&encoding, "encoding");
+    refuse(&good[..47], "header");
+    // Values and shapes sdfgrid cannot use.
+    let mut nan = sphere_grid(3, 0.3);
+    nan[13] = f32::NAN;
+    refuse(&encode_vol([3, 3, 3], 1, &nan), "NaN");
+    refuse(&encode_vol([3, 3, 1], 1, &[0.0; 9]), "at least 2");
+    refuse(&encode_vol([2, 2, 2], 3, &[0.0; 24]), "one channel");
+    let few_cells = Limits {
+        max_triangles: 7,
+        ..Limits::default()
+    };
+    let error = read_sdfgrid(&encode_vol([3, 3, 3], 1, &sphere_grid(3, 0.3)), &few_cells);
+    assert!(error.unwrap_err().to_string().contains("cells"));
+    // A checkerboard cuts every corner of its 8 cells: far more triangles than cells.
+    let checker: Vec<f32> = (0..27)
+        .map(|v| if v % 2 == 0 { -1.0 } else { 1.0 })
+        .collect();
+    let few_triangles = Limits {
+        max_triangles: 8,
+        ..Limits::default()
+    };
+    let error = read_sdfgrid(&encode_vol([3, 3, 3], 1, &checker), &few_triangles);
+    assert!(error.unwrap_err().to_string().contains("triangles"));
+}
