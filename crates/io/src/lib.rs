@@ -52,6 +52,7 @@ mod json;
 mod limits;
 mod mesh;
 mod mesh_file;
+mod mitsuba;
 mod obj;
 mod obj_fast;
 mod ply;
@@ -82,6 +83,16 @@ pub use mesh::Mesh;
 pub use mesh_file::{load_mesh, load_mesh_from, MeshError};
 pub use rays::{read_rays, write_hit_distances, write_rays, RayFileError};
 pub use scene_hash::scene_hash;
+
+/// Mitsuba 3's shape sources (`.serialized` meshes, `sdfgrid`, the tessellated `disk`,
+/// `cylinder` and `cube`), public only so that the integration tests and the fuzz targets can
+/// reach them; not part of the API, which is `load_scene`.
+#[doc(hidden)]
+pub mod mitsuba_shapes {
+    pub use crate::mitsuba::sdfgrid::*;
+    pub use crate::mitsuba::serialized::*;
+    pub use crate::mitsuba::shapes::*;
+}
 
 use diagnostic::Diagnostics;
 use read::Format;

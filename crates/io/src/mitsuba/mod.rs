@@ -1,0 +1,3 @@
+pub(crate) mod sdfgrid;
+pub(crate) mod serialized;
+pub(crate) mod shapes;
