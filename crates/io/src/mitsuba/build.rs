@@ -205,19 +205,20 @@ fn horizontal_fov(props: &Props, files: &Files, aspect: f64) -> Result<f64, Scen
         (Some(fov), None) => {
             let (name, span, file) =
                 axis.unwrap_or(("x".into(), props.element.span, props.element.file));
-            let name =
-                match name.to_lowercase().as_str() {
-                    "smaller" => if aspect > 1.0 { "y" } else { "x" }.to_owned(),
-                    "larger" => if aspect > 1.0 { "x" } else { "y" }.to_owned(),
-                    "x" | "y" | "diagonal" => name.to_lowercase(),
-                    _ => return Err(files.error(
+            let name = match name.to_lowercase().as_str() {
+                "smaller" => if aspect > 1.0 { "y" } else { "x" }.to_owned(),
+                "larger" => if aspect > 1.0 { "x" } else { "y" }.to_owned(),
+                "x" | "y" | "diagonal" => name.to_lowercase(),
+                _ => {
+                    return Err(files.error(
                         file,
                         span,
                         format!(
                             "`fov_axis` must be x, y, diagonal, smaller or larger, not \"{name}\""
                         ),
-                    )),
-                };
+                    ))
+                }
+            };
             (fov, name)
         }
         (None, focal) => {
@@ -760,12 +761,14 @@ impl<'a> Builder<'a> {
                     _ => return Err(self.error(p.file, p.span, "`color` must be an rgb")),
                 }
             }
-            other => return Err(self.element_error(
-                element,
-                format!(
+            other => {
+                return Err(self.element_error(
+                    element,
+                    format!(
                     "the spectrum `{other}` is not supported (Glint reads `uniform` and `srgb`)"
                 ),
-            )),
+                ))
+            }
         };
         props.check_all_used(self.files)?;
         Ok(value)
@@ -899,37 +902,39 @@ impl<'a> Builder<'a> {
                     .string(self.files, "filename")?
                     .ok_or_else(|| self.element_error(element, "`bitmap` needs a `filename`"))?;
                 let raw = props.boolean(self.files, "raw", false)?;
-                let filter =
-                    match props.string(self.files, "filter_type")? {
-                        None => TexelFilter::Bilinear,
-                        Some((text, span, file)) => match text.as_str() {
-                            "bilinear" => TexelFilter::Bilinear,
-                            "nearest" => TexelFilter::Nearest,
-                            _ => return Err(self.error(
+                let filter = match props.string(self.files, "filter_type")? {
+                    None => TexelFilter::Bilinear,
+                    Some((text, span, file)) => match text.as_str() {
+                        "bilinear" => TexelFilter::Bilinear,
+                        "nearest" => TexelFilter::Nearest,
+                        _ => {
+                            return Err(self.error(
                                 file,
                                 span,
                                 format!(
                                     "invalid filter type \"{text}\": must be nearest or bilinear"
                                 ),
-                            )),
-                        },
-                    };
-                let wrap =
-                    match props.string(self.files, "wrap_mode")? {
-                        None => Wrap::Repeat,
-                        Some((text, span, file)) => match text.as_str() {
-                            "repeat" => Wrap::Repeat,
-                            "mirror" => Wrap::Mirror,
-                            "clamp" => Wrap::Clamp,
-                            _ => return Err(self.error(
+                            ))
+                        }
+                    },
+                };
+                let wrap = match props.string(self.files, "wrap_mode")? {
+                    None => Wrap::Repeat,
+                    Some((text, span, file)) => match text.as_str() {
+                        "repeat" => Wrap::Repeat,
+                        "mirror" => Wrap::Mirror,
+                        "clamp" => Wrap::Clamp,
+                        _ => {
+                            return Err(self.error(
                                 file,
                                 span,
                                 format!(
                                     "invalid wrap mode \"{text}\": must be repeat, mirror or clamp"
                                 ),
-                            )),
-                        },
-                    };
+                            ))
+                        }
+                    },
+                };
                 if let Some((format, span, file)) = props.string(self.files, "format")? {
                     if format != "auto" && format != "variant" {
                         self.files.warn(
@@ -976,14 +981,16 @@ impl<'a> Builder<'a> {
                         Value::Float(v) => [*v; 3],
                         Value::Integer(v) => [*v as f64; 3],
                         Value::Rgb(c) | Value::Vector(c) | Value::Point(c) => *c,
-                        other => return Err(self.error(
-                            p.file,
-                            p.span,
-                            format!(
+                        other => {
+                            return Err(self.error(
+                                p.file,
+                                p.span,
+                                format!(
                                 "`value` of `rawconstant` must be a float, rgb or vector, not {}",
                                 other.kind()
                             ),
-                        )),
+                            ))
+                        }
                     },
                 };
                 let c = color(value);
