@@ -1717,14 +1717,14 @@ impl<'a> Builder<'a> {
             "sphere" => {
                 let center = props.vector(self.files, "center")?.unwrap_or([0.0; 3]);
                 let radius = props.float(self.files, "radius", 1.0)?;
-                if !(radius > 0.0) {
+                if radius <= 0.0 || radius.is_nan() {
                     let p = props.get("radius").expect("a bad radius was given");
                     return Err(self.error(p.file, p.span, "the radius must be positive"));
                 }
                 let mut local = Matrix4::IDENTITY;
-                for axis in 0..3 {
+                for (axis, offset) in center.iter().enumerate() {
                     local.m[axis][axis] = radius;
-                    local.m[axis][3] = center[axis];
+                    local.m[axis][3] = *offset;
                 }
                 (
                     Some(Shape::Sphere {
@@ -2004,7 +2004,7 @@ impl<'a> Builder<'a> {
                     (None, Some(m)) => column(&m, 2),
                     (None, None) => Vec3::new(0.0, 0.0, 1.0),
                 };
-                if !(direction.length_squared() > 0.0) || !direction.is_finite() {
+                if direction.length_squared() <= 0.0 || !direction.is_finite() {
                     return Err(self.element_error(element, "the direction must not be zero"));
                 }
                 self.parts.lights.push(Light::Directional {
