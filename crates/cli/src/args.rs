@@ -157,6 +157,25 @@ pub struct LimitOptions {
     #[arg(long, value_name = "N", default_value_t = glint_io::Limits::default().max_triangles,
           hide_default_value = true)]
     pub max_triangles: u64,
+
+    /// Set a Mitsuba scene's parameter `$NAME` to VALUE, over its `<default>` (as Mitsuba's
+    /// -D); repeatable.
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define,
+          action = ArgAction::Append)]
+    pub defines: Vec<(String, String)>,
+}
+
+/// `NAME=VALUE` of `-D`.
+fn parse_define(text: &str) -> Result<(String, String), String> {
+    let (name, value) = text
+        .split_once('=')
+        .ok_or_else(|| format!("`{text}` is not NAME=VALUE"))?;
+    if name.is_empty() || !name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_') {
+        return Err(format!(
+            "`{name}` is not a parameter name (letters, digits and _)"
+        ));
+    }
+    Ok((name.to_owned(), value.to_owned()))
 }
 
 impl LimitOptions {

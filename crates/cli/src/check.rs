@@ -9,10 +9,16 @@ use crate::report::{located, plural};
 /// `glint check`: loads every scene under `limits`, prints every diagnostic (warnings as
 /// errors with `strict`) and a line per scene, and returns the exit status: 0 when every scene
 /// loads (with `strict`: without warnings), 2 otherwise.
-pub fn run(scenes: &[PathBuf], limits: &glint_io::Limits, strict: bool, err: &mut dyn Write) -> u8 {
+pub fn run(
+    scenes: &[PathBuf],
+    limits: &glint_io::Limits,
+    defines: &[(String, String)],
+    strict: bool,
+    err: &mut dyn Write,
+) -> u8 {
     let mut failed = 0usize;
     for scene in scenes {
-        match glint_io::load_scene_limited(scene, limits) {
+        match glint_io::load_scene_limited_with_defines(scene, limits, defines) {
             Ok(loaded) => {
                 let label = if strict { "error" } else { "warning" };
                 for warning in &loaded.warnings {

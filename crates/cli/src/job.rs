@@ -60,6 +60,8 @@ pub struct Job {
     pub strict: bool,
     /// What the loader may read.
     pub limits: glint_io::Limits,
+    /// `-D NAME=VALUE` for Mitsuba scenes.
+    pub defines: Vec<(String, String)>,
     /// The memory estimate's budget, in bytes.
     pub max_memory: u64,
     /// `--checkpoint` / `--resume`.
@@ -216,6 +218,7 @@ impl Options {
         let (limits, max_memory) = self.limits.resolve();
         Ok(Job {
             strict: self.limits.strict,
+            defines: self.limits.defines.clone(),
             limits,
             max_memory,
             scene,

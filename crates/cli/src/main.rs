@@ -56,7 +56,13 @@ fn main() -> ExitCode {
     }
     if let Some(crate::args::Command::Check { scenes, limits, .. }) = &cli.command {
         let (resolved, _) = limits.resolve();
-        let status = check::run(scenes, &resolved, limits.strict, &mut std::io::stderr());
+        let status = check::run(
+            scenes,
+            &resolved,
+            &limits.defines,
+            limits.strict,
+            &mut std::io::stderr(),
+        );
         return ExitCode::from(status);
     }
     if matches!(cli.command, Some(crate::args::Command::Merge(_))) {

@@ -217,6 +217,7 @@ mod tests {
             notes: Vec::new(),
             strict: false,
             limits: glint_io::Limits::default(),
+            defines: Vec::new(),
             max_memory: 1 << 30,
             checkpoint: None,
             progress_every: Duration::from_secs(5),

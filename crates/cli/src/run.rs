@@ -156,7 +156,7 @@ fn load(
         .min(job.max_memory.saturating_sub(film_bytes));
     // In the pool, so that `-n` also bounds the threads that read meshes.
     let loaded = pool
-        .install(|| glint_io::load_scene_limited(&job.scene, &limits))
+        .install(|| glint_io::load_scene_limited_with_defines(&job.scene, &limits, &job.defines))
         .map_err(Failure::Scene)?;
     if job.strict && !loaded.warnings.is_empty() {
         for warning in &loaded.warnings {

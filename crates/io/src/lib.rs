@@ -113,13 +113,23 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, SceneError> {
 /// [`load_scene`] under `limits`: the scene file and every asset are refused, with an error,
 /// when over them.
 pub fn load_scene_limited(path: &Path, limits: &Limits) -> Result<LoadedScene, SceneError> {
+    load_scene_limited_with_defines(path, limits, &[])
+}
+
+/// [`load_scene_limited`] with a Mitsuba scene's `-D name=value` defines (see
+/// [`load_scene_with_defines`]).
+pub fn load_scene_limited_with_defines(
+    path: &Path,
+    limits: &Limits,
+    defines: &[(String, String)],
+) -> Result<LoadedScene, SceneError> {
     let bytes =
         read_file_at_most(path, limits.max_file_bytes).map_err(|source| SceneError::Io {
             path: path.to_path_buf(),
             source,
         })?;
     match String::from_utf8(bytes) {
-        Ok(text) => load_scene_with_assets_limited(&text, path, &FileSystem, limits),
+        Ok(text) => load_scene_with_defines(&text, path, &FileSystem, limits, defines),
         Err(error) => {
             let valid_up_to = error.utf8_error().valid_up_to();
             let valid = String::from_utf8_lossy(&error.as_bytes()[..valid_up_to]).into_owned();
@@ -175,8 +185,25 @@ pub fn load_scene_with_assets_limited(
     assets: &dyn Assets,
     limits: &Limits,
 ) -> Result<LoadedScene, SceneError> {
+    load_scene_with_defines(text, path, assets, limits, &[])
+}
+
+/// Loads a scene from its text as [`load_scene_with_assets_limited`] does, with `defines`:
+/// `name=value` pairs that a Mitsuba scene's `$name` references read, winning over its
+/// `<default>`s (Mitsuba's `-D`). Course scenes have no parameters and ignore them.
+pub fn load_scene_with_defines(
+    text: &str,
+    path: &Path,
+    assets: &dyn Assets,
+    limits: &Limits,
+    defines: &[(String, String)],
+) -> Result<LoadedScene, SceneError> {
     // A byte-order mark is not part of line 1's columns.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+    // A Mitsuba 3 scene's root is `<scene version="...">`; the course's has no version.
+    if mitsuba::is_mitsuba(text) {
+        return mitsuba::load(text, path, assets, limits, defines);
+    }
     let mut diagnostics = Diagnostics::new(path, text);
     let format = detect_format(text, path, &diagnostics)?;
     let json_syntax;

@@ -229,6 +229,127 @@ fn parse_with(bytes: &[u8], fast: bool) -> Result<PlyMesh, PlyError> {
     Ok((positions, triangles))
 }
 
+/// A PLY mesh with every scalar property of its vertices and faces, for readers that use
+/// more than positions (Mitsuba's `ply` shape: normals, uv, colours and other attributes).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct PlyAttributes {
+    pub positions: Vec<[f32; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    /// For each triangle, the face (record of the `face` element) it was cut from.
+    pub triangle_faces: Vec<u32>,
+    /// Scalar vertex properties other than x, y, z, by name, one value a vertex.
+    pub vertex_columns: Vec<(String, Vec<f32>)>,
+    /// Scalar face properties, by name, one value a face.
+    pub face_columns: Vec<(String, Vec<f32>)>,
+}
+
+/// Reads every scalar property of the `vertex` and `face` elements (the general reader
+/// only: these files are small next to the scanned models the fast paths serve).
+/// `max_triangles` is checked as faces are cut, so a hostile file stops early.
+pub(crate) fn parse_attributes(
+    bytes: &[u8],
+    max_triangles: u64,
+) -> Result<PlyAttributes, PlyError> {
+    let (encoding, elements, body_start) = parse_header(bytes)?;
+    let body = &bytes[body_start..];
+    let binary = |big_endian| {
+        Reader::Binary(BinaryReader {
+            bytes: body,
+            position: 0,
+            big_endian,
+        })
+    };
+    let mut reader = match encoding {
+        Encoding::Ascii => Reader::Ascii(AsciiReader::new(body)),
+        Encoding::BinaryLittleEndian => binary(false),
+        Encoding::BinaryBigEndian => binary(true),
+    };
+    let mut out = PlyAttributes::default();
+    let mut polygon: Vec<i64> = Vec::new();
+    for element in &elements {
+        let is_vertex = element.name == "vertex";
+        let is_face = element.name == "face";
+        let scalar_names: Vec<Option<String>> = element
+            .properties
+            .iter()
+            .map(|p| match p {
+                Property::Scalar { name, .. } => Some(name.clone()),
+                Property::List { .. } => None,
+            })
+            .collect();
+        let mut columns: Vec<(String, Vec<f32>)> = scalar_names
+            .iter()
+            .flatten()
+            .filter(|name| !(is_vertex && matches!(name.as_str(), "x" | "y" | "z")))
+            .map(|name| (name.clone(), Vec::new()))
+            .collect();
+        let axis = |name: &str| scalar_names.iter().position(|n| n.as_deref() == Some(name));
+        let xyz = (axis("x"), axis("y"), axis("z"));
+        if is_vertex && !matches!(xyz, (Some(_), Some(_), Some(_))) {
+            return error("the vertex element has no x, y and z properties");
+        }
+        let list = element.properties.iter().position(|p| {
+            matches!(p, Property::List { name, .. } if name == "vertex_indices" || name == "vertex_index")
+        });
+        if is_face && list.is_none() {
+            return error("the face element has no vertex_indices list");
+        }
+        let capacity = element.count.min(body.len());
+        if is_vertex {
+            out.positions.reserve(capacity);
+        }
+        for index in 0..element.count {
+            let mut position = [0.0f32; 3];
+            let mut column = 0;
+            for (k, property) in element.properties.iter().enumerate() {
+                match property {
+                    Property::Scalar { kind, name } => {
+                        let value = reader.scalar(*kind)?;
+                        if is_vertex && matches!(name.as_str(), "x" | "y" | "z") {
+                            position[usize::from(name.as_bytes()[0] - b'x')] = value as f32;
+                        } else if is_vertex || is_face {
+                            columns[column].1.push(value as f32);
+                            column += 1;
+                        }
+                    }
+                    Property::List { count, item, .. } => {
+                        let n = reader.count(*count)?;
+                        polygon.clear();
+                        for _ in 0..n {
+                            polygon.push(reader.scalar(*item)? as i64);
+                        }
+                        if is_face && Some(k) == list {
+                            let before = out.triangles.len();
+                            push_fan(&polygon, out.positions.len(), &mut out.triangles)?;
+                            if out.triangles.len() as u64 > max_triangles {
+                                return error(format!(
+                                    "its faces make more than the limit of {max_triangles} \
+                                     triangles (--max-triangles raises it)"
+                                ));
+                            }
+                            let cut = out.triangles.len() - before;
+                            out.triangle_faces
+                                .extend(std::iter::repeat_n(index as u32, cut));
+                        }
+                    }
+                }
+            }
+            if is_vertex {
+                if !position.iter().all(|c| c.is_finite()) {
+                    return error(format!("vertex {index} is not finite"));
+                }
+                out.positions.push(position);
+            }
+        }
+        if is_vertex {
+            out.vertex_columns = columns;
+        } else if is_face {
+            out.face_columns = columns;
+        }
+    }
+    Ok(out)
+}
+
 /// The first records of a binary `vertex` element whose properties are all scalars, read at
 /// their fixed offsets: as many as the body holds whole (the general reader takes the rest and
 /// reports the end of the file). Returns how many were read.

@@ -122,6 +122,42 @@ impl Checked {
         }
     }
 
+    /// The image as linear RGB for a physically based scene (Mitsuba's `bitmap` and
+    /// `envmap`): 8-bit levels are sRGB-encoded and decoded here unless `raw` asks for the
+    /// stored values (normal maps, masks meant as data); float images are linear already.
+    pub(crate) fn decode_srgb(self, raw: bool) -> Result<Image, AssetError> {
+        match self.decode_levels()? {
+            Decoded::Float(image) => Ok(image),
+            Decoded::Levels(rgb) => {
+                let (width, height) = rgb.dimensions();
+                let table: Vec<f32> = (0..=255u8)
+                    .map(|level| {
+                        let v = f32::from(level) / 255.0;
+                        if raw {
+                            v
+                        } else if v <= 0.04045 {
+                            v / 12.92
+                        } else {
+                            ((v + 0.055) / 1.055).powf(2.4)
+                        }
+                    })
+                    .collect();
+                let texels = rgb
+                    .pixels()
+                    .map(|pixel| {
+                        let [r, g, b] = pixel.0.map(|level| table[usize::from(level)]);
+                        Color::new(r, g, b)
+                    })
+                    .collect();
+                Ok(Image {
+                    width,
+                    height,
+                    texels,
+                })
+            }
+        }
+    }
+
     /// A vertical-cross environment map's six faces (`cut_vertical_cross`); an 8-bit cross's
     /// faces are made straight from its levels, the six cells outside the cross never made
     /// into texels (half the cross's texels, and as many more copied into the faces). The

@@ -39,11 +39,11 @@ pub(crate) fn parse<'text>(
 /// Far deeper than any scene needs (the course's deepest is 4). roxmltree and the conversion
 /// below descend recursively, so a file nested thousands deep would overflow the stack before
 /// it could report anything; such files are refused up front.
-const MAX_NESTING: usize = 100;
+pub(crate) const MAX_NESTING: usize = 100;
 
 /// Counts open and close tags outside comments, CDATA and declarations, and fails where the
 /// nesting gets too deep. Malformed markup is left for roxmltree to report.
-fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError> {
+pub(crate) fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError> {
     match too_deep(text.as_bytes()) {
         None => Ok(()),
         Some(start) => Err(diagnostics.error(

@@ -1,3 +1,135 @@
+//! Mitsuba 3 scenes (`<scene version="...">`): the XML with its includes, defaults and
+//! references (`parse.rs`), each object's typed properties (`props.rs`), spectra as Mitsuba's
+//! RGB variants convert them (`spectrum.rs`, `tables.rs`), meshes with their attributes
+//! (`meshes.rs`), and the assembly into `SceneParts` (`build.rs`).
+
+mod build;
+mod meshes;
+mod parse;
+mod props;
 pub(crate) mod sdfgrid;
 pub(crate) mod serialized;
 pub(crate) mod shapes;
+mod spectrum;
+mod tables;
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use crate::assets::Assets;
+use crate::desc::Span;
+use crate::diagnostic::{Diagnostic, Diagnostics, SceneError};
+use crate::limits::Limits;
+use crate::LoadedScene;
+
+/// The files of one load (the scene and what it includes), each with its text, so that any
+/// element's `Span` can become a located diagnostic.
+pub(crate) struct Files {
+    files: Vec<(PathBuf, Arc<str>)>,
+    warnings: Vec<Diagnostic>,
+}
+
+impl Files {
+    fn new(path: &Path, text: &str) -> Files {
+        Files {
+            files: vec![(path.to_path_buf(), Arc::from(text))],
+            warnings: Vec::new(),
+        }
+    }
+
+    pub fn add(&mut self, path: PathBuf, text: String) -> usize {
+        self.files.push((path, Arc::from(text)));
+        self.files.len() - 1
+    }
+
+    pub fn text(&self, file: usize) -> Arc<str> {
+        self.files[file].1.clone()
+    }
+
+    pub fn path(&self, file: usize) -> &Path {
+        &self.files[file].0
+    }
+
+    /// The folder of file `file`, which its relative names start from.
+    pub fn folder(&self, file: usize) -> PathBuf {
+        self.files[file]
+            .0
+            .parent()
+            .unwrap_or(Path::new(""))
+            .to_path_buf()
+    }
+
+    pub fn error(&self, file: usize, span: Span, message: impl Into<String>) -> SceneError {
+        let (path, text) = &self.files[file];
+        Diagnostics::new(path, text).error(span, message)
+    }
+
+    pub fn warn(&mut self, file: usize, span: Span, message: impl Into<String>) {
+        let message = message.into();
+        let duplicate = self
+            .warnings
+            .iter()
+            .any(|w| w.line == span.line && w.column == span.column && w.message == message);
+        if duplicate {
+            return;
+        }
+        let (path, text) = &self.files[file];
+        let mut diagnostics = Diagnostics::new(path, text);
+        diagnostics.warn(span, message);
+        self.warnings.extend(diagnostics.into_warnings());
+    }
+}
+
+/// Whether `text` is a Mitsuba scene: its first element is `<scene` with a `version`
+/// attribute (the course's `<scene>` has none).
+pub(crate) fn is_mitsuba(text: &str) -> bool {
+    let mut rest = text;
+    loop {
+        rest = rest.trim_start();
+        if let Some(after) = rest.strip_prefix("<?") {
+            let Some(end) = after.find("?>") else {
+                return false;
+            };
+            rest = &after[end + 2..];
+        } else if let Some(after) = rest.strip_prefix("<!--") {
+            let Some(end) = after.find("-->") else {
+                return false;
+            };
+            rest = &after[end + 3..];
+        } else if let Some(after) = rest.strip_prefix("<!") {
+            let Some(end) = after.find('>') else {
+                return false;
+            };
+            rest = &after[end + 1..];
+        } else {
+            break;
+        }
+    }
+    let Some(after) = rest.strip_prefix("<scene") else {
+        return false;
+    };
+    if !after.starts_with(|c: char| c.is_whitespace()) {
+        return false;
+    }
+    let tag = &after[..after.find('>').unwrap_or(after.len())];
+    tag.split(|c: char| c.is_whitespace() || c == '=')
+        .any(|word| word == "version")
+}
+
+/// Loads a Mitsuba scene from its text; `defines` are `-D name=value` pairs, which win over
+/// the scene's `<default>`s.
+pub(crate) fn load(
+    text: &str,
+    path: &Path,
+    assets: &dyn Assets,
+    limits: &Limits,
+    defines: &[(String, String)],
+) -> Result<LoadedScene, SceneError> {
+    let mut files = Files::new(path, text);
+    let parsed = parse::parse(&mut files, defines, assets, limits)?;
+    let parts = build::build(&parsed, &mut files, assets, limits)?;
+    Ok(LoadedScene {
+        parts,
+        warnings: files.warnings,
+    })
+}
