@@ -1,5 +1,6 @@
 //! Lights of the course: point lights, rectangular area lights and shape emitters.
 
+pub mod envmap;
 pub mod sampler;
 
 use crate::math::{Color, Frame, Transform, Vec3};
