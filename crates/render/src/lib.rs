@@ -94,7 +94,7 @@ pub use scene::physical::{
 pub use scene::{Background, BvhStats, GeometryDesc, Instance, Scene, SceneOptions, SceneParts};
 pub use texture::{
     ColorSource, CubeMap, Image, MeshAttribute, TexelFilter, TextureId, TextureKind, TextureNode,
-    Wrap, IDENTITY_UV,
+    TexturePoint, Wrap, IDENTITY_UV,
 };
 
 // Rendering it.

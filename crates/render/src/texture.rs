@@ -362,7 +362,8 @@ pub struct TextureNode {
 #[derive(Clone, Debug, PartialEq)]
 pub enum TextureKind {
     /// `SceneParts::textures[image]`, already linear unless the scene asked for `raw` data.
-    /// Row 0 of the image is at v = 1 (Mitsuba's convention after its OBJ reader's flip).
+    /// Texel row `floor(v · height)` counts from the top of the image, as Mitsuba reads
+    /// bitmaps (its OBJ reader stores 1 − v, so an OBJ's v = 1 is the top row).
     Bitmap {
         image: TextureId,
         filter: TexelFilter,
@@ -376,3 +377,217 @@ pub enum TextureKind {
 
 /// The identity `to_uv`.
 pub const IDENTITY_UV: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
+
+/// What a texture reads at a surface point: texture coordinates and the mesh's colours there
+/// (black where the mesh has none).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TexturePoint {
+    pub uv: (f32, f32),
+    pub vertex_color: Color,
+    pub face_color: Color,
+}
+
+impl TextureNode {
+    /// The texture's colour at `at`, reading its image from `images`; black for an image
+    /// index out of range or an empty image (the loader never makes either).
+    pub fn eval(&self, images: &[Image], at: &TexturePoint) -> Color {
+        let [[a, b, c], [d, e, f]] = self.to_uv;
+        let (u0, v0) = at.uv;
+        let (u, v) = (a * u0 + b * v0 + c, d * u0 + e * v0 + f);
+        match &self.kind {
+            TextureKind::Bitmap {
+                image,
+                filter,
+                wrap,
+            } => match images.get(*image as usize) {
+                Some(image) if !image.texels.is_empty() => {
+                    bitmap_lookup(image, *filter, *wrap, u, v)
+                }
+                _ => Color::ZERO,
+            },
+            TextureKind::Checkerboard { color0, color1 } => {
+                // The squares of one colour are where both fractional parts lie on the same
+                // side of 1/2.
+                let upper = |x: f32| x - x.floor() > 0.5;
+                if upper(u) == upper(v) {
+                    *color0
+                } else {
+                    *color1
+                }
+            }
+            TextureKind::MeshAttribute(MeshAttribute::VertexColor) => at.vertex_color,
+            TextureKind::MeshAttribute(MeshAttribute::FaceColor) => at.face_color,
+        }
+    }
+}
+
+/// Texel coordinate `x` of an axis of `size` texels, brought inside by `wrap`.
+#[inline]
+fn wrap_texel(x: i64, size: u32, wrap: Wrap) -> u32 {
+    let n = size as i64;
+    let wrapped = match wrap {
+        Wrap::Repeat => x.rem_euclid(n),
+        Wrap::Clamp => x.clamp(0, n - 1),
+        // Every other copy is reversed: period 2n.
+        Wrap::Mirror => {
+            let m = x.rem_euclid(2 * n);
+            if m >= n {
+                2 * n - 1 - m
+            } else {
+                m
+            }
+        }
+    };
+    wrapped as u32
+}
+
+/// A bitmap at (u, v): texel (floor(u·w), floor(v·h)) for `Nearest`; for `Bilinear` the
+/// four texels around (u·w − 1/2, v·h − 1/2), whose centres sit at half-integers.
+fn bitmap_lookup(image: &Image, filter: TexelFilter, wrap: Wrap, u: f32, v: f32) -> Color {
+    let (w, h) = (image.width, image.height);
+    // Far outside [0, 1] only the wrap matters; the clamp keeps the casts defined.
+    let limit = 1.0e9;
+    let (x, y) = (
+        (u * w as f32).clamp(-limit, limit),
+        (v * h as f32).clamp(-limit, limit),
+    );
+    if !(x.is_finite() && y.is_finite()) {
+        return Color::ZERO;
+    }
+    let texel = |x: i64, y: i64| {
+        let (x, y) = (wrap_texel(x, w, wrap), wrap_texel(y, h, wrap));
+        image.texels[(y as usize) * (w as usize) + x as usize]
+    };
+    match filter {
+        TexelFilter::Nearest => texel(x.floor() as i64, y.floor() as i64),
+        TexelFilter::Bilinear => {
+            let (x, y) = (x - 0.5, y - 0.5);
+            let (x0, y0) = (x.floor(), y.floor());
+            let (fx, fy) = (x - x0, y - y0);
+            let (x0, y0) = (x0 as i64, y0 as i64);
+            let top = texel(x0, y0) * (1.0 - fx) + texel(x0 + 1, y0) * fx;
+            let bottom = texel(x0, y0 + 1) * (1.0 - fx) + texel(x0 + 1, y0 + 1) * fx;
+            top * (1.0 - fy) + bottom * fy
+        }
+    }
+}
+
+#[cfg(test)]
+mod mitsuba_texture_tests {
+    use super::*;
+
+    /// A 2 x 2 image whose texels are (column, row, 0).
+    fn grid() -> Image {
+        let texels = (0..4)
+            .map(|i| Color::new((i % 2) as f32, (i / 2) as f32, 0.0))
+            .collect();
+        Image {
+            width: 2,
+            height: 2,
+            texels,
+        }
+    }
+
+    fn bitmap(filter: TexelFilter, wrap: Wrap) -> TextureNode {
+        TextureNode {
+            kind: TextureKind::Bitmap {
+                image: 0,
+                filter,
+                wrap,
+            },
+            to_uv: IDENTITY_UV,
+        }
+    }
+
+    fn at(u: f32, v: f32) -> TexturePoint {
+        TexturePoint {
+            uv: (u, v),
+            ..TexturePoint::default()
+        }
+    }
+
+    #[test]
+    fn nearest_reads_rows_from_the_top_and_wraps_each_way() {
+        let images = [grid()];
+        let repeat = bitmap(TexelFilter::Nearest, Wrap::Repeat);
+        assert_eq!(
+            repeat.eval(&images, &at(0.25, 0.25)),
+            Color::new(0.0, 0.0, 0.0)
+        );
+        assert_eq!(
+            repeat.eval(&images, &at(0.75, 0.25)),
+            Color::new(1.0, 0.0, 0.0)
+        );
+        assert_eq!(
+            repeat.eval(&images, &at(0.25, 0.75)),
+            Color::new(0.0, 1.0, 0.0)
+        );
+        // Texel column −1: repeat gives the last column, clamp the first, mirror the first.
+        let u = -0.25;
+        assert_eq!(repeat.eval(&images, &at(u, 0.25)).x, 1.0);
+        let clamp = bitmap(TexelFilter::Nearest, Wrap::Clamp);
+        assert_eq!(clamp.eval(&images, &at(u, 0.25)).x, 0.0);
+        let mirror = bitmap(TexelFilter::Nearest, Wrap::Mirror);
+        assert_eq!(mirror.eval(&images, &at(u, 0.25)).x, 0.0);
+        // Column −3 (u = −1.25): repeat → 1, mirror → the reversed copy's column 1... i.e. 1.
+        assert_eq!(repeat.eval(&images, &at(-1.25, 0.25)).x, 1.0);
+        assert_eq!(mirror.eval(&images, &at(-1.25, 0.25)).x, 1.0);
+        // Column 2 (u = 1.25): mirror reads column 1, repeat column 0.
+        assert_eq!(mirror.eval(&images, &at(1.25, 0.25)).x, 1.0);
+        assert_eq!(repeat.eval(&images, &at(1.25, 0.25)).x, 0.0);
+    }
+
+    #[test]
+    fn bilinear_interpolates_between_texel_centres() {
+        let images = [grid()];
+        let clamp = bitmap(TexelFilter::Bilinear, Wrap::Clamp);
+        // Texel centres sit at 1/4 and 3/4: the image's centre is the mean of all four.
+        let centre = clamp.eval(&images, &at(0.5, 0.5));
+        assert!((centre.x - 0.5).abs() < 1e-6 && (centre.y - 0.5).abs() < 1e-6);
+        // A third of the way from centre 1/4 to centre 3/4 in u.
+        let third = clamp.eval(&images, &at(0.25 + 0.5 / 3.0, 0.25));
+        assert!((third.x - 1.0 / 3.0).abs() < 1e-5, "{third:?}");
+        assert!(third.y.abs() < 1e-6);
+        // At a texel centre it is that texel.
+        assert_eq!(
+            clamp.eval(&images, &at(0.75, 0.75)),
+            Color::new(1.0, 1.0, 0.0)
+        );
+    }
+
+    #[test]
+    fn checkerboard_and_to_uv() {
+        let node = TextureNode {
+            kind: TextureKind::Checkerboard {
+                color0: Color::splat(0.4),
+                color1: Color::splat(0.2),
+            },
+            to_uv: [[2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+        };
+        // uv (0.1, 0.1) → (0.2, 0.2): both halves lower → colour 0.
+        assert_eq!(node.eval(&[], &at(0.1, 0.1)).x, 0.4);
+        // (0.3, 0.1) → (0.6, 0.2): different halves → colour 1.
+        assert_eq!(node.eval(&[], &at(0.3, 0.1)).x, 0.2);
+        // (0.3, 0.3) → (0.6, 0.6): both upper → colour 0.
+        assert_eq!(node.eval(&[], &at(0.3, 0.3)).x, 0.4);
+    }
+
+    #[test]
+    fn mesh_attributes_come_from_the_point() {
+        let vertex = TextureNode {
+            kind: TextureKind::MeshAttribute(MeshAttribute::VertexColor),
+            to_uv: IDENTITY_UV,
+        };
+        let face = TextureNode {
+            kind: TextureKind::MeshAttribute(MeshAttribute::FaceColor),
+            to_uv: IDENTITY_UV,
+        };
+        let point = TexturePoint {
+            uv: (0.0, 0.0),
+            vertex_color: Color::new(0.1, 0.2, 0.3),
+            face_color: Color::new(0.4, 0.5, 0.6),
+        };
+        assert_eq!(vertex.eval(&[], &point), point.vertex_color);
+        assert_eq!(face.eval(&[], &point), point.face_color);
+    }
+}

@@ -4,6 +4,7 @@
 //! `scatter.rs` on the stack.
 
 use crate::math::Color;
+use crate::texture::{Image, TextureNode, TexturePoint};
 
 /// A parameter that is a constant or a texture (`SceneParts::physical.textures[i]`). A float
 /// parameter is a `Param` whose colour is grey; a texture read as a float gives its
@@ -18,6 +19,33 @@ impl Param {
     /// A grey constant.
     pub const fn value(v: f32) -> Param {
         Param::Constant(Color::new(v, v, v))
+    }
+
+    /// The colour at `at`; black for a texture index out of range (the loader never makes
+    /// one).
+    #[inline]
+    pub fn eval(&self, nodes: &[TextureNode], images: &[Image], at: &TexturePoint) -> Color {
+        match self {
+            Param::Constant(c) => *c,
+            Param::Texture(i) => nodes
+                .get(*i as usize)
+                .map_or(Color::ZERO, |node| node.eval(images, at)),
+        }
+    }
+
+    /// The value of a float parameter: a constant's first channel, a texture's luminance
+    /// (Mitsuba's `eval_1` of RGB data).
+    #[inline]
+    pub fn eval_float(&self, nodes: &[TextureNode], images: &[Image], at: &TexturePoint) -> f32 {
+        match self {
+            Param::Constant(c) => c.x,
+            Param::Texture(_) => self.eval(nodes, images, at).luminance(),
+        }
+    }
+
+    /// Whether the value depends on the surface point.
+    pub fn is_textured(&self) -> bool {
+        matches!(self, Param::Texture(_))
     }
 }
 
