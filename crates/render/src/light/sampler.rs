@@ -27,7 +27,7 @@ use crate::sampling::warp::{
 };
 use crate::scene::{Background, Scene};
 use crate::texture::CubeMap;
-use crate::texture::Image;
+use crate::texture::{Image, TexturePoint};
 use rayon::prelude::*;
 
 use std::f32::consts::PI;
@@ -668,7 +668,7 @@ impl LightSampler {
                 aspect,
             } => {
                 let local = to_world.point_to_object(reference);
-                if !(local.z > 0.0) {
+                if local.z.is_nan() || local.z <= 0.0 {
                     return None;
                 }
                 // Mitsuba's perspective projection onto its texture's uv (v = 0 on the top
@@ -1038,12 +1038,20 @@ fn delta_sample(
 }
 
 /// Texture `node` of `PhysicalParts::textures` at (u, v) in Mitsuba's texture space, where
-/// v = 0 is the image's top row (a spot's and a projector's uv are computed there).
+/// v = 0 is the image's top row (a spot's and a projector's uv are computed there, as
+/// `TextureNode::eval` reads them); black for a node out of range.
 #[inline]
 fn texture_value(scene: &Scene, node: u32, uv: (f32, f32)) -> Color {
-    // TODO(emitters): the lead's TextureNode evaluation; until it lands, white.
-    let _ = (scene, node, uv);
-    Color::ONE
+    match scene.physical.textures.get(node as usize) {
+        Some(texture) => texture.eval(
+            &scene.textures,
+            &TexturePoint {
+                uv,
+                ..TexturePoint::default()
+            },
+        ),
+        None => Color::ZERO,
+    }
 }
 
 /// Width / height of texture `node`, as Mitsuba's `Texture::resolution` gives it: the
@@ -1384,9 +1392,13 @@ impl LatLongDistribution {
         // Cells start at texel centres: half a texel on in u.
         let map_u = (column as f32 + 0.5 + u_offset) / self.columns as f32;
         let map_v = (row as f32 + v_offset) / self.rows as f32;
-        let (local, sin_theta) = uv_to_direction(map_u, map_v);
+        let local = uv_to_direction(map_u, map_v).0;
         let direction = self.to_world.vector_to_world(local).normalized();
         let density = row_probability * column_probability * (self.columns * self.rows) as f32;
+        // sin θ of the direction as `pdf` computes it: near the poles a few ulps of rounding
+        // in the turn are a large share of sin θ, and both must give the same density.
+        let back = self.to_world.vector_to_object(direction).normalized();
+        let sin_theta = (back.x * back.x + back.z * back.z).sqrt();
         let pdf = density / (2.0 * PI * PI * sin_theta.max(POLE_SIN_THETA));
         (pdf > 0.0 && pdf.is_finite() && direction.is_finite()).then_some((direction, pdf))
     }
