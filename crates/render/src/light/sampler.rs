@@ -7,11 +7,17 @@
 //!   (v1 − v0) × (v2 − v0), outward from a sphere. Rectangles and triangles are sampled
 //!   uniformly by area and converted to solid angle (pdf_area · r² / cos θ_light); spheres by
 //!   the cone they subtend (uniform in solid angle, pbrt's `Sphere::Sample(ctx)`).
-//! - Point lights are Dirac deltas of intensity I: radiance I / r² arrives.
+//! - Point lights are Dirac deltas of intensity I: radiance I / r² arrives (Mitsuba's `point`).
+//! - Mitsuba's delta emitters, as its 3.9 plugins define them: a `spot` sends I · falloff ·
+//!   texture / r², the falloff linear in the angle from the beam width to the cutoff; a
+//!   `directional` light sends E from infinitely far; a `projector` sends
+//!   π · scale · E(uv) / (z² cos θ) inside its frustum, so that E · π is the irradiance at
+//!   z = 1 (Mitsuba's factor π included).
 //! - The background is an infinite light: a constant colour sampled uniformly over the sphere,
 //!   a cube map (six faces or a vertical cross cut into faces by the loader) sampled in
 //!   proportion to luminance × texel solid angle with a row/column piecewise-constant
-//!   distribution (pbrt's `PiecewiseConstant2D`, here over the cube's texels).
+//!   distribution (pbrt's `PiecewiseConstant2D`, here over the cube's texels), or Mitsuba's
+//!   latitude-longitude `envmap` (`light::envmap`) by luminance × sin θ over its texel grid.
 
 #[cfg(test)]
 use crate::geometry::intersect_triangle;
