@@ -1,5 +1,6 @@
 //! Lights of the course: point lights, rectangular area lights and shape emitters.
 
+pub mod envmap;
 pub mod sampler;
 
 use crate::math::{Color, Frame, Transform, Vec3};
@@ -47,7 +48,8 @@ pub enum Light {
     /// the way the light travels) with `irradiance` on a surface facing it.
     Directional { direction: Vec3, irradiance: Color },
     /// Mitsuba's `projector`: a texture projected from the origin of `to_world` along its
-    /// +z through a pinhole of horizontal field of view `fov` (degrees), its `irradiance`
+    /// +z through a pinhole of horizontal field of view `fov` (degrees: Mitsuba's `fov`
+    /// converted to the x axis by `fov_axis` and the texture's width / height), its `irradiance`
     /// (a texture of `PhysicalParts::textures`) times `scale` at unit distance.
     Projector {
         to_world: Transform,

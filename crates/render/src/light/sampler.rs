@@ -7,17 +7,24 @@
 //!   (v1 − v0) × (v2 − v0), outward from a sphere. Rectangles and triangles are sampled
 //!   uniformly by area and converted to solid angle (pdf_area · r² / cos θ_light); spheres by
 //!   the cone they subtend (uniform in solid angle, pbrt's `Sphere::Sample(ctx)`).
-//! - Point lights are Dirac deltas of intensity I: radiance I / r² arrives.
+//! - Point lights are Dirac deltas of intensity I: radiance I / r² arrives (Mitsuba's `point`).
+//! - Mitsuba's delta emitters, as its 3.9 plugins define them: a `spot` sends I · falloff ·
+//!   texture / r², the falloff linear in the angle from the beam width to the cutoff; a
+//!   `directional` light sends E from infinitely far; a `projector` sends
+//!   π · scale · E(uv) / (z² cos θ) inside its frustum, so that E · π is the irradiance at
+//!   z = 1 (Mitsuba's factor π included).
 //! - The background is an infinite light: a constant colour sampled uniformly over the sphere,
 //!   a cube map (six faces or a vertical cross cut into faces by the loader) sampled in
 //!   proportion to luminance × texel solid angle with a row/column piecewise-constant
-//!   distribution (pbrt's `PiecewiseConstant2D`, here over the cube's texels).
+//!   distribution (pbrt's `PiecewiseConstant2D`, here over the cube's texels), or Mitsuba's
+//!   latitude-longitude `envmap` (`light::envmap`) by luminance × sin θ over its texel grid.
 
 #[cfg(test)]
 use crate::geometry::intersect_triangle;
+use crate::light::envmap::{direction_to_uv, uv_to_direction, LatLongMap};
 use crate::light::Light;
 use crate::material::Material;
-use crate::math::{Color, Vec3};
+use crate::math::{Color, Transform, Vec3};
 #[cfg(test)]
 use crate::ray::Ray;
 use crate::sampling::warp::{
@@ -26,6 +33,7 @@ use crate::sampling::warp::{
 };
 use crate::scene::{Background, Scene};
 use crate::texture::CubeMap;
+use crate::texture::{Image, TexturePoint};
 use rayon::prelude::*;
 
 use std::f32::consts::PI;
@@ -177,6 +185,38 @@ enum PreparedLight {
         radiance: Color,
     },
     Environment,
+    /// Mitsuba's `spot`: intensity × falloff(θ) × texture(uv) / r², θ from the local +z.
+    Spot {
+        position: Vec3,
+        to_world: Transform,
+        intensity: Color,
+        cos_cutoff: f32,
+        cos_beam: f32,
+        cutoff: f32,
+        /// 1 / (cutoff − beam width), radians: the falloff's slope.
+        inverse_transition: f32,
+        /// tan(cutoff): the texture spans the cutoff cone.
+        uv_factor: f32,
+        texture: Option<u32>,
+    },
+    /// Mitsuba's `directional`: `irradiance` arriving against `direction` (unit, the way the
+    /// light travels) from infinitely far.
+    Directional {
+        direction: Vec3,
+        irradiance: Color,
+    },
+    /// Mitsuba's `projector`: π · scale · E(uv) / (z² cos θ) from its pinhole.
+    Projector {
+        position: Vec3,
+        to_world: Transform,
+        /// to_world · (0, 0, 1), not normalised (Mitsuba's `ds.n`).
+        axis: Vec3,
+        irradiance: u32,
+        scale: f32,
+        /// cot(fov / 2) and the texture's width / height.
+        cot: f32,
+        aspect: f32,
+    },
 }
 
 #[derive(Clone, Copy, Debug)]
@@ -233,6 +273,13 @@ impl LightSampler {
                 }
             }
         }
+        // The scene's bounding radius, for the power of the lights at infinity.
+        let bounds = scene.bounds();
+        let radius = if bounds.is_empty() {
+            1.0
+        } else {
+            0.5 * (bounds.max - bounds.min).length()
+        };
         for light in &scene.lights {
             // The total area of emitting triangles, summed with their table.
             let mut triangles_area = 0.0f64;
@@ -308,32 +355,71 @@ impl LightSampler {
                         radiance: *intensity,
                     }
                 }
-                // TODO(emitters): sampled as Mitsuba does; until then they emit nothing.
-                Light::Spot { to_world, .. } | Light::Projector { to_world, .. } => {
-                    PreparedLight::Point {
+                Light::Spot {
+                    to_world,
+                    intensity,
+                    cutoff_angle,
+                    beam_width,
+                    texture,
+                } => {
+                    let cutoff = cutoff_angle.to_radians();
+                    let beam = beam_width.to_radians();
+                    PreparedLight::Spot {
                         position: to_world.point_to_world(Vec3::ZERO),
-                        intensity: Color::ZERO,
+                        to_world: *to_world,
+                        intensity: *intensity,
+                        cos_cutoff: cutoff.cos(),
+                        cos_beam: beam.cos(),
+                        cutoff,
+                        inverse_transition: 1.0 / (cutoff - beam),
+                        uv_factor: cutoff.tan(),
+                        texture: *texture,
                     }
                 }
-                Light::Directional { .. } => PreparedLight::Point {
-                    position: Vec3::ZERO,
-                    intensity: Color::ZERO,
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => PreparedLight::Directional {
+                    direction: direction.normalized(),
+                    irradiance: *irradiance,
+                },
+                Light::Projector {
+                    to_world,
+                    irradiance,
+                    scale,
+                    fov,
+                } => PreparedLight::Projector {
+                    position: to_world.point_to_world(Vec3::ZERO),
+                    to_world: *to_world,
+                    axis: to_world.vector_to_world(Vec3::Z),
+                    irradiance: *irradiance,
+                    scale: *scale,
+                    cot: 1.0 / (0.5 * fov.to_radians()).tan(),
+                    aspect: texture_aspect(scene, *irradiance),
                 },
             };
             lights.push(prepared);
-            power.push(LightSelection::power(light, triangles_area));
+            power.push(match light {
+                Light::Directional { irradiance, .. } => {
+                    LightSelection::environment_power(radius, mean(*irradiance))
+                }
+                Light::Projector {
+                    irradiance,
+                    scale,
+                    fov,
+                    ..
+                } => LightSelection::projector_power(
+                    *fov,
+                    texture_aspect(scene, *irradiance),
+                    *scale * texture_mean(scene, *irradiance),
+                ),
+                _ => LightSelection::power(light, triangles_area),
+            });
         }
         let environment = with_environment
             .then(|| EnvironmentDistribution::new(&scene.background))
             .flatten();
         if let Some(env) = &environment {
-            // The scene's bounding radius, for the environment's power.
-            let bounds = scene.bounds();
-            let radius = if bounds.is_empty() {
-                1.0
-            } else {
-                0.5 * (bounds.max - bounds.min).length()
-            };
             lights.push(PreparedLight::Environment);
             reachable.push(true);
             power.push(LightSelection::environment_power(radius, env.integral));
@@ -528,6 +614,94 @@ impl LightSampler {
                     reachable_by_bsdf,
                 })
             }
+            PreparedLight::Spot {
+                position,
+                to_world,
+                intensity,
+                cos_cutoff,
+                cos_beam,
+                cutoff,
+                inverse_transition,
+                uv_factor,
+                texture,
+            } => {
+                let (direction, distance_squared) = towards(reference, *position)?;
+                let local = to_world.vector_to_object(-direction).normalized();
+                let cos_theta = local.z;
+                // Mitsuba's falloff: linear in the angle from the beam width to the cutoff.
+                let falloff = if cos_theta <= *cos_cutoff {
+                    return None;
+                } else if cos_theta >= *cos_beam {
+                    1.0
+                } else {
+                    (cutoff - cos_theta.clamp(-1.0, 1.0).acos()) * inverse_transition
+                };
+                let mut radiance = *intensity * (falloff / distance_squared);
+                if let Some(texture) = texture {
+                    // Mitsuba's uv over the cutoff cone, v = 0 on its image's top row.
+                    let uv = (
+                        0.5 + 0.5 * local.x / (local.z * uv_factor),
+                        0.5 + 0.5 * local.y / (local.z * uv_factor),
+                    );
+                    radiance = radiance.mul_elem(texture_value(scene, *texture, uv));
+                }
+                Some(delta_sample(
+                    *position,
+                    direction,
+                    distance_squared,
+                    radiance,
+                ))
+            }
+            PreparedLight::Directional {
+                direction,
+                irradiance,
+            } => Some(LightSample {
+                radiance: *irradiance,
+                direction: -*direction,
+                position: reference - *direction,
+                distance: f32::INFINITY,
+                pdf: 1.0,
+                is_delta: true,
+                reachable_by_bsdf: false,
+            }),
+            PreparedLight::Projector {
+                position,
+                to_world,
+                axis,
+                irradiance,
+                scale,
+                cot,
+                aspect,
+            } => {
+                let local = to_world.point_to_object(reference);
+                if local.z.is_nan() || local.z <= 0.0 {
+                    return None;
+                }
+                // Mitsuba's perspective projection onto its texture's uv (v = 0 on the top
+                // row); nothing outside the frustum.
+                let uv = (
+                    0.5 - 0.5 * cot * local.x / local.z,
+                    0.5 - 0.5 * aspect * cot * local.y / local.z,
+                );
+                if !(0.0..=1.0).contains(&uv.0) || !(0.0..=1.0).contains(&uv.1) {
+                    return None;
+                }
+                let (direction, distance_squared) = towards(reference, *position)?;
+                // So that the irradiance at z = 1 is the texture's (times π, as Mitsuba
+                // has it): dist² cos³θ = z² cos θ.
+                let cos_theta = -axis.dot(direction);
+                let factor = PI * scale / (local.z * local.z * cos_theta);
+                if !(factor > 0.0 && factor.is_finite()) {
+                    return None;
+                }
+                let radiance = texture_value(scene, *irradiance, uv) * factor;
+                Some(delta_sample(
+                    *position,
+                    direction,
+                    distance_squared,
+                    radiance,
+                ))
+            }
             PreparedLight::Environment => {
                 let env = self.environment.as_ref()?;
                 let (direction, pdf) = env.sample(u)?;
@@ -550,7 +724,13 @@ impl LightSampler {
     #[cfg(test)]
     pub fn pdf_light_direction(&self, index: usize, reference: Vec3, direction: Vec3) -> f32 {
         match self.lights.get(index) {
-            None | Some(PreparedLight::Point { .. }) => 0.0,
+            None
+            | Some(
+                PreparedLight::Point { .. }
+                | PreparedLight::Spot { .. }
+                | PreparedLight::Directional { .. }
+                | PreparedLight::Projector { .. },
+            ) => 0.0,
             Some(PreparedLight::Rectangle {
                 center,
                 u_edge,
@@ -647,7 +827,11 @@ impl LightSampler {
                     None => 0.0,
                 }
             }
-            PreparedLight::Point { .. } | PreparedLight::Environment => 0.0,
+            PreparedLight::Point { .. }
+            | PreparedLight::Spot { .. }
+            | PreparedLight::Directional { .. }
+            | PreparedLight::Projector { .. }
+            | PreparedLight::Environment => 0.0,
         };
         if pdf.is_finite() {
             pdf * probability
@@ -745,8 +929,21 @@ impl LightSelection {
     pub fn power(light: &Light, triangles_area: f64) -> f32 {
         let phi = match light {
             Light::Point { intensity, .. } => 4.0 * PI * mean(*intensity),
-            // TODO(emitters): their power.
-            Light::Spot { .. } | Light::Directional { .. } | Light::Projector { .. } => 0.0,
+            // pbrt-v4's spot light power: the full cone to the beam width, half of the
+            // falloff's ring (Mitsuba gives none).
+            Light::Spot {
+                intensity,
+                cutoff_angle,
+                beam_width,
+                ..
+            } => {
+                let cos_cutoff = cutoff_angle.to_radians().cos();
+                let cos_beam = beam_width.to_radians().cos();
+                2.0 * PI * ((1.0 - cos_beam) + 0.5 * (cos_beam - cos_cutoff)) * mean(*intensity)
+            }
+            // Their power needs the scene (its size, the projector's texture):
+            // `LightSampler::new` weighs them with `environment_power` and `projector_power`.
+            Light::Directional { .. } | Light::Projector { .. } => 0.0,
             Light::Area {
                 normal,
                 width,
@@ -780,6 +977,19 @@ impl LightSelection {
         PI * scene_radius * scene_radius * integral
     }
 
+    /// Φ of a projector of horizontal field of view `fov` (degrees) and image aspect `aspect`
+    /// whose texture's mean irradiance times its scale is `irradiance`: what Mitsuba's
+    /// `projector` sends, π · E · the image's area on the plane at unit distance.
+    pub fn projector_power(fov: f32, aspect: f32, irradiance: f32) -> f32 {
+        let half = (0.5 * fov.to_radians()).tan();
+        let phi = PI * irradiance * (2.0 * half) * (2.0 * half / aspect);
+        if phi.is_finite() {
+            phi.max(0.0)
+        } else {
+            0.0
+        }
+    }
+
     /// The cumulative distribution: entry i is the probability of choosing a light before i,
     /// one more entry than lights.
     pub fn cdf(&self) -> &[f32] {
@@ -803,6 +1013,79 @@ impl LightSelection {
 #[inline]
 fn mean(c: Color) -> f32 {
     (c.x + c.y + c.z) / 3.0
+}
+
+/// The unit direction from `reference` to `position`, and the squared distance; `None` when
+/// they coincide.
+#[inline]
+fn towards(reference: Vec3, position: Vec3) -> Option<(Vec3, f32)> {
+    let to_light = position - reference;
+    let distance_squared = to_light.length_squared();
+    (distance_squared > 0.0).then(|| (to_light / distance_squared.sqrt(), distance_squared))
+}
+
+/// The sample of a light at a point (a spot, a projector): no BSDF sample finds it.
+#[inline]
+fn delta_sample(
+    position: Vec3,
+    direction: Vec3,
+    distance_squared: f32,
+    radiance: Color,
+) -> LightSample {
+    LightSample {
+        radiance,
+        direction,
+        position,
+        distance: distance_squared.sqrt(),
+        pdf: 1.0,
+        is_delta: true,
+        reachable_by_bsdf: false,
+    }
+}
+
+/// Texture `node` of `PhysicalParts::textures` at (u, v) in Mitsuba's texture space, where
+/// v = 0 is the image's top row (a spot's and a projector's uv are computed there, as
+/// `TextureNode::eval` reads them); black for a node out of range.
+#[inline]
+fn texture_value(scene: &Scene, node: u32, uv: (f32, f32)) -> Color {
+    match scene.physical.textures.get(node as usize) {
+        Some(texture) => texture.eval(
+            &scene.textures,
+            &TexturePoint {
+                uv,
+                ..TexturePoint::default()
+            },
+        ),
+        None => Color::ZERO,
+    }
+}
+
+/// Width / height of texture `node`, as Mitsuba's `Texture::resolution` gives it: the
+/// image's for a bitmap, 1 for the others.
+fn texture_aspect(scene: &Scene, node: u32) -> f32 {
+    use crate::texture::TextureKind;
+    match scene.physical.textures.get(node as usize).map(|t| &t.kind) {
+        Some(TextureKind::Bitmap { image, .. }) => match scene.textures.get(*image as usize) {
+            Some(image) if image.width > 0 && image.height > 0 => {
+                image.width as f32 / image.height as f32
+            }
+            _ => 1.0,
+        },
+        _ => 1.0,
+    }
+}
+
+/// Texture `node`'s mean over its uv square (channel mean), for the light's power.
+fn texture_mean(scene: &Scene, node: u32) -> f32 {
+    const N: usize = 16;
+    let mut sum = 0.0f64;
+    for i in 0..N {
+        for j in 0..N {
+            let uv = ((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
+            sum += mean(texture_value(scene, node, uv).max(Color::ZERO)) as f64;
+        }
+    }
+    (sum / (N * N) as f64) as f32
 }
 
 /// A point sampled by area on a one-sided planar emitter, converted to solid angle.
@@ -908,7 +1191,16 @@ fn cube_solid_angle_per_area(s: f32, t: f32) -> f32 {
 struct EnvironmentDistribution {
     /// ∫ L dω by channel mean, for choosing between lights by power.
     integral: f32,
-    cube: Option<CubeDistribution>,
+    shape: EnvironmentShape,
+}
+
+/// How the environment's directions are drawn.
+#[derive(Clone, Debug)]
+enum EnvironmentShape {
+    /// A constant colour: uniformly over the sphere.
+    Uniform,
+    Cube(CubeDistribution),
+    LatLong(LatLongDistribution),
 }
 
 /// A cube map's importance-sampling distribution, by luminance times each texel's solid angle:
@@ -936,34 +1228,199 @@ impl EnvironmentDistribution {
                 let integral = 4.0 * PI * mean(c.max(Color::ZERO));
                 (integral > 0.0 && c.is_finite()).then_some(EnvironmentDistribution {
                     integral,
-                    cube: None,
+                    shape: EnvironmentShape::Uniform,
                 })
             }
             Background::CubeMap(map) => {
                 CubeDistribution::new(map).map(|(cube, integral)| EnvironmentDistribution {
                     integral,
-                    cube: Some(cube),
+                    shape: EnvironmentShape::Cube(cube),
                 })
             }
-            // TODO(emitters): importance-sampled by luminance.
-            Background::Environment { .. } => None,
+            Background::Environment {
+                image,
+                scale,
+                to_world,
+            } => LatLongDistribution::new(image, *scale, to_world).map(|(latlong, integral)| {
+                EnvironmentDistribution {
+                    integral,
+                    shape: EnvironmentShape::LatLong(latlong),
+                }
+            }),
         }
     }
 
     #[inline]
     fn sample(&self, u: (f32, f32)) -> Option<(Vec3, f32)> {
-        match &self.cube {
-            None => Some((sample_uniform_sphere(u.0, u.1), uniform_sphere_pdf())),
-            Some(cube) => cube.sample(u),
+        match &self.shape {
+            EnvironmentShape::Uniform => {
+                Some((sample_uniform_sphere(u.0, u.1), uniform_sphere_pdf()))
+            }
+            EnvironmentShape::Cube(cube) => cube.sample(u),
+            EnvironmentShape::LatLong(latlong) => latlong.sample(u),
         }
     }
 
     #[inline]
     fn pdf(&self, direction: Vec3) -> f32 {
-        match &self.cube {
-            None => uniform_sphere_pdf(),
-            Some(cube) => cube.pdf(direction),
+        match &self.shape {
+            EnvironmentShape::Uniform => uniform_sphere_pdf(),
+            EnvironmentShape::Cube(cube) => cube.pdf(direction),
+            EnvironmentShape::LatLong(latlong) => latlong.pdf(direction),
         }
+    }
+}
+
+/// Mitsuba's smallest sin θ in the envmap's solid-angle Jacobian (its `Epsilon`, 2⁻²⁴): the
+/// pdf at the poles is large and finite instead of infinite.
+const POLE_SIN_THETA: f32 = 5.960_464_5e-8;
+
+/// A latitude-longitude environment's importance-sampling distribution (`light::envmap`).
+///
+/// Mitsuba's `envmap` samples a piecewise-bilinear density over the (W + 1) x H grid of its
+/// texels' luminance times sin θ; this is the piecewise-constant version over the same grid:
+/// one cell between each two neighbouring texel centres in u (W cells, the last wrapping
+/// round to column 0) and each two rows in v (H − 1 cells, rows at v = y / (H − 1) as the
+/// lookup places them), weighted by the mean luminance of its four corner texels times
+/// ∫ sin θ dθ over the cell. The bilinear lookup is positive only inside cells with a
+/// positive corner, so the density covers every direction that sends light. Rows of cells
+/// are stacked with their column distributions as `CubeDistribution` stacks them. Which
+/// density samples changes only the variance: the estimate's expectation is Mitsuba's.
+#[derive(Clone, Debug)]
+pub struct LatLongDistribution {
+    to_world: Transform,
+    /// Cells across (the padded map's columns) and down (its rows − 1).
+    columns: u32,
+    rows: u32,
+    /// Cumulative probability of the rows of cells before row r; rows + 1 entries.
+    row_cdf: Vec<f32>,
+    /// Per row of cells, columns + 1 cumulative probabilities, one row after another.
+    column_cdf: Vec<f32>,
+}
+
+impl LatLongDistribution {
+    /// The distribution for `image` (times `scale`, turned by `to_world`) and ∫ L dω by
+    /// channel mean; `None` for a black map.
+    pub fn new(
+        image: &Image,
+        scale: f32,
+        to_world: &Transform,
+    ) -> Option<(LatLongDistribution, f32)> {
+        let map = LatLongMap::new(image)?;
+        if !(scale > 0.0 && scale.is_finite()) {
+            return None;
+        }
+        let (columns, rows) = (map.width, map.height - 1);
+        let stride = columns as usize + 1;
+        let mut column_cdf = vec![0.0f32; rows as usize * stride];
+        let delta_phi = 2.0 * std::f64::consts::PI / columns as f64;
+        let clean = |c: Color| {
+            let c = c.max(Color::ZERO);
+            if c.is_finite() {
+                c
+            } else {
+                Color::ZERO
+            }
+        };
+        // Per row of cells: its weight (luminance) and ∫ L dω over it (channel mean).
+        let sums: Vec<(f64, f64)> = column_cdf
+            .par_chunks_mut(stride)
+            .enumerate()
+            .map(|(row, cdf)| {
+                let theta = |y: usize| std::f64::consts::PI * y as f64 / rows as f64;
+                // ∫ sin θ dθ over the row: the solid angle of its cells over Δφ.
+                let band = theta(row).cos() - theta(row + 1).cos();
+                let (top, bottom) = (row as u32, row as u32 + 1);
+                let (mut running, mut integral) = (0.0f64, 0.0f64);
+                for x in 0..columns {
+                    let next = (x + 1) % columns;
+                    let corners = clean(map.texel(x, top))
+                        + clean(map.texel(next, top))
+                        + clean(map.texel(x, bottom))
+                        + clean(map.texel(next, bottom));
+                    let corners = corners * 0.25;
+                    running += corners.luminance() as f64 * band;
+                    integral += mean(corners) as f64 * band * delta_phi;
+                    cdf[x as usize + 1] = running as f32;
+                }
+                if running > 0.0 {
+                    for c in cdf.iter_mut() {
+                        *c = (*c as f64 / running) as f32;
+                    }
+                    cdf[columns as usize] = 1.0;
+                }
+                (running, integral)
+            })
+            .collect();
+        let total: f64 = sums.iter().map(|s| s.0).sum();
+        if !(total > 0.0 && total.is_finite()) {
+            return None;
+        }
+        let integral: f64 = sums.iter().map(|s| s.1).sum::<f64>() * scale as f64;
+        let mut row_cdf = Vec::with_capacity(rows as usize + 1);
+        row_cdf.push(0.0f32);
+        let mut running = 0.0f64;
+        for (weight, _) in &sums {
+            running += weight;
+            row_cdf.push((running / total) as f32);
+        }
+        row_cdf[rows as usize] = 1.0;
+        Some((
+            LatLongDistribution {
+                to_world: *to_world,
+                columns,
+                rows,
+                row_cdf,
+                column_cdf,
+            },
+            integral as f32,
+        ))
+    }
+
+    fn row_columns(&self, row: usize) -> &[f32] {
+        let stride = self.columns as usize + 1;
+        &self.column_cdf[row * stride..(row + 1) * stride]
+    }
+
+    /// Density per unit (u, v) area of cell (column, row).
+    #[inline]
+    fn cell_density(&self, column: usize, row: usize) -> f32 {
+        let row_probability = self.row_cdf[row + 1] - self.row_cdf[row];
+        let columns = self.row_columns(row);
+        let column_probability = columns[column + 1] - columns[column];
+        row_probability * column_probability * (self.columns * self.rows) as f32
+    }
+
+    #[inline]
+    fn sample(&self, u: (f32, f32)) -> Option<(Vec3, f32)> {
+        let (row, row_probability, v_offset) = sample_cdf(&self.row_cdf, u.0)?;
+        let (column, column_probability, u_offset) = sample_cdf(self.row_columns(row), u.1)?;
+        // Cells start at texel centres: half a texel on in u.
+        let map_u = (column as f32 + 0.5 + u_offset) / self.columns as f32;
+        let map_v = (row as f32 + v_offset) / self.rows as f32;
+        let local = uv_to_direction(map_u, map_v).0;
+        let direction = self.to_world.vector_to_world(local).normalized();
+        let density = row_probability * column_probability * (self.columns * self.rows) as f32;
+        // sin θ of the direction as `pdf` computes it: near the poles a few ulps of rounding
+        // in the turn are a large share of sin θ, and both must give the same density.
+        let back = self.to_world.vector_to_object(direction).normalized();
+        let sin_theta = (back.x * back.x + back.z * back.z).sqrt();
+        let pdf = density / (2.0 * PI * PI * sin_theta.max(POLE_SIN_THETA));
+        (pdf > 0.0 && pdf.is_finite() && direction.is_finite()).then_some((direction, pdf))
+    }
+
+    #[inline]
+    fn pdf(&self, direction: Vec3) -> f32 {
+        let local = self.to_world.vector_to_object(direction).normalized();
+        if !local.is_finite() {
+            return 0.0;
+        }
+        let (u, v) = direction_to_uv(local);
+        let x = (u - u.floor()) * self.columns as f32 - 0.5;
+        let column = (x.floor() as i64).rem_euclid(self.columns as i64) as usize;
+        let row = ((v * self.rows as f32) as usize).min(self.rows as usize - 1);
+        let sin_theta = (local.x * local.x + local.z * local.z).sqrt();
+        self.cell_density(column, row) / (2.0 * PI * PI * sin_theta.max(POLE_SIN_THETA))
     }
 }
 

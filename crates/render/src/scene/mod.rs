@@ -32,8 +32,9 @@ pub enum Background {
     /// An environment cube map (`envMapPrefix`, or `envMapVertCross` cut into faces).
     CubeMap(Box<CubeMap>),
     /// Mitsuba's `envmap`: a latitude-longitude image times `scale`, turned by `to_world`
-    /// (a rotation). In the map's own frame +y is up, and u = 0.5 looks along +z... as
-    /// Mitsuba's `envmap` maps directions to the image.
+    /// (a rotation). In the map's own frame +y is up (row 0 of the image), u = 0 looks along
+    /// −z and u = 1/2 along +z, as Mitsuba's `envmap` maps directions to the image
+    /// (`light::envmap`).
     Environment {
         image: Box<Image>,
         scale: f32,
@@ -457,8 +458,11 @@ impl Scene {
         match &self.background {
             Background::Color(c) => *c,
             Background::CubeMap(map) => map.lookup(direction),
-            // Filled in with the environment's sampling (light/sampler.rs).
-            Background::Environment { .. } => Color::ZERO,
+            Background::Environment {
+                image,
+                scale,
+                to_world,
+            } => crate::light::envmap::environment_radiance(image, *scale, to_world, direction),
         }
     }
 }

@@ -7,6 +7,7 @@ mod accel_watertight;
 mod chi2_sampling;
 mod depth_of_field;
 mod lecture_math;
+mod mitsuba_emitters;
 mod path_known_answers;
 mod path_no_allocation;
 mod path_preliminary_hits;

@@ -12,7 +12,7 @@ use crate::{
     Projection, Ray, RenderSettings, Scene, SceneParts, Shape, Vec3,
 };
 
-fn instance(geometry: u32, casts_shadow: bool) -> Instance {
+pub(super) fn instance(geometry: u32, casts_shadow: bool) -> Instance {
     Instance {
         geometry,
         transform: None,
@@ -21,7 +21,7 @@ fn instance(geometry: u32, casts_shadow: bool) -> Instance {
     }
 }
 
-fn camera_looking_at_origin(distance: f32) -> Camera {
+pub(super) fn camera_looking_at_origin(distance: f32) -> Camera {
     Camera::new(
         Projection::Perspective,
         Vec3::new(0.0, 0.0, distance),
@@ -51,7 +51,7 @@ fn furnace(material: Material) -> Scene {
     })
 }
 
-fn path_settings(size: u32, samples: u32) -> RenderSettings {
+pub(super) fn path_settings(size: u32, samples: u32) -> RenderSettings {
     RenderSettings {
         width: size,
         height: size,
@@ -253,7 +253,7 @@ fn furnace_blinn_phong_has_its_known_albedo() {
 }
 
 /// A square diffuse floor (z = 0, normal +z) of albedo `albedo`, 20 units wide.
-fn floor(albedo: f32) -> (GeometryDesc, Material) {
+pub(super) fn floor(albedo: f32) -> (GeometryDesc, Material) {
     let corner = |x: f32, y: f32| Vec3::new(x, y, 0.0);
     let (a, b, c, d) = (
         corner(-10.0, -10.0),
@@ -281,7 +281,12 @@ fn floor(albedo: f32) -> (GeometryDesc, Material) {
 
 /// The radiance the path tracer sees at floor point `p`, looking down from above, averaged
 /// over `samples` independent samples.
-fn radiance_at(scene: &Scene, integrator: &PathIntegrator, p: Vec3, samples: u32) -> Color {
+pub(super) fn radiance_at(
+    scene: &Scene,
+    integrator: &PathIntegrator,
+    p: Vec3,
+    samples: u32,
+) -> Color {
     let eye = p + Vec3::new(0.05, -0.03, 0.4);
     let ray = Ray::new(eye, p - eye);
     let mut sum = Color::ZERO;
