@@ -18,7 +18,7 @@ use crate::material::bsdf::BsdfSample;
 use crate::math::{Color, Vec3};
 
 /// A BSDF with its parameters resolved at one surface point (textures already looked up).
-pub trait Scatter {
+pub trait Scatter: std::fmt::Debug {
     /// f(ωo, ωi) · |cos θi| of the non-delta components.
     fn eval(&self, wo: Vec3, wi: Vec3) -> Color;
 
@@ -41,4 +41,39 @@ pub trait Scatter {
     /// The colour a denoiser's albedo feature shows: the reflectance at normal incidence, or
     /// the family's base colour, in [0, 1].
     fn albedo(&self) -> Color;
+}
+
+/// `Some(s)` when every field is finite, the pdf positive and the weight non-negative: the
+/// families pass their samples through it so that no input (NaN, grazing angles, degenerate
+/// parameters) lets a NaN reach the integrator.
+#[inline]
+pub(crate) fn usable(s: BsdfSample) -> Option<BsdfSample> {
+    let ok = s.wi.is_finite()
+        && s.weight.is_finite()
+        && s.weight.min_component() >= 0.0
+        && s.pdf.is_finite()
+        && s.pdf > 0.0
+        && s.eta.is_finite()
+        && s.eta > 0.0;
+    ok.then_some(s)
+}
+
+/// `c`, or zero where it is not finite.
+#[inline]
+pub(crate) fn finite_or_zero(c: Color) -> Color {
+    if c.is_finite() {
+        c
+    } else {
+        Color::ZERO
+    }
+}
+
+/// `p`, or zero where it is not a finite non-negative density.
+#[inline]
+pub(crate) fn finite_pdf(p: f32) -> f32 {
+    if p.is_finite() && p > 0.0 {
+        p
+    } else {
+        0.0
+    }
 }
