@@ -1,6 +1,15 @@
 //! Materials: the course's shaders as one closed enum.
 
 pub mod bsdf;
+// Mitsuba 3's BSDF families and their interface: only the tests reach them until the path
+// tracer's material table maps scenes onto them, so dead-code analysis would flag them.
+#[allow(dead_code)]
+pub mod diffuse;
+#[allow(dead_code)]
+pub mod fresnel;
+#[allow(dead_code)]
+pub mod microfacet;
+#[allow(dead_code)]
 pub mod scatter;
 
 use crate::math::Color;

@@ -35,14 +35,14 @@ use std::f64::consts::PI;
 
 /// The probability that the family of chi-square tests below fails although every sampler is
 /// right.
-const FAMILY_SIGNIFICANCE: f64 = 0.01;
+pub(crate) const FAMILY_SIGNIFICANCE: f64 = 0.01;
 /// m, the number of chi-square p-values this file compares with `significance()`: one per
 /// `chi2_test` call (cosine_hemisphere 1, phong_lobe 2, uniform_cone 1, diffuse_bsdf 2,
 /// blinn_phong_bsdf 4, phong_bsdf 2, rough_mirror_bsdf 2, layered_bsdfs 2, five lights) plus the
 /// discrete ones (Glaze's mirror choice 1, dielectric_bsdf 4, light selection 1): 27. Adding a
 /// test means raising this; `significance()` panics when more p-values than m are tested.
 const FAMILY_SIZE: usize = 27;
-const MIN_EXPECTED: f64 = 5.0;
+pub(crate) const MIN_EXPECTED: f64 = 5.0;
 
 /// Šidák's per-test level for a family of `FAMILY_SIZE` independent tests at an overall
 /// `FAMILY_SIGNIFICANCE` (Mitsuba 3's chi2 harness corrects the same way):
@@ -60,17 +60,17 @@ fn significance() -> f64 {
 }
 
 /// 1 − (1 − alpha)^(1/m).
-fn sidak_level(alpha: f64, m: usize) -> f64 {
+pub(crate) fn sidak_level(alpha: f64, m: usize) -> f64 {
     1.0 - (1.0 - alpha).powf(1.0 / m as f64)
 }
 
 /// The harness's parameters; `Default` suits smooth pdfs.
 #[derive(Clone, Copy, Debug)]
-struct Chi2Config {
-    theta_bins: usize,
-    phi_bins: usize,
-    samples: usize,
-    integration_steps: usize,
+pub(crate) struct Chi2Config {
+    pub(crate) theta_bins: usize,
+    pub(crate) phi_bins: usize,
+    pub(crate) samples: usize,
+    pub(crate) integration_steps: usize,
 }
 
 impl Default for Chi2Config {
@@ -93,7 +93,7 @@ struct Chi2Outcome {
     accepted: f64,
 }
 
-fn cell_of(config: &Chi2Config, d: Vec3) -> usize {
+pub(crate) fn cell_of(config: &Chi2Config, d: Vec3) -> usize {
     let d = d.normalized();
     let cos_theta = (d.z as f64).clamp(-1.0, 1.0);
     let mut phi = (d.y as f64).atan2(d.x as f64);
@@ -110,7 +110,7 @@ fn cell_of(config: &Chi2Config, d: Vec3) -> usize {
 /// node has weight 1 / (2 · steps)). An open rule on purpose: a pdf that jumps exactly on a cell
 /// boundary (a light's edge along a meridian, a cone's rim on a cos θ grid line) would be
 /// counted on both sides by a rule that evaluates the endpoints, such as Simpson's.
-fn gauss_legendre_nodes(steps: usize) -> Vec<f64> {
+pub(crate) fn gauss_legendre_nodes(steps: usize) -> Vec<f64> {
     let offset = 0.5 / 3f64.sqrt();
     (0..steps)
         .flat_map(|i| {
@@ -125,7 +125,7 @@ fn gauss_legendre_nodes(steps: usize) -> Vec<f64> {
 
 /// ∫ pdf dω over cell (t, p), in (cos θ, φ) where dω = d(cos θ) dφ, by the composite
 /// Gauss-Legendre rule with `steps` intervals per axis.
-fn integrate_cell(
+pub(crate) fn integrate_cell(
     config: &Chi2Config,
     t: usize,
     p: usize,
@@ -156,7 +156,7 @@ fn integrate_cell(
 }
 
 /// `integrate_cell` for every cell, row-major in (cos θ, φ).
-fn integrate_cells(config: &Chi2Config, pdf: &dyn Fn(Vec3) -> f64) -> Vec<f64> {
+pub(crate) fn integrate_cells(config: &Chi2Config, pdf: &dyn Fn(Vec3) -> f64) -> Vec<f64> {
     (0..config.theta_bins * config.phi_bins)
         .map(|i| {
             integrate_cell(
@@ -171,7 +171,7 @@ fn integrate_cells(config: &Chi2Config, pdf: &dyn Fn(Vec3) -> f64) -> Vec<f64> {
 }
 
 /// ln Γ(x), Lanczos approximation (g = 7, n = 9), accurate to ~1e-15 for x > 0.
-fn ln_gamma(x: f64) -> f64 {
+pub(crate) fn ln_gamma(x: f64) -> f64 {
     const COEFFICIENTS: [f64; 9] = [
         0.999_999_999_999_809_9,
         676.520_368_121_885_1,
@@ -197,7 +197,7 @@ fn ln_gamma(x: f64) -> f64 {
 
 /// Regularised upper incomplete gamma Q(a, x) = Γ(a, x) / Γ(a): the series for x < a + 1, the
 /// continued fraction (modified Lentz) otherwise (Numerical Recipes §6.2).
-fn regularized_gamma_q(a: f64, x: f64) -> f64 {
+pub(crate) fn regularized_gamma_q(a: f64, x: f64) -> f64 {
     if x <= 0.0 {
         return 1.0;
     }
@@ -245,7 +245,7 @@ fn regularized_gamma_q(a: f64, x: f64) -> f64 {
 
 /// Pearson's chi-square on observed against expected counts, pooling cells that expect fewer
 /// than `MIN_EXPECTED`. Panics if a cell that expects nothing received samples.
-fn chi2_statistic(observed: &[f64], expected: &[f64]) -> (f64, usize, f64) {
+pub(crate) fn chi2_statistic(observed: &[f64], expected: &[f64]) -> (f64, usize, f64) {
     let mut order: Vec<usize> = (0..observed.len()).collect();
     order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
     let (mut pool_observed, mut pool_expected) = (0.0, 0.0);
@@ -405,7 +405,7 @@ fn uniform_cone() {
 
 // ---- BSDFs -------------------------------------------------------------------------------
 
-fn direction_at(theta_degrees: f32, phi_degrees: f32) -> Vec3 {
+pub(crate) fn direction_at(theta_degrees: f32, phi_degrees: f32) -> Vec3 {
     let (theta, phi) = (theta_degrees.to_radians(), phi_degrees.to_radians());
     Vec3::new(
         theta.sin() * phi.cos(),

@@ -11,4 +11,5 @@ mod path_known_answers;
 mod path_no_allocation;
 mod path_preliminary_hits;
 mod pipeline;
+mod scatter_harness;
 mod split_methods;
