@@ -10,6 +10,8 @@ pub mod fresnel;
 #[allow(dead_code)]
 pub mod microfacet;
 #[allow(dead_code)]
+pub mod principled;
+#[allow(dead_code)]
 pub mod scatter;
 
 use crate::math::Color;
