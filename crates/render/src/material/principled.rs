@@ -494,7 +494,9 @@ impl Principled {
         let (_, bsdf) = self.weights();
         let reflect = cos_o * cos_i > 0.0;
         let refract = cos_o * cos_i < 0.0;
-        if !(reflect || refract) || (!front && !(bsdf > 0.0)) {
+        // From below only the transmissive part scatters (NaN weights count as none).
+        let transmits = bsdf > 0.0;
+        if !(reflect || refract) || (!front && !transmits) {
             return 0.0;
         }
         let eta_path = if front { self.eta } else { 1.0 / self.eta };
@@ -549,7 +551,8 @@ impl Scatter for Principled {
         }
         let front = cos_o > 0.0;
         let (_, bsdf) = self.weights();
-        if !front && !(bsdf > 0.0) {
+        let transmits = bsdf > 0.0;
+        if !front && !transmits {
             return None;
         }
         let spec = ggx(self.anisotropic, self.roughness, self.sample_visible);
