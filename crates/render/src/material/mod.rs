@@ -17,6 +17,8 @@ pub mod physical;
 #[allow(dead_code)]
 pub mod plastic;
 #[allow(dead_code)]
+pub mod principled;
+#[allow(dead_code)]
 pub mod scatter;
 pub mod surface;
 

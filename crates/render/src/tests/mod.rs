@@ -12,6 +12,7 @@ mod path_known_answers;
 mod path_no_allocation;
 mod path_preliminary_hits;
 mod pipeline;
+mod principled_bsdfs;
 mod scatter_bsdfs;
 mod scatter_harness;
 mod split_methods;
