@@ -85,6 +85,7 @@ pub use light::Light;
 pub use material::physical::{
     BsdfId, BsdfNode, DistributionKind, Param, PrincipledParams, Roughness,
 };
+pub use material::principled::eta_from_specular;
 pub use material::{Material, MaterialId};
 pub use math::{Color, Matrix4, Transform, Vec3};
 pub use ray::Ray;

@@ -1353,8 +1353,7 @@ impl<'a> Builder<'a> {
                             if has_trans && specular == 0.0 {
                                 specular = 1e-3;
                             }
-                            // Mitsuba's map from the `specular` reflectance at normal incidence to an IOR.
-                            2.0 / (1.0 - (0.08 * specular).sqrt()) - 1.0
+                            glint_render::eta_from_specular(specular)
                         }
                     };
                     params.eta = Param::value(eta);

@@ -28,7 +28,8 @@ use crate::light::sampler::LightSample;
 use crate::light::sampler::LightSampler;
 use crate::material::bsdf::Bsdf;
 use crate::material::physical::BsdfId;
-use crate::material::surface::SurfaceBsdf;
+use crate::material::plastic::RoughPlastic;
+use crate::material::surface::{prepare_rough_plastics, SurfaceBsdf};
 use crate::material::{Material, MaterialId};
 use crate::math::Color;
 use crate::math::Frame;
@@ -99,6 +100,8 @@ pub struct PathIntegrator {
     materials: Vec<PreparedMaterial>,
     /// Where a sample lands in its pixel: the scene's reconstruction filter.
     filter: FilterSampler,
+    /// The rough plastics' tables by BSDF id (`surface::prepare_rough_plastics`).
+    rough_plastics: Vec<Option<RoughPlastic>>,
 }
 
 /// What the path tracer needs of one material at every hit, worked out once per render so
@@ -197,6 +200,7 @@ impl PathIntegrator {
                 .map(|id| PreparedMaterial::new(scene, id))
                 .collect(),
             filter: FilterSampler::new(scene.physical.defaults.filter),
+            rough_plastics: prepare_rough_plastics(&scene.physical, &scene.textures),
         }
     }
 
@@ -347,7 +351,14 @@ impl PathIntegrator {
                 // directions.
                 let surface = scene.physical_surface(&ray, &hit);
                 let wo = -ray.direction;
-                let bsdf = SurfaceBsdf::new(&scene.physical, &scene.textures, id, &surface, wo);
+                let bsdf = SurfaceBsdf::new(
+                    &scene.physical,
+                    &self.rough_plastics,
+                    &scene.textures,
+                    id,
+                    &surface,
+                    wo,
+                );
                 if depth == 0 {
                     let n = surface.frame.w;
                     first_hit.normal = if n.dot(wo) < 0.0 { -n } else { n };

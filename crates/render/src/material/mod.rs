@@ -1,24 +1,14 @@
 //! Materials: the course's shaders as one closed enum.
 
 pub mod bsdf;
-// Mitsuba 3's BSDF families and their interface: only the tests reach them until the path
-// tracer's material table maps scenes onto them, so dead-code analysis would flag them.
-#[allow(dead_code)]
 pub mod conductor;
-#[allow(dead_code)]
 pub mod dielectric;
-#[allow(dead_code)]
 pub mod diffuse;
-#[allow(dead_code)]
 pub mod fresnel;
-#[allow(dead_code)]
 pub mod microfacet;
 pub mod physical;
-#[allow(dead_code)]
 pub mod plastic;
-#[allow(dead_code)]
 pub mod principled;
-#[allow(dead_code)]
 pub mod scatter;
 pub mod surface;
 

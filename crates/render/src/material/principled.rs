@@ -260,6 +260,7 @@ pub fn eta_from_specular(specular: f32) -> f32 {
 }
 
 /// The inverse of `eta_from_specular`: 12.5 · ((η − 1)/(η + 1))².
+#[cfg(test)]
 pub fn specular_from_eta(eta: f32) -> f32 {
     schlick_r0(eta) / 0.08
 }
@@ -337,6 +338,7 @@ impl Principled {
     /// The index from Mitsuba's `specular` parameter. `has_spec_trans` says whether the
     /// scene gives `spec_trans` (a texture, or a non-zero number): Mitsuba then raises a
     /// specular of exactly 0 (index 1, which cannot transmit) to 0.001.
+    #[cfg(test)]
     pub fn with_specular(self, specular: f32, has_spec_trans: bool) -> Self {
         let specular = if has_spec_trans && specular == 0.0 {
             1e-3

@@ -17,9 +17,13 @@
 //! delta sample by its own probability.
 
 use crate::material::bsdf::BsdfSample;
+use crate::material::conductor::{Conductor, RoughConductor};
+use crate::material::dielectric::{Dielectric, RoughDielectric, ThinDielectric};
 use crate::material::diffuse::Diffuse;
 use crate::material::microfacet::{Distribution, Microfacet};
 use crate::material::physical::{BsdfId, BsdfNode, DistributionKind, Param, Roughness};
+use crate::material::plastic::{specular_sampling_weight, Plastic, RoughPlastic};
+use crate::material::principled::{Principled, PrincipledThin};
 use crate::material::scatter::Scatter;
 use crate::math::{Color, Frame, Vec3};
 use crate::scene::physical::{PhysicalParts, PhysicalSurface};
@@ -35,6 +39,15 @@ const MAX_NESTING: u32 = 16;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Family {
     Diffuse(Diffuse),
+    Conductor(Conductor),
+    RoughConductor(RoughConductor),
+    Dielectric(Dielectric),
+    ThinDielectric(ThinDielectric),
+    RoughDielectric(RoughDielectric),
+    Plastic(Plastic),
+    RoughPlastic(RoughPlastic),
+    Principled(Principled),
+    PrincipledThin(PrincipledThin),
     /// Light passes straight on (a mask's transparent part, `null`).
     Null,
 }
@@ -43,6 +56,15 @@ macro_rules! each_family {
     ($family:expr, $f:ident => $body:expr, $null:expr) => {
         match $family {
             Family::Diffuse($f) => $body,
+            Family::Conductor($f) => $body,
+            Family::RoughConductor($f) => $body,
+            Family::Dielectric($f) => $body,
+            Family::ThinDielectric($f) => $body,
+            Family::RoughDielectric($f) => $body,
+            Family::Plastic($f) => $body,
+            Family::RoughPlastic($f) => $body,
+            Family::Principled($f) => $body,
+            Family::PrincipledThin($f) => $body,
             Family::Null => $null,
         }
     };
@@ -142,16 +164,54 @@ pub struct SurfaceBsdf {
 /// What resolving a tree reads.
 struct Resolver<'a> {
     parts: &'a PhysicalParts,
+    prepared: &'a [Option<RoughPlastic>],
     images: &'a [Image],
     surface: &'a PhysicalSurface,
     /// Towards the viewer, world space.
     wo: Vec3,
 }
 
+/// The tables of every rough plastic of `parts` by BSDF id (`None` elsewhere): Mitsuba's
+/// rough transmittance, tabulated once per material because it takes a million microfacet
+/// evaluations. Its colours are the hit's; its roughness and index must be constants
+/// (Mitsuba's are), read at uv (0, 0).
+pub fn prepare_rough_plastics(
+    parts: &PhysicalParts,
+    images: &[Image],
+) -> Vec<Option<RoughPlastic>> {
+    let at = crate::texture::TexturePoint::default();
+    parts
+        .bsdfs
+        .iter()
+        .map(|node| match node {
+            BsdfNode::Plastic {
+                eta,
+                nonlinear,
+                roughness: Some(r),
+                ..
+            } => Some(RoughPlastic::new(
+                match r.distribution {
+                    DistributionKind::Beckmann => Distribution::Beckmann,
+                    DistributionKind::Ggx => Distribution::Ggx,
+                },
+                r.alpha_u.eval_float(&parts.textures, images, &at),
+                r.sample_visible,
+                *eta,
+                Color::splat(0.5),
+                Color::ONE,
+                *nonlinear,
+            )),
+            _ => None,
+        })
+        .collect()
+}
+
 impl SurfaceBsdf {
-    /// The BSDF of tree `id` at `surface`, seen from world direction `wo`.
+    /// The BSDF of tree `id` at `surface`, seen from world direction `wo`; `prepared` is
+    /// `prepare_rough_plastics` of the same parts.
     pub fn new(
         parts: &PhysicalParts,
+        prepared: &[Option<RoughPlastic>],
         images: &[Image],
         id: BsdfId,
         surface: &PhysicalSurface,
@@ -168,6 +228,7 @@ impl SurfaceBsdf {
         };
         let resolver = Resolver {
             parts,
+            prepared,
             images,
             surface,
             wo,
@@ -320,13 +381,136 @@ impl Resolver<'_> {
                     reflectance: self.color(reflectance),
                 })),
             ),
-            // TODO(bsdf families): wired as they land.
-            BsdfNode::Conductor { .. }
-            | BsdfNode::Dielectric { .. }
-            | BsdfNode::ThinDielectric { .. }
-            | BsdfNode::Plastic { .. }
-            | BsdfNode::Principled(_)
-            | BsdfNode::PrincipledThin(_) => {}
+            BsdfNode::Conductor {
+                eta_k,
+                specular_reflectance,
+                roughness,
+            } => {
+                let specular = self.color(specular_reflectance);
+                let eta_k = eta_k.map(|(eta, k)| (self.color(&eta), self.color(&k)));
+                let family = match (roughness, eta_k) {
+                    (None, Some((eta, k))) => Family::Conductor(Conductor {
+                        eta,
+                        k,
+                        specular_reflectance: specular,
+                    }),
+                    (None, None) => Family::Conductor(Conductor::mirror(specular)),
+                    (Some(r), Some((eta, k))) => Family::RoughConductor(RoughConductor {
+                        eta,
+                        k,
+                        specular_reflectance: specular,
+                        microfacet: self.microfacet(r),
+                    }),
+                    (Some(r), None) => {
+                        Family::RoughConductor(RoughConductor::mirror(specular, self.microfacet(r)))
+                    }
+                };
+                self.push(bsdf, leaf(family));
+            }
+            BsdfNode::Dielectric {
+                eta,
+                specular_reflectance,
+                specular_transmittance,
+                roughness,
+            } => {
+                let (r, t) = (
+                    self.color(specular_reflectance),
+                    self.color(specular_transmittance),
+                );
+                let family = match roughness {
+                    None => Family::Dielectric(Dielectric {
+                        eta: *eta,
+                        specular_reflectance: r,
+                        specular_transmittance: t,
+                    }),
+                    Some(rough) => Family::RoughDielectric(RoughDielectric {
+                        eta: *eta,
+                        specular_reflectance: r,
+                        specular_transmittance: t,
+                        microfacet: self.microfacet(rough),
+                    }),
+                };
+                self.push(bsdf, leaf(family));
+            }
+            BsdfNode::ThinDielectric {
+                eta,
+                specular_reflectance,
+                specular_transmittance,
+            } => self.push(
+                bsdf,
+                leaf(Family::ThinDielectric(ThinDielectric {
+                    eta: *eta,
+                    specular_reflectance: self.color(specular_reflectance),
+                    specular_transmittance: self.color(specular_transmittance),
+                })),
+            ),
+            BsdfNode::Plastic {
+                eta,
+                diffuse_reflectance,
+                specular_reflectance,
+                nonlinear,
+                roughness,
+            } => {
+                let (d, sp) = (
+                    self.color(diffuse_reflectance),
+                    self.color(specular_reflectance),
+                );
+                let family = match (roughness, self.prepared.get(id as usize)) {
+                    (Some(_), Some(Some(tables))) => {
+                        let mean = |c: Color| (c.x + c.y + c.z) / 3.0;
+                        Family::RoughPlastic(RoughPlastic {
+                            diffuse_reflectance: d,
+                            specular_reflectance: sp,
+                            specular_sampling_weight: specular_sampling_weight(mean(d), mean(sp)),
+                            ..*tables
+                        })
+                    }
+                    // A rough plastic nobody prepared (never from `SurfaceBsdf::new`'s
+                    // callers) scatters nothing rather than tabulate per hit.
+                    (Some(_), _) => return,
+                    (None, _) => Family::Plastic(Plastic::new(d, sp, *eta, *nonlinear)),
+                };
+                self.push(bsdf, leaf(family));
+            }
+            BsdfNode::Principled(p) => {
+                let has_spec_trans = p.spec_trans.is_textured() || self.float(&p.spec_trans) != 0.0;
+                let family = Family::Principled(
+                    Principled {
+                        base_color: self.color(&p.base_color),
+                        roughness: self.float(&p.roughness),
+                        anisotropic: self.float(&p.anisotropic),
+                        metallic: self.float(&p.metallic),
+                        spec_trans: self.float(&p.spec_trans),
+                        spec_tint: self.float(&p.spec_tint),
+                        sheen: self.float(&p.sheen),
+                        sheen_tint: self.float(&p.sheen_tint),
+                        flatness: self.float(&p.flatness),
+                        clearcoat: self.float(&p.clearcoat),
+                        clearcoat_gloss: self.float(&p.clearcoat_gloss),
+                        sample_visible: p.sample_visible,
+                        ..Principled::new()
+                    }
+                    .with_eta(self.float(&p.eta), has_spec_trans),
+                );
+                self.push(bsdf, leaf(family));
+            }
+            BsdfNode::PrincipledThin(p) => {
+                let family = Family::PrincipledThin(PrincipledThin {
+                    base_color: self.color(&p.base_color),
+                    roughness: self.float(&p.roughness),
+                    anisotropic: self.float(&p.anisotropic),
+                    spec_trans: self.float(&p.spec_trans),
+                    diff_trans: self.float(&p.diff_trans),
+                    eta: self.float(&p.eta),
+                    spec_tint: self.float(&p.spec_tint),
+                    sheen: self.float(&p.sheen),
+                    sheen_tint: self.float(&p.sheen_tint),
+                    flatness: self.float(&p.flatness),
+                    sample_visible: p.sample_visible,
+                    ..PrincipledThin::new()
+                });
+                self.push(bsdf, leaf(family));
+            }
             BsdfNode::Null => self.push(bsdf, leaf(Family::Null)),
             BsdfNode::TwoSided { front, back } => {
                 if frame.to_local(self.wo).z >= 0.0 {
