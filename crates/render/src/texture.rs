@@ -406,10 +406,9 @@ impl TextureNode {
                 _ => Color::ZERO,
             },
             TextureKind::Checkerboard { color0, color1 } => {
-                // The squares of one colour are where both fractional parts lie on the same
-                // side of 1/2.
-                let upper = |x: f32| x - x.floor() > 0.5;
-                if upper(u) == upper(v) {
+                // The squares of `color0` are where both fractional parts lie on the same side
+                // of 1/2.
+                if checker_square(u, v) {
                     *color0
                 } else {
                     *color1
@@ -466,6 +465,36 @@ impl TextureNode {
         let dfy = ((1.0 - fx) * (f01 - f00) + fx * (f11 - f10)) * h as f32;
         (a * dfx + d * dfy, b * dfx + e * dfy)
     }
+}
+
+impl TextureNode {
+    /// The texture read as a float parameter (Mitsuba's `eval_1`): the luminance of its
+    /// colour, except that a checkerboard read as a float puts `color0` on the other squares,
+    /// as Mitsuba 3.9's `eval_1` does (its `eval` and `eval_1` disagree; scenes made with it
+    /// depend on both).
+    pub fn eval_float(&self, images: &[Image], at: &TexturePoint) -> f32 {
+        match &self.kind {
+            TextureKind::Checkerboard { color0, color1 } => {
+                let [[a, b, c], [d, e, f]] = self.to_uv;
+                let (u0, v0) = at.uv;
+                let (u, v) = (a * u0 + b * v0 + c, d * u0 + e * v0 + f);
+                if checker_square(u, v) {
+                    color1.luminance()
+                } else {
+                    color0.luminance()
+                }
+            }
+            _ => self.eval(images, at).luminance(),
+        }
+    }
+}
+
+/// Whether (u, v) lies on a checkerboard square whose fractional parts fall on the same side
+/// of 1/2.
+#[inline]
+fn checker_square(u: f32, v: f32) -> bool {
+    let upper = |x: f32| x - x.floor() > 0.5;
+    upper(u) == upper(v)
 }
 
 /// Texel coordinate `x` of an axis of `size` texels, brought inside by `wrap`.
@@ -617,6 +646,9 @@ mod mitsuba_texture_tests {
         assert_eq!(node.eval(&[], &at(0.3, 0.1)).x, 0.2);
         // (0.3, 0.3) → (0.6, 0.6): both upper → colour 0.
         assert_eq!(node.eval(&[], &at(0.3, 0.3)).x, 0.4);
+        // Read as a float, Mitsuba swaps the squares.
+        assert_eq!(node.eval_float(&[], &at(0.1, 0.1)), 0.2);
+        assert_eq!(node.eval_float(&[], &at(0.3, 0.1)), 0.4);
     }
 
     #[test]

@@ -39,7 +39,9 @@ impl Param {
     pub fn eval_float(&self, nodes: &[TextureNode], images: &[Image], at: &TexturePoint) -> f32 {
         match self {
             Param::Constant(c) => c.x,
-            Param::Texture(_) => self.eval(nodes, images, at).luminance(),
+            Param::Texture(i) => nodes
+                .get(*i as usize)
+                .map_or(0.0, |node| node.eval_float(images, at)),
         }
     }
 

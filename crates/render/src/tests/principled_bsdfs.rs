@@ -498,6 +498,7 @@ fn thin_smooth_sheet_known_albedo() {
 
 /// A BSDF whose values and weights are `factor` times `inner`'s: a wrong lobe weight that
 /// is consistent with itself.
+#[derive(Debug)]
 struct WeightScaled<B>(B, f32);
 
 impl<B: Scatter> Scatter for WeightScaled<B> {
@@ -526,6 +527,7 @@ impl<B: Scatter> Scatter for WeightScaled<B> {
 
 /// Draws directions from `draws` but claims `claims`'s pdf and eval for them: consistent
 /// with itself sample by sample, so only the histogram can tell.
+#[derive(Debug)]
 struct Mismatched<B> {
     draws: B,
     claims: B,
@@ -597,6 +599,7 @@ fn harness_rejects_wrong_principled_variants() {
         Err(e) => eprintln!("rejected: {e}"),
     }
 
+    #[derive(Debug)]
     struct WrongWeight(Principled);
     impl Scatter for WrongWeight {
         fn eval(&self, wo: Vec3, wi: Vec3) -> Color {
