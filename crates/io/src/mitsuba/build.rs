@@ -20,6 +20,9 @@ use crate::texture_io::{read_image, TextureBudget};
 
 use super::meshes::{self, TriMesh};
 use super::parse::{Element, Parsed};
+
+/// The filter of a Mitsuba film that names none (`hdrfilm`'s default `gaussian`).
+const MITSUBA_DEFAULT_FILTER: PixelFilter = PixelFilter::Gaussian { stddev: 0.5 };
 use super::props::{Props, Spectrum, Value};
 use super::spectrum::{self, Role};
 use super::Files;
@@ -431,7 +434,10 @@ impl<'a> Builder<'a> {
         }
         let (width, height) = match film {
             Some(film) => self.film(film)?,
-            None => (768, 576),
+            None => {
+                self.parts.physical.defaults.filter = MITSUBA_DEFAULT_FILTER;
+                (768, 576)
+            }
         };
         self.parts.physical.defaults.width = Some(width);
         self.parts.physical.defaults.height = Some(height);
@@ -570,6 +576,8 @@ impl<'a> Builder<'a> {
                 ));
             }
         }
+        // Mitsuba's film reconstructs with a Gaussian unless it names a filter.
+        self.parts.physical.defaults.filter = MITSUBA_DEFAULT_FILTER;
         for p in props.unnamed() {
             let child = self.resolve(p)?;
             if child.tag != "rfilter" {
