@@ -650,7 +650,10 @@ impl LightTables {
                     triangles_area = total;
                 }
                 // Refused by `check_supported`: they stay zero words, which emit nothing.
-                Light::Spot { .. } | Light::Directional { .. } | Light::Projector { .. } => {}
+                Light::Spot { .. }
+                | Light::Directional { .. }
+                | Light::Projector { .. }
+                | Light::TexturedTriangles { .. } => {}
             }
             words.extend_from_slice(&w);
             power.push(LightSelection::power(light, triangles_area));

@@ -106,6 +106,7 @@ fn unsupported_feature(parts: &SceneParts) -> Option<String> {
             Light::Spot { .. } => "spot",
             Light::Directional { .. } => "directional",
             Light::Projector { .. } => "projector",
+            Light::TexturedTriangles { .. } => "area (with a textured radiance)",
             _ => continue,
         };
         return Some(format!(

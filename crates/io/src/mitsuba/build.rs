@@ -7,9 +7,9 @@ use std::path::{Path, PathBuf};
 
 use glint_render::{
     Background, BsdfNode, Camera, Color, DistributionKind, GeometryDesc, Image, Instance, Light,
-    Material, MaterialId, Matrix4, MeshAttribute, MeshAttributes, Param, PixelFilter,
-    PrincipledParams, Projection, Roughness, SceneIntegrator, SceneParts, Shape, TexelFilter,
-    TextureKind, TextureNode, Transform, Vec3, Wrap, IDENTITY_UV,
+    Material, MaterialId, Matrix4, MeshAttribute, MeshAttributes, Param, PhysicalParts,
+    PixelFilter, PrincipledParams, Projection, RenderDefaults, Roughness, SceneIntegrator,
+    SceneParts, Shape, TexelFilter, TextureKind, TextureNode, Transform, Vec3, Wrap, IDENTITY_UV,
 };
 
 use crate::assets::{AssetError, Assets, TooLarge};
@@ -110,7 +110,14 @@ pub(crate) fn build(
             background: Background::Color(Color::ZERO),
             geometries: Vec::new(),
             instances: Vec::new(),
-            physical: Default::default(),
+            physical: PhysicalParts {
+                defaults: RenderDefaults {
+                    // Mitsuba chooses among its emitters uniformly.
+                    uniform_light_selection: true,
+                    ..RenderDefaults::default()
+                },
+                ..PhysicalParts::default()
+            },
         },
         budget: TextureBudget::new(*limits),
         bsdfs: HashMap::new(),
@@ -1813,7 +1820,13 @@ impl<'a> Builder<'a> {
         };
         let mut material = surface;
         if let Some(emitter) = emitter {
-            material = self.area_light(emitter, &shapes, &object_to_world, surface)?;
+            material = self.area_light(
+                emitter,
+                &shapes,
+                attributes.uvs.as_deref(),
+                &object_to_world,
+                surface,
+            )?;
         }
         self.parts.geometries.push(GeometryDesc {
             materials: vec![material; shapes.len()],
@@ -1855,6 +1868,7 @@ impl<'a> Builder<'a> {
         &mut self,
         element: &'a Element,
         shapes: &[Shape],
+        uvs: Option<&[[(f32, f32); 3]]>,
         m: &Matrix4,
         surface: MaterialId,
     ) -> Result<MaterialId, SceneError> {
@@ -1872,16 +1886,19 @@ impl<'a> Builder<'a> {
                 "an area emitter takes its shape's to_world, not its own",
             ));
         }
-        let radiance = match self.param_opt(&props, "radiance", Role::Emission)? {
-            None => Color::splat(1.0),
-            Some(Param::Constant(c)) => c,
-            Some(Param::Texture(_)) => {
-                let p = props.get("radiance").expect("read above");
-                return Err(self.error(
-                    p.file,
-                    p.span,
-                    "textured radiance of an area emitter is not supported yet",
-                ));
+        let (radiance, texture) = match self.param_opt(&props, "radiance", Role::Emission)? {
+            None => (Color::splat(1.0), None),
+            Some(Param::Constant(c)) => (c, None),
+            Some(Param::Texture(t)) => {
+                if matches!(shapes, [Shape::Sphere { .. }]) {
+                    let p = props.get("radiance").expect("read above");
+                    return Err(self.error(
+                        p.file,
+                        p.span,
+                        "textured radiance on a sphere emitter is not supported yet (a mesh sphere is)",
+                    ));
+                }
+                (Color::splat(1.0), Some(t))
             }
         };
         props.check_all_used(self.files)?;
@@ -1908,9 +1925,26 @@ impl<'a> Builder<'a> {
                         triangles.push(vertices.map(|v| m.transform_point(v)));
                     }
                 }
-                Light::Triangles {
-                    triangles,
-                    intensity: radiance,
+                match texture {
+                    None => Light::Triangles {
+                        triangles,
+                        intensity: radiance,
+                    },
+                    // Without the mesh's own uvs, a triangle's are its barycentrics (Mitsuba's).
+                    Some(texture) => Light::TexturedTriangles {
+                        uvs: (0..triangles.len())
+                            .map(|t| {
+                                uvs.and_then(|uvs| uvs.get(t).copied()).unwrap_or([
+                                    (0.0, 0.0),
+                                    (1.0, 0.0),
+                                    (0.0, 1.0),
+                                ])
+                            })
+                            .collect(),
+                        triangles,
+                        texture,
+                        intensity: radiance,
+                    },
                 }
             }
         };

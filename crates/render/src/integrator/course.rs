@@ -746,9 +746,11 @@ fn cool_to_warm(scene: &Scene, si: &SurfaceInteraction, n: Vec3, kd: Color) -> C
             | Light::Sphere {
                 center: position, ..
             } => *position,
-            Light::Triangles { triangles, .. } => triangles
-                .first()
-                .map_or(si.point, |t| (t[0] + t[1] + t[2]) / 3.0),
+            Light::Triangles { triangles, .. } | Light::TexturedTriangles { triangles, .. } => {
+                triangles
+                    .first()
+                    .map_or(si.point, |t| (t[0] + t[1] + t[2]) / 3.0)
+            }
             Light::Spot { to_world, .. } | Light::Projector { to_world, .. } => {
                 to_world.point_to_world(Vec3::ZERO)
             }

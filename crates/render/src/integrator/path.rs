@@ -305,10 +305,23 @@ impl PathIntegrator {
             let mut behind_emitter = false;
             if let Emitter::Light(_) | Emitter::Unsampled(_) = material.emitter {
                 let emitted = match material.emitter {
-                    Emitter::Light(index) => {
-                        self.lights
-                            .emission_towards(index, ray.direction, si.normal)
-                    }
+                    Emitter::Light(index) => self
+                        .lights
+                        .emission_towards(index, ray.direction, si.normal)
+                        .map(|emitted| match self.lights.radiance_texture(index) {
+                            // A textured radiance, read at the hit's uv.
+                            Some(texture) => {
+                                let at = scene.physical_surface(&ray, &hit).texture;
+                                scene
+                                    .physical
+                                    .textures
+                                    .get(texture as usize)
+                                    .map_or(Color::ZERO, |node| {
+                                        emitted.mul_elem(node.eval(&scene.textures, &at))
+                                    })
+                            }
+                            None => emitted,
+                        }),
                     // An emitter no light samples: one-sided along its geometric normal.
                     Emitter::Unsampled(emitted) => {
                         (ray.direction.dot(si.normal) < 0.0).then_some(emitted)

@@ -33,6 +33,15 @@ pub enum Light {
         triangles: Vec<[Vec3; 3]>,
         intensity: Color,
     },
+    /// Mitsuba's `area` emitter with a textured `radiance`: emitting triangles whose
+    /// radiance at a point is `PhysicalParts::textures[texture]` at its uv, interpolated
+    /// from `uvs` (one entry per triangle), times `intensity`.
+    TexturedTriangles {
+        triangles: Vec<[Vec3; 3]>,
+        uvs: Vec<[(f32, f32); 3]>,
+        texture: u32,
+        intensity: Color,
+    },
     /// Mitsuba's `spot`: at the origin of `to_world` (a rigid transform), shining along its
     /// +z; full `intensity` inside `beam_width`, falling off smoothly to zero at
     /// `cutoff_angle` (both in degrees, half-angles), optionally modulated by a texture
@@ -72,6 +81,7 @@ impl Light {
             | Light::Area { intensity, .. }
             | Light::Sphere { intensity, .. }
             | Light::Triangles { intensity, .. }
+            | Light::TexturedTriangles { intensity, .. }
             | Light::Spot { intensity, .. } => *intensity,
             Light::Directional { irradiance, .. } => *irradiance,
             Light::Projector { scale, .. } => Color::splat(*scale),

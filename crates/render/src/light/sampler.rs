@@ -140,12 +140,12 @@ pub(crate) fn course_light_point(
                 pdf_area: 1.0 / area.max(f32::MIN_POSITIVE),
             }
         }
-        Light::Triangles { .. } => {
+        Light::Triangles { .. } | Light::TexturedTriangles { .. } => {
             let point = lights.and_then(|lights| {
                 lights.triangle_point(index, u.unwrap_or((0.5, 1.0 / 3.0)), u.is_none())
             });
             match point {
-                Some((point, _)) => point,
+                Some((point, _, _)) => point,
                 None => LightPoint {
                     position: p,
                     normal: None,
@@ -183,6 +183,9 @@ enum PreparedLight {
         /// 1 / area: the density per unit area of a point sampled on the light.
         inverse_area: f32,
         radiance: Color,
+        /// A textured radiance: the texture node, and where the triangles' uvs start in
+        /// `LightSampler::triangle_uvs`; the radiance is `radiance` times the texture.
+        texture: Option<(u32, u32)>,
     },
     Environment,
     /// Mitsuba's `spot`: intensity × falloff(θ) × texture(uv) / r², θ from the local +z.
@@ -239,6 +242,8 @@ pub struct LightSampler {
     reachable: Vec<bool>,
     selection: LightSelection,
     triangles: Vec<PreparedTriangle>,
+    /// The corner uvs of textured emitting triangles (`PreparedLight::Triangles::texture`).
+    triangle_uvs: Vec<[(f32, f32); 3]>,
     environment: Option<EnvironmentDistribution>,
 }
 
@@ -261,6 +266,7 @@ impl LightSampler {
     fn prepare(scene: &Scene, with_environment: bool) -> LightSampler {
         let mut lights = Vec::with_capacity(scene.lights.len() + 1);
         let mut triangles = Vec::new();
+        let mut triangle_uvs = Vec::new();
         let mut power = Vec::with_capacity(scene.lights.len() + 1);
         let mut reachable = vec![false; scene.lights.len()];
         for material in &scene.materials {
@@ -320,7 +326,22 @@ impl LightSampler {
                 Light::Triangles {
                     triangles: list,
                     intensity,
+                }
+                | Light::TexturedTriangles {
+                    triangles: list,
+                    intensity,
+                    ..
                 } => {
+                    let texture = match light {
+                        Light::TexturedTriangles { uvs, texture, .. } => {
+                            let uv_first = triangle_uvs.len() as u32;
+                            triangle_uvs.extend(
+                                (0..list.len()).map(|i| uvs.get(i).copied().unwrap_or_default()),
+                            );
+                            Some((*texture, uv_first))
+                        }
+                        _ => None,
+                    };
                     let first = triangles.len() as u32;
                     let mut total = 0.0f64;
                     for &[v0, v1, v2] in list {
@@ -353,6 +374,7 @@ impl LightSampler {
                         area: total as f32,
                         inverse_area: 1.0 / total as f32,
                         radiance: *intensity,
+                        texture,
                     }
                 }
                 Light::Spot {
@@ -413,6 +435,9 @@ impl LightSampler {
                     texture_aspect(scene, *irradiance),
                     *scale * texture_mean(scene, *irradiance),
                 ),
+                Light::TexturedTriangles { texture, .. } => {
+                    LightSelection::power(light, triangles_area) * texture_mean(scene, *texture)
+                }
                 _ => LightSelection::power(light, triangles_area),
             });
         }
@@ -427,8 +452,17 @@ impl LightSampler {
         LightSampler {
             lights,
             reachable,
-            selection: LightSelection::new(&power),
+            selection: if scene.physical.defaults.uniform_light_selection {
+                let uniform: Vec<f32> = power
+                    .iter()
+                    .map(|&p| if p > 0.0 { 1.0 } else { 0.0 })
+                    .collect();
+                LightSelection::new(&uniform)
+            } else {
+                LightSelection::new(&power)
+            },
             triangles,
+            triangle_uvs,
             environment,
         }
     }
@@ -460,7 +494,7 @@ impl LightSampler {
         let u = (remapped, u.1);
         // Shape emitters, the commonest lights, inline; the others out of line.
         let mut sample = match self.lights.get(index)? {
-            PreparedLight::Triangles { .. } => self.sample_triangles(index, reference, u)?,
+            PreparedLight::Triangles { .. } => self.sample_triangles(scene, index, reference, u)?,
             _ => self.sample_light(scene, index, reference, u)?,
         };
         sample.pdf *= probability;
@@ -472,11 +506,23 @@ impl LightSampler {
     #[inline]
     fn sample_triangles(
         &self,
+        scene: &Scene,
         index: usize,
         reference: Vec3,
         u: (f32, f32),
     ) -> Option<LightSample> {
-        let (point, radiance) = self.triangle_point(index, u, false)?;
+        let (point, mut radiance, (slot, b1, b2)) = self.triangle_point(index, u, false)?;
+        if let Some(PreparedLight::Triangles {
+            first,
+            texture: Some((texture, uv_first)),
+            ..
+        }) = self.lights.get(index)
+        {
+            let uvs = self
+                .triangle_uvs
+                .get((*uv_first as usize) + slot - *first as usize)?;
+            radiance = radiance.mul_elem(textured_radiance(scene, *texture, uvs, b1, b2));
+        }
         let mut sample = area_sample(reference, point, radiance)?;
         sample.reachable_by_bsdf = self.reachable_by_bsdf(index);
         Some(sample)
@@ -492,7 +538,7 @@ impl LightSampler {
         index: usize,
         u: (f32, f32),
         centroid: bool,
-    ) -> Option<(LightPoint, Color)> {
+    ) -> Option<(LightPoint, Color, (usize, f32, f32))> {
         let PreparedLight::Triangles {
             first,
             count,
@@ -504,10 +550,10 @@ impl LightSampler {
             return None;
         };
         let list = &self.triangles[first as usize..(first + count) as usize];
-        let (triangle, u0) = match list {
+        let (chosen, u0) = match list {
             [] => return None,
             // One triangle (a shape light): all of u.0 is its own.
-            [triangle] => (triangle, u.0),
+            [_] => (0, u.0),
             _ => {
                 let chosen = list
                     .partition_point(|t| t.cumulative <= u.0)
@@ -521,9 +567,10 @@ impl LightSampler {
                 if width <= 0.0 {
                     return None;
                 }
-                (&list[chosen], ((u.0 - start) / width).clamp(0.0, 1.0))
+                (chosen, ((u.0 - start) / width).clamp(0.0, 1.0))
             }
         };
+        let triangle = &list[chosen];
         let (b1, b2) = if centroid {
             (1.0 / 3.0, 1.0 / 3.0)
         } else {
@@ -534,7 +581,20 @@ impl LightSampler {
             normal: Some(triangle.normal),
             pdf_area: inverse_area,
         };
-        Some((point, radiance))
+        Some((point, radiance, (first as usize + chosen, b1, b2)))
+    }
+
+    /// The texture of light `index`'s radiance when it is textured (`Light::TexturedTriangles`):
+    /// an emitter hit multiplies `emission_towards` by it at the hit's uv.
+    #[inline]
+    pub fn radiance_texture(&self, index: usize) -> Option<u32> {
+        match self.lights.get(index) {
+            Some(PreparedLight::Triangles {
+                texture: Some((texture, _)),
+                ..
+            }) => Some(*texture),
+            _ => None,
+        }
     }
 
     /// A point on light `index` as seen from `reference`; the pdf is per unit solid angle of
@@ -586,7 +646,7 @@ impl LightSampler {
                     ..s
                 })
             }
-            PreparedLight::Triangles { .. } => self.sample_triangles(index, reference, u),
+            PreparedLight::Triangles { .. } => self.sample_triangles(scene, index, reference, u),
             PreparedLight::Sphere {
                 center,
                 radius,
@@ -961,7 +1021,9 @@ impl LightSelection {
                 let radius = radius.abs();
                 PI * 4.0 * PI * radius * radius * mean(*intensity)
             }
-            Light::Triangles { intensity, .. } => PI * triangles_area as f32 * mean(*intensity),
+            Light::Triangles { intensity, .. } | Light::TexturedTriangles { intensity, .. } => {
+                PI * triangles_area as f32 * mean(*intensity)
+            }
         };
         if phi.is_finite() {
             phi.max(0.0)
@@ -1719,4 +1781,20 @@ mod tests {
             "{sum}"
         );
     }
+}
+
+/// Radiance texture `texture` at barycentrics (b1, b2) of a triangle with corner uvs `uvs`.
+fn textured_radiance(
+    scene: &Scene,
+    texture: u32,
+    uvs: &[(f32, f32); 3],
+    b1: f32,
+    b2: f32,
+) -> Color {
+    let b0 = 1.0 - b1 - b2;
+    let uv = (
+        uvs[0].0 * b0 + uvs[1].0 * b1 + uvs[2].0 * b2,
+        uvs[0].1 * b0 + uvs[1].1 * b1 + uvs[2].1 * b2,
+    );
+    texture_value(scene, texture, uv)
 }

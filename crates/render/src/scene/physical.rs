@@ -76,6 +76,11 @@ pub struct RenderDefaults {
     /// Emitters and the environment are not seen directly (Mitsuba's `hide_emitters`).
     pub hide_emitters: bool,
     pub filter: PixelFilter,
+    /// Next-event estimation picks every emitting light with the same probability, as
+    /// Mitsuba does, instead of in proportion to its power. Mitsuba's references (and their
+    /// variance images, by which its test rule judges) come from that estimator; power
+    /// misjudges lights whose light reaches a pixel only after bounces (spots on a floor).
+    pub uniform_light_selection: bool,
 }
 
 /// Shading data of a hit on a physically based material, as Mitsuba 3.9 computes it

@@ -1274,7 +1274,7 @@ fn course_lights_leave_the_environment_out() {
     let mut rng = Rng::new(5, 9);
     for _ in 0..100 {
         let u = (rng.next_f32(), rng.next_f32());
-        let point = |s: &LightSampler| s.triangle_point(0, u, false).map(|(p, _)| p.position);
+        let point = |s: &LightSampler| s.triangle_point(0, u, false).map(|(p, _, _)| p.position);
         assert!(point(&course).is_some());
         assert_eq!(point(&course), point(&all));
     }
