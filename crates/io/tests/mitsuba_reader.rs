@@ -662,3 +662,32 @@ fn broken_shape_files_are_located_errors() {
         assert_eq!(line, 2, "{message}");
     }
 }
+
+#[test]
+fn rr_depth_is_kept_as_mitsuba_counts_it() {
+    let depth = |integrator: &str| {
+        let scene = format!("<scene version=\"3.0.0\">{integrator}</scene>");
+        load_text(&scene, &[])
+            .unwrap()
+            .parts
+            .physical
+            .defaults
+            .russian_roulette_depth
+    };
+    // Both renderers start roulette once `depth >= rr_depth`, depth counted after the
+    // bounce, so the value passes through unchanged.
+    assert_eq!(depth(r#"<integrator type="path"/>"#), Some(5));
+    assert_eq!(
+        depth(r#"<integrator type="path"><integer name="rr_depth" value="3"/></integrator>"#),
+        Some(3)
+    );
+    assert_eq!(
+        depth(r#"<integrator type="path"><integer name="rr_depth" value="1"/></integrator>"#),
+        Some(1)
+    );
+    let (_, _, message) = error_at(load_text(
+        r#"<scene version="3.0.0"><integrator type="path"><integer name="rr_depth" value="0"/></integrator></scene>"#,
+        &[],
+    ));
+    assert!(message.contains("rr_depth"), "{message}");
+}

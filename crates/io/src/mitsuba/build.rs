@@ -354,7 +354,9 @@ impl<'a> Builder<'a> {
                     let p = props.get("rr_depth").expect("read above");
                     return Err(files.error(p.file, p.span, "rr_depth must be at least 1"));
                 }
-                defaults.russian_roulette_depth = Some((rr_depth - 1) as u32);
+                // Mitsuba and Glint both compare the scattering events so far, counted
+                // after the increment, with it: the same number.
+                defaults.russian_roulette_depth = Some(rr_depth as u32);
                 defaults.hide_emitters = props.boolean(files, "hide_emitters", false)?;
                 props.ignore("samples_per_pass");
             }
