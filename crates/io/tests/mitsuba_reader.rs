@@ -220,7 +220,7 @@ fn defaults_and_defines_substitute() {
     assert_eq!(d.filter, PixelFilter::Gaussian { stddev: 0.5 });
     assert_eq!(
         (d.integrator, d.max_depth, d.russian_roulette_depth),
-        (Some(SceneIntegrator::Path), Some(2), Some(4))
+        (Some(SceneIntegrator::Path), Some(2), Some(5))
     );
     let d = load_text(scene, &[("spp", "64")])
         .unwrap()
