@@ -1644,10 +1644,12 @@ impl<'a> Builder<'a> {
                     )
                 }
                 other => {
-                    return Err(self.element_error(
-                        child,
+                    // At the reference, where the mistake is, when it is one.
+                    return Err(self.error(
+                        p.file,
+                        p.span,
                         format!("a shape takes a BSDF and an emitter, not a <{other}>"),
-                    ))
+                    ));
                 }
             }
         }
