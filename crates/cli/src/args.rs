@@ -130,7 +130,7 @@ pub struct MergeArgs {
 }
 
 /// How strict a load is and what it may take: shared by rendering and `glint check`.
-#[derive(Args, Debug, Clone)]
+#[derive(Args, Debug, Clone, PartialEq)]
 pub struct LimitOptions {
     /// Treat every warning about the scene as an error (exit 2, nothing rendered).
     #[arg(long, action = ArgAction::SetTrue)]
@@ -232,29 +232,32 @@ pub fn parse_size(text: &str) -> Result<u64, String> {
 }
 
 /// Options shared by both forms.
-#[derive(Args, Debug, Clone)]
+#[derive(Args, Debug, Clone, PartialEq)]
 pub struct Options {
     /// Output image, .png or .exr [default: ./SCENE-NAME.png].
     #[arg(short = 'o', long = "outputfile", value_name = "FILE")]
     pub output: Option<PathBuf>,
 
-    /// Image width in pixels.
-    #[arg(short = 'w', long, value_name = "PIXELS", default_value_t = 100,
+    /// Image width in pixels [default: the scene's film, else 100].
+    #[arg(short = 'w', long, value_name = "PIXELS",
           value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
-    pub width: u32,
+    pub width: Option<u32>,
 
-    /// Image height in pixels (-h is height, as in the course: help is -?).
-    #[arg(short = 'h', long, value_name = "PIXELS", default_value_t = 100,
+    /// Image height in pixels (-h is height, as in the course: help is -?) [default: the
+    /// scene's film, else 100].
+    #[arg(short = 'h', long, value_name = "PIXELS",
           value_parser = clap::value_parser!(u32).range(1..=MAX_SIDE as i64))]
-    pub height: u32,
+    pub height: Option<u32>,
 
-    /// Rays per pixel, on an N x N jittered grid, N = floor(sqrt(RPP)).
+    /// Rays per pixel, on an N x N jittered grid, N = floor(sqrt(RPP)) [default: the scene's
+    /// sample_count, else 1].
     #[arg(short = 'r', long = "rpp", visible_alias = "spp", value_name = "RPP",
-          default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
-    pub rpp: u32,
+          value_parser = clap::value_parser!(u32).range(1..))]
+    pub rpp: Option<u32>,
 
     /// Maximum recursion depth: reflection/refraction for the course integrator, scattering
-    /// events for the path tracer [default: 4 for the course, unbounded (1024) for path].
+    /// events for the path tracer [default: 4 for the course; for path the scene's max_depth
+    /// (1 for its `direct` integrator), else unbounded (1024)].
     #[arg(short = 'k', long = "recursionDepth", value_name = "DEPTH",
           value_parser = clap::value_parser!(u32).range(0..=MAX_DEPTH as i64))]
     pub recursion_depth: Option<u32>,
@@ -279,9 +282,9 @@ pub struct Options {
     /// `course`: the course's ray tracer. `path`: the physically based path tracer (exactly
     /// RPP samples per pixel). Debug views of the first hit: `normals` ((n + 1) / 2),
     /// `albedo`, `depth`. An .exr output also gets `albedo`, `normal` and `depth` layers.
-    #[arg(long, visible_alias = "shader", value_name = "NAME", value_enum,
-          default_value_t = IntegratorArg::Course)]
-    pub integrator: IntegratorArg,
+    /// [default: `path` for a scene that names an integrator (Mitsuba's), else `course`]
+    #[arg(long, visible_alias = "shader", value_name = "NAME", value_enum)]
+    pub integrator: Option<IntegratorArg>,
 
     /// PNG only: exposure in stops (values times 2^EV) before the tone curve. Giving it, or
     /// --tonemap or --transfer, turns on the display transform for any integrator.

@@ -7,7 +7,9 @@ use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 use glint_io::{DisplayTransform, PngEncoding, ToneMap, Transfer};
-use glint_render::{Color, IntegratorKind, RenderSettings, SplitMethod};
+use glint_render::{
+    Color, IntegratorKind, RenderDefaults, RenderSettings, SceneIntegrator, SplitMethod,
+};
 
 use crate::args::{
     Cli, Command, DeviceArg, IntegratorArg, Options, Rgb, ToneMapArg, TransferArg, MAX_SIDE,
@@ -68,6 +70,35 @@ pub struct Job {
     pub checkpoint: Option<Checkpointing>,
     /// Between progress lines when stderr is not a terminal.
     pub progress_every: Duration,
+    /// The options as given, to settle again with the scene's render defaults once it is
+    /// loaded (`Job::with_scene_defaults`).
+    options: Box<Options>,
+}
+
+/// What depends on the image size, the samples and the integrator, which a scene may set.
+struct Settled {
+    settings: RenderSettings,
+    preview: Option<(u32, u32)>,
+    png: PngEncoding,
+    notes: Vec<String>,
+}
+
+impl Job {
+    /// The job with the scene's render defaults (a Mitsuba scene's film, samples, integrator
+    /// and depth) wherever the user gave no flag; the same job for scenes that set none.
+    pub fn with_scene_defaults(&self, defaults: &RenderDefaults) -> Result<Job, UsageError> {
+        if *defaults == RenderDefaults::default() {
+            return Ok(self.clone());
+        }
+        let settled = self.options.settle(&self.output, defaults)?;
+        Ok(Job {
+            settings: settled.settings,
+            preview: settled.preview,
+            png: settled.png,
+            notes: settled.notes,
+            ..self.clone()
+        })
+    }
 }
 
 /// Where and how often a render keeps its finished part.
@@ -111,7 +142,8 @@ impl Cli {
 
 impl Options {
     fn into_job(self, scene: PathBuf, available_threads: usize) -> Result<Job, UsageError> {
-        let output = match self.output {
+        let options = Box::new(self.clone());
+        let output = match self.output.clone() {
             Some(output) if output.as_os_str().is_empty() => {
                 return Err(UsageError("the output file name is empty".to_string()))
             }
@@ -135,51 +167,9 @@ impl Options {
                     .into(),
             );
         }
-        // One side given: the other keeps the image's aspect ratio.
-        let scaled = |side: u32, from: u32, to: u32| {
-            ((side as u64 * to as u64).div_ceil(from as u64)).clamp(1, MAX_SIDE as u64) as u32
-        };
-        let preview = match (self.winwidth, self.winheight) {
-            (Some(w), Some(h)) => Some((w, h)),
-            (Some(w), None) => Some((w, scaled(w, self.width, self.height))),
-            (None, Some(h)) => Some((scaled(h, self.height, self.width), h)),
-            (None, None) => None,
-        };
-        let pixel_bounds = match (self.crop_window, self.pixel_bounds, self.tile) {
-            (Some(crop), _, _) => Some(crop.pixel_bounds(self.width, self.height)?),
-            (_, Some(bounds), _) => Some(bounds),
-            (_, _, Some(tile)) => Some(tile.pixel_bounds(self.width, self.height)?),
-            _ => None,
-        };
-        let integrator = IntegratorKind::from(self.integrator);
-        let sample_range = self
-            .sample_range
-            .as_ref()
-            .map(|range| range.resolve(integrator.samples_per_pixel(self.rpp)))
-            .transpose()?;
-        if sample_range.is_some() && !output_is_exr(&output) {
-            return Err(UsageError(format!(
-                "--sample-range needs an .exr output (it keeps each pixel's sum and sample \
-                 count for `glint merge`), not '{}'",
-                output.display()
-            )));
-        }
-        let settings = RenderSettings {
-            width: self.width,
-            height: self.height,
-            samples_per_pixel: self.rpp,
-            max_depth: self.recursion_depth,
-            aspect: self.aspect,
-            seed: self.seed,
-            integrator,
-            // Feature layers cost a first-hit ray per sample; only an EXR keeps them, and
-            // only a whole range of samples averages them (merge cannot add them up).
-            features: output_is_exr(&output) && sample_range.is_none(),
-            pixel_bounds,
-            sample_range,
-            ..RenderSettings::default()
-        };
-        settings.validate().map_err(UsageError)?;
+        let settled = self.settle(&output, &RenderDefaults::default())?;
+        notes.extend(settled.notes);
+        let settings = settled.settings;
         let checkpoint = match (self.checkpoint, self.resume) {
             (Some(file), _) => Some((file, false)),
             (_, Some(file)) => Some((file, true)),
@@ -206,15 +196,6 @@ impl Options {
                 )));
             }
         }
-        // The path tracer takes exactly RPP samples; the course's grid takes N².
-        let taken = settings.samples_per_pixel();
-        if taken != self.rpp {
-            let grid = (taken as f64).sqrt() as u32;
-            notes.push(format!(
-                "-r {} is not a perfect square: using a {grid}x{grid} grid, {taken} rays per pixel",
-                self.rpp,
-            ));
-        }
         let (limits, max_memory) = self.limits.resolve();
         Ok(Job {
             strict: self.limits.strict,
@@ -228,7 +209,7 @@ impl Options {
                 .threads
                 .map_or(available_threads.max(1), |n| n as usize),
             background: self.background.map(Rgb::to_color),
-            png: png_encoding(self.integrator, self.exposure, self.tonemap, self.transfer),
+            png: settled.png,
             device: self.device,
             verbose: self.verbose,
             split: self.split,
@@ -237,11 +218,93 @@ impl Options {
                 .filter(|&distance| distance > 0.0)
                 .map(|distance| (distance, self.aperture)),
             stats: self.stats,
-            preview,
+            preview: settled.preview,
             preview_close: self.preview_close,
             notes,
             checkpoint,
             progress_every: Duration::from_secs_f64(self.progress_every),
+            options,
+        })
+    }
+    /// Settles what the scene may set: the flags given, else `defaults`, else the course's
+    /// (100 × 100, one sample, the course integrator).
+    fn settle(&self, output: &Path, defaults: &RenderDefaults) -> Result<Settled, UsageError> {
+        let mut notes = Vec::new();
+        let width = self.width.or(defaults.width).unwrap_or(100);
+        let height = self.height.or(defaults.height).unwrap_or(100);
+        let rpp = self.rpp.or(defaults.samples_per_pixel).unwrap_or(1);
+        // A scene that names an integrator is meant for the path tracer.
+        let integrator_arg = self.integrator.unwrap_or(match defaults.integrator {
+            Some(_) => IntegratorArg::Path,
+            None => IntegratorArg::Course,
+        });
+        // The scene's depth counts scattering events, the path tracer's count.
+        let max_depth = self.recursion_depth.or(match integrator_arg {
+            IntegratorArg::Path => match defaults.integrator {
+                Some(SceneIntegrator::Direct) => Some(1),
+                Some(SceneIntegrator::Path) => defaults.max_depth,
+                None => None,
+            },
+            _ => None,
+        });
+        // One side given: the other keeps the image's aspect ratio.
+        let scaled = |side: u32, from: u32, to: u32| {
+            ((side as u64 * to as u64).div_ceil(from as u64)).clamp(1, MAX_SIDE as u64) as u32
+        };
+        let preview = match (self.winwidth, self.winheight) {
+            (Some(w), Some(h)) => Some((w, h)),
+            (Some(w), None) => Some((w, scaled(w, width, height))),
+            (None, Some(h)) => Some((scaled(h, height, width), h)),
+            (None, None) => None,
+        };
+        let pixel_bounds = match (self.crop_window, self.pixel_bounds, self.tile) {
+            (Some(crop), _, _) => Some(crop.pixel_bounds(width, height)?),
+            (_, Some(bounds), _) => Some(bounds),
+            (_, _, Some(tile)) => Some(tile.pixel_bounds(width, height)?),
+            _ => None,
+        };
+        let integrator = IntegratorKind::from(integrator_arg);
+        let sample_range = self
+            .sample_range
+            .as_ref()
+            .map(|range| range.resolve(integrator.samples_per_pixel(rpp)))
+            .transpose()?;
+        if sample_range.is_some() && !output_is_exr(output) {
+            return Err(UsageError(format!(
+                "--sample-range needs an .exr output (it keeps each pixel's sum and sample \
+                 count for `glint merge`), not '{}'",
+                output.display()
+            )));
+        }
+        let settings = RenderSettings {
+            width,
+            height,
+            samples_per_pixel: rpp,
+            max_depth,
+            aspect: self.aspect,
+            seed: self.seed,
+            integrator,
+            // Feature layers cost a first-hit ray per sample; only an EXR keeps them, and
+            // only a whole range of samples averages them (merge cannot add them up).
+            features: output_is_exr(output) && sample_range.is_none(),
+            pixel_bounds,
+            sample_range,
+            ..RenderSettings::default()
+        };
+        settings.validate().map_err(UsageError)?;
+        // The path tracer takes exactly RPP samples; the course's grid takes N².
+        let taken = settings.samples_per_pixel();
+        if taken != rpp {
+            let grid = (taken as f64).sqrt() as u32;
+            notes.push(format!(
+                "-r {rpp} is not a perfect square: using a {grid}x{grid} grid, {taken} rays per pixel",
+            ));
+        }
+        Ok(Settled {
+            settings,
+            preview,
+            png: png_encoding(integrator_arg, self.exposure, self.tonemap, self.transfer),
+            notes,
         })
     }
 }

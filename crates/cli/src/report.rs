@@ -180,7 +180,6 @@ pub fn print_warnings(warnings: &[Diagnostic], limit: usize, err: &mut dyn Write
 #[cfg(test)]
 mod tests {
     use super::*;
-    use glint_render::RenderSettings;
 
     use crate::args::DeviceArg;
 
@@ -194,34 +193,19 @@ mod tests {
     }
 
     fn job(integrator: glint_render::IntegratorKind) -> Job {
-        Job {
-            scene: "s.xml".into(),
-            output: "out.png".into(),
-            settings: RenderSettings {
-                width: 250,
-                height: 250,
-                samples_per_pixel: 16,
-                integrator,
-                ..RenderSettings::default()
-            },
-            threads: 2,
-            background: None,
-            png: glint_io::PngEncoding::Course,
-            device: DeviceArg::Cpu,
-            verbose: false,
-            split: glint_render::SplitMethod::Sah,
-            depth_of_field: None,
-            stats: false,
-            preview: None,
-            preview_close: false,
-            notes: Vec::new(),
-            strict: false,
-            limits: glint_io::Limits::default(),
-            defines: Vec::new(),
-            max_memory: 1 << 30,
-            checkpoint: None,
-            progress_every: Duration::from_secs(5),
-        }
+        use clap::Parser;
+        let args = [
+            "glint", "-i", "s.xml", "-o", "out.png", "-w", "250", "-h", "250", "-r", "16", "-n",
+            "2",
+        ];
+        let mut job = crate::args::Cli::try_parse_from(args)
+            .unwrap()
+            .into_job(2)
+            .unwrap();
+        job.settings.integrator = integrator;
+        job.png = glint_io::PngEncoding::Course;
+        assert_eq!(job.device, DeviceArg::Cpu);
+        job
     }
 
     #[test]

@@ -48,6 +48,19 @@ pub fn run(
     let film_bytes = memory::film_bytes(&job.settings);
     memory::check(film_bytes, 0, 0, job.max_memory)?;
     let loaded = load(job, &pool, film_bytes, err)?;
+    // A scene may set its film, samples, integrator and depth (Mitsuba's do); flags win.
+    let settled = job
+        .with_scene_defaults(&loaded.parts.physical.defaults)
+        .map_err(Failure::Usage)?;
+    for note in settled
+        .notes
+        .iter()
+        .filter(|note| !job.notes.contains(note))
+    {
+        let _ = writeln!(err, "note: {note}");
+    }
+    let job = &settled;
+    let film_bytes = memory::film_bytes(&job.settings);
     check_memory(job, film_bytes, &loaded.parts)?;
     if job.device == DeviceArg::Gpu {
         return crate::gpu::run(job, &loaded.parts, interrupt, err, progress_bar);

@@ -847,3 +847,94 @@ fn bench_rays_walks_report_which_ran_and_agree() {
         );
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Mitsuba scenes bring their own render settings
+
+/// A diffuse square lit by a constant environment, with a 12x8 film, 4 samples, and the path
+/// tracer at Mitsuba's max_depth 3 (two scattering events in Glint's count).
+const MITSUBA_XML: &str = r#"<scene version="3.0.0">
+  <integrator type="path"><integer name="max_depth" value="3"/></integrator>
+  <sensor type="perspective">
+    <float name="fov" value="45"/>
+    <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="12"/><integer name="height" value="8"/></film>
+  </sensor>
+  <emitter type="constant"/>
+  <shape type="rectangle"><bsdf type="conductor"/></shape>
+</scene>
+"#;
+
+#[test]
+fn a_mitsuba_scene_renders_with_its_own_settings_unless_flags_say_otherwise() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.xml"), MITSUBA_XML).unwrap();
+    let result = glint_in(dir.path(), &["render", "m.xml", "-o", "out.exr", "-v"]);
+    assert_exit(&result, 0);
+    let log = stderr(&result);
+    assert!(
+        log.contains("rendering 12x8, 4 samples per pixel, depth 2,")
+            && log.contains("path integrator"),
+        "{log}"
+    );
+    let image = image::open(dir.path().join("out.exr")).unwrap();
+    assert_eq!(image::GenericImageView::dimensions(&image), (12, 8));
+    // Every flag still wins over the scene.
+    let result = glint_in(
+        dir.path(),
+        &[
+            "render",
+            "m.xml",
+            "-o",
+            "flags.exr",
+            "-v",
+            "-w",
+            "6",
+            "-h",
+            "5",
+            "--spp",
+            "9",
+            "-k",
+            "7",
+            "--integrator",
+            "normals",
+        ],
+    );
+    assert_exit(&result, 0);
+    let log = stderr(&result);
+    assert!(
+        log.contains("rendering 6x5, 9 samples per pixel, depth 7,")
+            && log.contains("normals integrator"),
+        "{log}"
+    );
+    let image = image::open(dir.path().join("flags.exr")).unwrap();
+    assert_eq!(image::GenericImageView::dimensions(&image), (6, 5));
+    // `direct` is the path tracer with one scattering event.
+    let direct = MITSUBA_XML.replace(
+        r#"<integrator type="path"><integer name="max_depth" value="3"/></integrator>"#,
+        r#"<integrator type="direct"/>"#,
+    );
+    std::fs::write(dir.path().join("d.xml"), direct).unwrap();
+    let result = glint_in(dir.path(), &["render", "d.xml", "-o", "d.exr", "-v"]);
+    assert_exit(&result, 0);
+    let log = stderr(&result);
+    assert!(
+        log.contains("depth 1,") && log.contains("path integrator"),
+        "{log}"
+    );
+}
+
+#[test]
+fn the_gpu_refuses_mitsubas_materials_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("m.xml"), MITSUBA_XML).unwrap();
+    let result = glint_in(
+        dir.path(),
+        &["render", "m.xml", "-o", "g.exr", "--device", "gpu"],
+    );
+    assert_exit(&result, 2);
+    let log = stderr(&result);
+    assert!(log.contains("conductor"), "{log}");
+    assert!(!dir.path().join("g.exr").exists());
+}

@@ -661,3 +661,86 @@ fn a_refused_scene_leaves_the_previous_image() {
     assert_eq!(std::fs::read(case.path("out.png")).unwrap(), b"previous");
     case.assert_nothing_written();
 }
+
+/// A Mitsuba 3 scene: a sphere under a constant environment; `</scene>` is where each case adds
+/// its part.
+const MITSUBA_XML: &str = r#"<scene version="3.0.0">
+  <sensor type="perspective">
+    <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+  </sensor>
+  <emitter type="constant"/>
+  <shape type="sphere"/>
+</scene>
+"#;
+
+fn mitsuba_with(part: &str) -> String {
+    MITSUBA_XML.replacen("</scene>", &format!("{part}\n</scene>"), 1)
+}
+
+/// Mitsuba scenes that lie, loop or name what is not there, each with its scene text, the
+/// line the error must point at (empty: any line of the file named) and what the message must
+/// say.
+fn bad_mitsuba_scenes() -> Vec<(&'static str, String, &'static str, &'static str)> {
+    vec![
+        ("cycle.xml", mitsuba_with("  <include filename=\"other.xml\"/>"), "", "includes itself"),
+        ("self.xml", mitsuba_with("  <include filename=\"self.xml\"/>"), "<include", "includes itself"),
+        ("define.xml", mitsuba_with("  <default name=\"a\" value=\"$a\"/>"), "name=\"a\"", "$a"),
+        ("missing.xml", mitsuba_with("  <shape type=\"sphere\"><ref id=\"nothere\"/></shape>"), "nothere", "nothere"),
+        ("kind.xml", mitsuba_with("  <texture type=\"checkerboard\" id=\"t\"/>\n  <shape type=\"sphere\"><ref id=\"t\"/></shape>"), "<ref id=\"t\"", "texture"),
+        ("vol.xml", mitsuba_with("  <shape type=\"sdfgrid\"><string name=\"filename\" value=\"lying.vol\"/></shape>"), "sdfgrid", "lying.vol"),
+        ("zlib.xml", mitsuba_with("  <shape type=\"serialized\"><string name=\"filename\" value=\"corrupt.serialized\"/></shape>"), "serialized", "corrupt.serialized"),
+        ("plugin.xml", mitsuba_with("  <shape type=\"sphere\"><bsdf type=\"difuse\"/></shape>"), "difuse", "difuse"),
+        ("type.xml", mitsuba_with("  <shape type=\"sphere\"><string name=\"radius\" value=\"1\"/></shape>"), "name=\"radius\"", "radius"),
+    ]
+}
+
+#[test]
+fn hostile_mitsuba_scenes_are_located_errors_in_bounded_memory() {
+    // A .vol header that claims 4096³ samples over 64 bytes of data.
+    let mut lying = b"VOL\x03".to_vec();
+    for value in [1i32, 4096, 4096, 4096, 1] {
+        lying.extend(value.to_le_bytes());
+    }
+    lying.extend([0u8; 24 + 64]);
+    // A .serialized header, then a zlib header followed by bytes that are no deflate stream,
+    // and a dictionary naming one shape.
+    let mut corrupt = vec![0x1C, 0x04, 4, 0, 0x78, 0x9C];
+    corrupt.extend([0xFFu8; 64]);
+    corrupt.extend(0u64.to_le_bytes());
+    corrupt.extend(1u32.to_le_bytes());
+    let mut checked = 0;
+    for (name, scene, needle, says) in bad_mitsuba_scenes() {
+        let case = Case::new()
+            .file(name, &scene)
+            .file(
+                "other.xml",
+                format!("<scene version=\"3.0.0\">\n  <include filename=\"{name}\"/>\n</scene>\n"),
+            )
+            .file("lying.vol", &lying)
+            .file("corrupt.serialized", &corrupt);
+        // Under a cap on address space, so that a reader that believed a header would fail
+        // to allocate and abort rather than pass.
+        let output = Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "ulimit -v 4000000 && exec \"{GLINT}\" render {name} -o out.png -n 2"
+            ))
+            .current_dir(case.dir.path())
+            .output()
+            .unwrap();
+        let text = stderr(&output);
+        assert_eq!(output.status.code(), Some(2), "{name}: {text}");
+        case.assert_nothing_written();
+        assert!(text.contains(says), "{name}: {text}");
+        let (line, column) = location(&text, name)
+            .or_else(|| location(&text, "other.xml"))
+            .unwrap_or_else(|| panic!("{name}: no file:LINE:COL in stderr:\n{text}"));
+        assert!(line >= 1 && column >= 1, "{name}: {text}");
+        if !needle.is_empty() {
+            assert_eq!(line, line_of(&scene, needle), "{name}: {text}");
+        }
+        checked += 1;
+    }
+    assert_eq!(checked, 9);
+}

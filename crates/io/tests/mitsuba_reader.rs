@@ -220,7 +220,7 @@ fn defaults_and_defines_substitute() {
     assert_eq!(d.filter, PixelFilter::Gaussian { stddev: 0.5 });
     assert_eq!(
         (d.integrator, d.max_depth, d.russian_roulette_depth),
-        (Some(SceneIntegrator::Path), Some(2), Some(4))
+        (Some(SceneIntegrator::Path), Some(2), Some(5))
     );
     let d = load_text(scene, &[("spp", "64")])
         .unwrap()
@@ -369,4 +369,325 @@ fn suite_golden_facts() {
         1,
         "the shared diffuse is one node"
     );
+}
+
+/// Triangles, world-space area and world bounds of each instance, in scene order.
+fn placed(parts: &glint_render::SceneParts) -> Vec<(usize, f64, [f32; 3], [f32; 3])> {
+    parts
+        .instances
+        .iter()
+        .map(|instance| {
+            let geometry = &parts.geometries[instance.geometry as usize];
+            let (mut area, mut lo, mut hi) = (0.0f64, [f32::MAX; 3], [f32::MIN; 3]);
+            for shape in &geometry.shapes {
+                let glint_render::Shape::Triangle { vertices } = shape else {
+                    panic!("not a triangle: {shape:?}");
+                };
+                let v = vertices.map(|p| match &instance.transform {
+                    Some(t) => t.point_to_world(p),
+                    None => p,
+                });
+                area += 0.5 * f64::from((v[1] - v[0]).cross(v[2] - v[0]).length());
+                for p in v {
+                    for (axis, value) in p.to_array().into_iter().enumerate() {
+                        lo[axis] = lo[axis].min(value);
+                        hi[axis] = hi[axis].max(value);
+                    }
+                }
+            }
+            (geometry.shapes.len(), area, lo, hi)
+        })
+        .collect()
+}
+
+fn near(a: [f32; 3], b: [f32; 3], tolerance: f32) -> bool {
+    a.iter().zip(b).all(|(x, y)| (x - y).abs() <= tolerance)
+}
+
+/// A version 4 `.serialized` file of one shape: positions and triangles, optional normals.
+fn serialized_file(positions: &[[f32; 3]], triangles: &[[u32; 3]], normals: bool) -> Vec<u8> {
+    use std::io::Write;
+    let mut raw = Vec::new();
+    let flags: u32 = 0x1000 | if normals { 0x1 } else { 0 };
+    raw.extend(flags.to_le_bytes());
+    raw.extend(b"shape\0");
+    raw.extend((positions.len() as u64).to_le_bytes());
+    raw.extend((triangles.len() as u64).to_le_bytes());
+    for p in positions {
+        p.iter().for_each(|v| raw.extend(v.to_le_bytes()));
+    }
+    if normals {
+        for _ in positions {
+            [0.0f32, 0.0, 1.0]
+                .iter()
+                .for_each(|v| raw.extend(v.to_le_bytes()));
+        }
+    }
+    for t in triangles {
+        t.iter().for_each(|i| raw.extend(i.to_le_bytes()));
+    }
+    let mut file = vec![0x1C, 0x04, 4, 0];
+    let mut encoder = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::default());
+    encoder.write_all(&raw).unwrap();
+    file.extend(encoder.finish().unwrap());
+    file.extend(0u64.to_le_bytes());
+    file.extend(1u32.to_le_bytes());
+    file
+}
+
+/// A `.vol` grid of `n`³ float samples given by `f` at the unit cube's sample points.
+fn vol_file(n: u32, f: impl Fn([f32; 3]) -> f32) -> Vec<u8> {
+    let mut file = b"VOL\x03".to_vec();
+    for v in [1i32, n as i32, n as i32, n as i32, 1] {
+        file.extend(v.to_le_bytes());
+    }
+    for v in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0] {
+        file.extend(v.to_le_bytes());
+    }
+    let step = 1.0 / (n - 1) as f32;
+    for k in 0..n {
+        for j in 0..n {
+            for i in 0..n {
+                let value = f([i as f32 * step, j as f32 * step, k as f32 * step]);
+                file.extend(value.to_le_bytes());
+            }
+        }
+    }
+    file
+}
+
+fn load_with(assets: &MemoryAssets, text: &str) -> Result<glint_io::LoadedScene, SceneError> {
+    load_scene_with_defines(
+        text,
+        Path::new("mem/scene.xml"),
+        assets,
+        &Limits::default(),
+        &[],
+    )
+}
+
+#[test]
+fn mitsubas_shapes_load_with_their_size_and_place() {
+    let mut assets = MemoryAssets::new();
+    // A unit square in z = 0 from two triangles, without normals.
+    assets.insert(
+        "mem/square.serialized",
+        serialized_file(
+            &[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            &[[0, 1, 2], [0, 2, 3]],
+            false,
+        ),
+    );
+    // A sphere of radius 0.3 around the unit cube's centre.
+    assets.insert(
+        "mem/ball.vol",
+        vol_file(24, |[x, y, z]| {
+            ((x - 0.5).powi(2) + (y - 0.5).powi(2) + (z - 0.5).powi(2)).sqrt() - 0.3
+        }),
+    );
+    let scene = r#"<scene version="3.0.0">
+        <shape type="cube"><transform name="to_world"><scale value="2"/></transform></shape>
+        <shape type="disk"><transform name="to_world"><scale value="3"/><translate z="1"/></transform></shape>
+        <shape type="cylinder"><float name="radius" value="0.5"/><point name="p0" x="1" y="0" z="0"/><point name="p1" x="1" y="0" z="2"/></shape>
+        <shape type="serialized"><string name="filename" value="square.serialized"/><transform name="to_world"><scale x="2" y="3" z="1"/><translate x="5"/></transform></shape>
+        <shape type="sdfgrid"><string name="filename" value="ball.vol"/><transform name="to_world"><scale value="2"/></transform></shape>
+        <shape type="shapegroup" id="group"><shape type="cube"/></shape>
+        <shape type="instance"><ref id="group"/><transform name="to_world"><translate x="10"/></transform></shape>
+        <shape type="instance"><ref id="group"/><transform name="to_world"><translate y="-10"/></transform></shape>
+    </scene>"#;
+    let parts = load_with(&assets, scene).unwrap().parts;
+    let shapes = placed(&parts);
+    assert_eq!(shapes.len(), 7, "five shapes and two instances");
+    let pi = std::f64::consts::PI;
+    let within = |area: f64, expected: f64, share: f64| (area / expected - 1.0).abs() <= share;
+    // The cube: 12 triangles, six faces of 4 × 4.
+    let (count, area, lo, hi) = shapes[0];
+    assert_eq!(count, 12);
+    assert!(within(area, 96.0, 1e-6), "{area}");
+    assert!(near(lo, [-2.0; 3], 1e-6) && near(hi, [2.0; 3], 1e-6));
+    // The disk: radius 3 at z = 1, its polygon within 0.05 % of the circle.
+    let (count, area, lo, hi) = shapes[1];
+    assert_eq!(count, 128);
+    assert!(within(area, 9.0 * pi, 5e-4), "{area}");
+    assert!(near(lo, [-3.0, -3.0, 1.0], 1e-5) && near(hi, [3.0, 3.0, 1.0], 1e-5));
+    // The cylinder: radius 0.5 and length 2 along z, open ends.
+    let (count, area, lo, hi) = shapes[2];
+    assert_eq!(count, 256);
+    assert!(within(area, 2.0 * pi, 2e-4), "{area}");
+    assert!(near(lo, [0.5, -0.5, 0.0], 1e-5) && near(hi, [1.5, 0.5, 2.0], 1e-5));
+    // The serialized square, stretched to 2 × 3 and moved.
+    let (count, area, lo, hi) = shapes[3];
+    assert_eq!(count, 2);
+    assert!(within(area, 6.0, 1e-6), "{area}");
+    assert!(near(lo, [5.0, 0.0, 0.0], 1e-6) && near(hi, [7.0, 3.0, 0.0], 1e-6));
+    // The sdfgrid sphere, radius 0.6 after the scale, centred on (1, 1, 1).
+    let (count, area, lo, hi) = shapes[4];
+    assert!(count > 100, "{count}");
+    assert!(within(area, 4.0 * pi * 0.36, 0.02), "{area}");
+    assert!(
+        near(lo, [0.4; 3], 0.02) && near(hi, [1.6; 3], 0.02),
+        "{lo:?} {hi:?}"
+    );
+    // Two instances of one cube geometry.
+    assert_eq!(parts.instances[5].geometry, parts.instances[6].geometry);
+    assert_eq!(parts.geometries.len(), 6);
+    let (_, area, lo, hi) = shapes[5];
+    assert!(
+        within(area, 24.0, 1e-6)
+            && near(lo, [9.0, -1.0, -1.0], 1e-6)
+            && near(hi, [11.0, 1.0, 1.0], 1e-6)
+    );
+    let (_, _, lo, hi) = shapes[6];
+    assert!(near(lo, [-1.0, -11.0, -1.0], 1e-6) && near(hi, [1.0, -9.0, 1.0], 1e-6));
+    // The serialized square had no normals: Mitsuba computes them (+z); the cube's point out.
+    let attributes = |g: usize| parts.physical.attributes[g].as_ref().unwrap();
+    let normals = attributes(3).normals.as_ref().expect("computed normals");
+    assert!(normals.iter().flatten().all(|n| n.z > 0.999), "{normals:?}");
+}
+
+#[test]
+fn flip_normals_and_face_normals_follow_mitsuba() {
+    let mut assets = MemoryAssets::new();
+    assets.insert(
+        "mem/square.serialized",
+        serialized_file(
+            &[
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [1.0, 1.0, 0.0],
+                [0.0, 1.0, 0.0],
+            ],
+            &[[0, 1, 2], [0, 2, 3]],
+            true,
+        ),
+    );
+    let scene = r#"<scene version="3.0.0">
+        <shape type="cube"><boolean name="flip_normals" value="true"/></shape>
+        <shape type="cylinder"/>
+        <shape type="cylinder"><transform name="to_world"><scale x="-1"/></transform></shape>
+        <shape type="cylinder"><boolean name="flip_normals" value="true"/><transform name="to_world"><scale x="-1"/></transform></shape>
+        <shape type="serialized"><string name="filename" value="square.serialized"/><boolean name="face_normals" value="true"/></shape>
+        <shape type="serialized"><string name="filename" value="square.serialized"/></shape>
+        <shape type="disk"><boolean name="flip_normals" value="true"/></shape>
+    </scene>"#;
+    let parts = load_with(&assets, scene).unwrap().parts;
+    let attributes = |g: usize| parts.physical.attributes[g].as_ref().unwrap();
+    // Whether every shading normal, and every winding, points away from the object's axis
+    // (the origin for the cube, the z axis for the cylinders).
+    let outward = |g: usize, axis_only: bool| {
+        let normals = attributes(g).normals.as_ref().unwrap();
+        let geometry = &parts.geometries[g];
+        let mut signs = Vec::new();
+        for (shape, corners) in geometry.shapes.iter().zip(normals) {
+            let glint_render::Shape::Triangle { vertices: v } = shape else {
+                panic!()
+            };
+            let mut centre = (v[0] + v[1] + v[2]) / 3.0;
+            if axis_only {
+                centre.z = 0.0;
+            }
+            let winding = (v[1] - v[0]).cross(v[2] - v[0]);
+            signs.push((winding.dot(centre) > 0.0, corners[0].dot(centre) > 0.0));
+        }
+        assert!(signs.iter().all(|s| *s == signs[0]), "mixed signs in {g}");
+        signs[0]
+    };
+    assert_eq!(outward(0, false), (false, false), "a flipped cube faces in");
+    assert_eq!(outward(1, true), (true, true));
+    // Mitsuba toggles flip_normals when to_world mirrors a cylinder (in object space, so the
+    // mirror then turns the winding back out in the world).
+    assert_eq!(outward(2, true), (false, false));
+    assert_eq!(outward(3, true), (true, true));
+    // face_normals drops the file's normals; without it they are kept.
+    assert!(attributes(4).normals.is_none());
+    assert!(attributes(5).normals.is_some());
+    let disk = attributes(6).normals.as_ref().unwrap();
+    assert!(disk.iter().flatten().all(|n| n.z == -1.0));
+    let glint_render::Shape::Triangle { vertices: v } = parts.geometries[6].shapes[0] else {
+        panic!()
+    };
+    assert!(
+        (v[1] - v[0]).cross(v[2] - v[0]).z < 0.0,
+        "a flipped disk winds clockwise"
+    );
+}
+
+#[test]
+fn broken_shape_files_are_located_errors() {
+    let mut assets = MemoryAssets::new();
+    let mut corrupt = serialized_file(
+        &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[[0, 1, 2]],
+        false,
+    );
+    // Past the 4-byte header and zlib's 2-byte header: garbage in the deflate stream.
+    for byte in &mut corrupt[6..20] {
+        *byte = 0xFF;
+    }
+    assets.insert("mem/corrupt.serialized", corrupt);
+    // A header that claims a 4096³ grid over a few bytes of data.
+    let mut lying = b"VOL\x03".to_vec();
+    for v in [1i32, 4096, 4096, 4096, 1] {
+        lying.extend(v.to_le_bytes());
+    }
+    lying.extend([0u8; 24 + 64]);
+    assets.insert("mem/lying.vol", lying);
+    assets.insert("mem/ok.vol", vol_file(4, |p| p[0] - 0.5));
+    let cases = [
+        ("<shape type=\"serialized\"><string name=\"filename\" value=\"corrupt.serialized\"/></shape>", "corrupt.serialized"),
+        ("<shape type=\"sdfgrid\"><string name=\"filename\" value=\"lying.vol\"/></shape>", "lying.vol"),
+    ];
+    for (shape, file) in cases {
+        let scene = format!("<scene version=\"3.0.0\">\n\n  {shape}\n</scene>");
+        let (line, column, message) = error_at(load_with(&assets, &scene));
+        assert_eq!((line, column), (3, 3), "{message}");
+        assert!(message.contains(file), "{message}");
+        assert!(message.contains("at byte"), "{message}");
+    }
+    // A missing index, a negative one, and flip_normals where Mitsuba's sdfgrid reads none.
+    for (shape, why) in [
+        ("<shape type=\"serialized\"><string name=\"filename\" value=\"corrupt.serialized\"/><integer name=\"shape_index\" value=\"-1\"/></shape>", "0 or more"),
+        ("<shape type=\"sdfgrid\"><string name=\"filename\" value=\"ok.vol\"/><boolean name=\"flip_normals\" value=\"true\"/></shape>", "flip_normals"),
+        ("<shape type=\"cylinder\"><point name=\"p1\" x=\"0\" y=\"0\" z=\"0\"/></shape>", "coincide"),
+        ("<shape type=\"shapegroup\" id=\"g\"><shape type=\"cube\"><emitter type=\"area\"/></shape></shape>", "cannot emit"),
+    ] {
+        let scene = format!("<scene version=\"3.0.0\">\n{shape}\n</scene>");
+        let (line, _, message) = error_at(load_with(&assets, &scene));
+        assert!(message.contains(why), "{message}");
+        assert_eq!(line, 2, "{message}");
+    }
+}
+
+#[test]
+fn rr_depth_is_kept_as_mitsuba_counts_it() {
+    let depth = |integrator: &str| {
+        let scene = format!("<scene version=\"3.0.0\">{integrator}</scene>");
+        load_text(&scene, &[])
+            .unwrap()
+            .parts
+            .physical
+            .defaults
+            .russian_roulette_depth
+    };
+    // Both renderers start roulette once `depth >= rr_depth`, depth counted after the
+    // bounce, so the value passes through unchanged.
+    assert_eq!(depth(r#"<integrator type="path"/>"#), Some(5));
+    assert_eq!(
+        depth(r#"<integrator type="path"><integer name="rr_depth" value="3"/></integrator>"#),
+        Some(3)
+    );
+    assert_eq!(
+        depth(r#"<integrator type="path"><integer name="rr_depth" value="1"/></integrator>"#),
+        Some(1)
+    );
+    let (_, _, message) = error_at(load_text(
+        r#"<scene version="3.0.0"><integrator type="path"><integer name="rr_depth" value="0"/></integrator></scene>"#,
+        &[],
+    ));
+    assert!(message.contains("rr_depth"), "{message}");
 }

@@ -318,3 +318,93 @@ fn mutated_scenes_never_panic_and_fail_where_the_damage_is() {
     );
     assert!(outcome.loaded > 0, "no mutant loaded");
 }
+
+/// A small Mitsuba 3 scene with every kind of object the reader builds from text alone.
+const SMALL_MITSUBA: &str = r#"<scene version="3.0.0">
+  <default name="spp" value="4"/>
+  <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+  <sensor type="perspective"><float name="fov" value="40"/>
+    <transform name="to_world"><lookat origin="0,0,6" target="0,0,0" up="0,1,0"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="6"/><integer name="height" value="4"/></film>
+  </sensor>
+  <emitter type="constant"><rgb name="radiance" value="0.5"/></emitter>
+  <bsdf type="roughconductor" id="metal"><float name="alpha" value="0.2"/></bsdf>
+  <shape type="cube"><ref id="metal"/><transform name="to_world"><scale value="0.5"/></transform></shape>
+  <shape type="cylinder"><float name="radius" value="0.3"/><bsdf type="dielectric"/></shape>
+  <shape type="disk"><emitter type="area"><rgb name="radiance" value="2"/></emitter>
+    <transform name="to_world"><translate y="2"/></transform></shape>
+  <shape type="shapegroup" id="g"><shape type="sphere"><float name="radius" value="0.2"/></shape></shape>
+  <shape type="instance"><ref id="g"/><transform name="to_world"><translate x="1"/></transform></shape>
+</scene>"#;
+
+#[test]
+fn mutated_mitsuba_scenes_never_panic_and_fail_where_the_damage_is() {
+    let per_file: usize = std::env::var("GLINT_MUTANTS")
+        .ok()
+        .and_then(|value| value.parse().ok())
+        .unwrap_or(6)
+        * 4;
+    let mut files = vec![(
+        PathBuf::from("inline/small_mitsuba.xml"),
+        SMALL_MITSUBA.to_owned(),
+    )];
+    let suite = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/mitsuba/tests/scenes");
+    for scene in [
+        "orthographic_sensor/test_orthographic_path.xml",
+        "floating_sphere/test_directional_direct.xml",
+    ] {
+        match std::fs::read_to_string(suite.join(scene)) {
+            Ok(text) => files.push((suite.join(scene), text)),
+            Err(_) => {
+                assert!(std::env::var_os("CI").is_none(), "{scene} is missing");
+                println!("SKIPPED: ../shared/mitsuba/tests/scenes/{scene} is missing");
+            }
+        }
+    }
+    let cache = RefCell::new(HashMap::new());
+    let mut outcome = Outcome {
+        loaded: 0,
+        refused: 0,
+        rendered: 0,
+    };
+    let (mut failures, mut mutants) = (Vec::new(), 0);
+    for (index, (path, text)) in files.iter().enumerate() {
+        // The unmutated scene must load, or the mutants test nothing.
+        let mut clean = Outcome {
+            loaded: 0,
+            refused: 0,
+            rendered: 0,
+        };
+        let plain = MutatedAssets {
+            cache: &cache,
+            replaced: None,
+        };
+        try_mutant(text, path, &plain, &mut clean).unwrap();
+        assert_eq!(clean.loaded, 1, "{} does not load", path.display());
+        for round in 0..per_file {
+            let seed = 0x4d49_0000_0000 | (index as u64) << 32 | round as u64;
+            let mut random = Random(seed);
+            let bytes = mutate(text.as_bytes(), &mut random);
+            let mutated = MutatedAssets {
+                cache: &cache,
+                replaced: None,
+            };
+            mutants += 1;
+            let scene_text = String::from_utf8_lossy(&bytes);
+            if let Err(why) = try_mutant(&scene_text, path, &mutated, &mut outcome) {
+                failures.push(format!("{} (seed {seed:#x}): {why}", path.display()));
+            }
+        }
+    }
+    eprintln!(
+        "{mutants} Mitsuba mutants: {} loaded ({} rendered), {} refused with a located error",
+        outcome.loaded, outcome.rendered, outcome.refused
+    );
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    assert!(
+        outcome.refused > mutants / 10,
+        "too few mutants were refused"
+    );
+    assert!(outcome.loaded > 0, "no mutant loaded");
+}

@@ -26,6 +26,7 @@ const MITSUBA_DEFAULT_FILTER: PixelFilter = PixelFilter::Gaussian { stddev: 0.5 
 use super::props::{Props, Spectrum, Value};
 use super::spectrum::{self, Role};
 use super::Files;
+use super::{sdfgrid, serialized, shapes};
 
 /// Mitsuba's diffuse default: a grey of 0.5.
 const DEFAULT_REFLECTANCE: f32 = 0.5;
@@ -52,6 +53,8 @@ struct Builder<'a> {
     /// Where the environment came from, to name both when a second one comes.
     environment: Option<(usize, Span)>,
     shapegroups: HashMap<usize, Vec<BuiltShape>>,
+    /// A shapegroup's shapes are being built (they may not emit, nested or referred to).
+    in_shapegroup: bool,
     sensor_seen: bool,
     /// The `mesh_attribute` name of each such texture, and the names each BSDF reads
     /// (through its nested BSDFs and textures): a shape fills its colour slots from them.
@@ -127,6 +130,7 @@ pub(crate) fn build(
         default_bsdf: None,
         environment: None,
         shapegroups: HashMap::new(),
+        in_shapegroup: false,
         sensor_seen: false,
         attribute_names: HashMap::new(),
         bsdf_attributes: HashMap::new(),
@@ -360,7 +364,9 @@ impl<'a> Builder<'a> {
                     let p = props.get("rr_depth").expect("read above");
                     return Err(files.error(p.file, p.span, "rr_depth must be at least 1"));
                 }
-                defaults.russian_roulette_depth = Some((rr_depth - 1) as u32);
+                // Mitsuba and Glint both compare the scattering events so far, counted
+                // after the increment, with it: the same number.
+                defaults.russian_roulette_depth = Some(rr_depth as u32);
                 defaults.hide_emitters = props.boolean(files, "hide_emitters", false)?;
                 props.ignore("samples_per_pass");
             }
@@ -1569,10 +1575,10 @@ impl<'a> Builder<'a> {
                     "a shapegroup holds shapes only (no groups or instances)",
                 ));
             }
-            if child.children.iter().any(|c| c.tag == "emitter") {
-                return Err(self.element_error(child, "a shape in a shapegroup cannot emit light"));
-            }
-            built.extend(self.shape(child)?);
+            self.in_shapegroup = true;
+            let shape = self.shape(child);
+            self.in_shapegroup = false;
+            built.extend(shape?);
         }
         props.check_all_used(self.files)?;
         self.shapegroups.insert(element.index, built);
@@ -1634,6 +1640,13 @@ impl<'a> Builder<'a> {
                     bsdf = Some(self.bsdf(child)?);
                 }
                 "emitter" => {
+                    if self.in_shapegroup {
+                        return Err(self.error(
+                            p.file,
+                            p.span,
+                            "a shape in a shapegroup cannot emit light",
+                        ));
+                    }
                     if emitter.is_some() {
                         return Err(self.error(p.file, p.span, "a shape takes one emitter"));
                     }
@@ -1645,10 +1658,12 @@ impl<'a> Builder<'a> {
                     )
                 }
                 other => {
-                    return Err(self.element_error(
-                        child,
+                    // At the reference, where the mistake is, when it is one.
+                    return Err(self.error(
+                        p.file,
+                        p.span,
                         format!("a shape takes a BSDF and an emitter, not a <{other}>"),
-                    ))
+                    ));
                 }
             }
         }
@@ -1666,7 +1681,10 @@ impl<'a> Builder<'a> {
             None => self.default_bsdf(),
         };
         let surface = self.material_of(bsdf);
-        let flip_normals = props.boolean(self.files, "flip_normals", false)?;
+        // Mitsuba's sdfgrid does not read `flip_normals`, so there it is an unused property.
+        let flip_normals =
+            plugin != "sdfgrid" && props.boolean(self.files, "flip_normals", false)?;
+        let mut mirrored = false;
         let (geometry_shape, mesh, object_to_world) = match plugin.as_str() {
             "obj" | "ply" => {
                 let (name, span, file) =
@@ -1752,11 +1770,81 @@ impl<'a> Builder<'a> {
             "shapegroup" => {
                 return Err(self.element_error(element, "a shapegroup cannot be nested"))
             }
-            "cube" | "disk" | "cylinder" | "serialized" | "sdfgrid" => {
-                return Err(self.element_error(
-                    element,
-                    format!("the shape `{plugin}` is not supported yet"),
-                ));
+            "cube" => {
+                // Mitsuba's cube reads `face_normals` but always keeps its vertex normals,
+                // which are the face normals anyway.
+                props.boolean(self.files, "face_normals", false)?;
+                let mesh = TriMesh::from_shape(shapes::cube(false));
+                (None, Some(mesh), to_world)
+            }
+            "disk" => (
+                None,
+                Some(TriMesh::from_shape(shapes::disk(false))),
+                to_world,
+            ),
+            "cylinder" => {
+                let radius = props.float(self.files, "radius", 1.0)?;
+                let p0 = props.vector(self.files, "p0")?.unwrap_or([0.0; 3]);
+                let p1 = props.vector(self.files, "p1")?.unwrap_or([0.0, 0.0, 1.0]);
+                let point = |p: [f64; 3]| Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+                let mesh = shapes::cylinder(radius as f32, point(p0), point(p1), false)
+                    .map_err(|e| self.element_error(element, e.to_string()))?;
+                // A mirroring to_world turns Mitsuba's cylinder inside out: its normals
+                // follow the transform, and it toggles `flip_normals` as well.
+                if determinant3(&to_world) < 0.0 {
+                    mirrored = true;
+                }
+                (None, Some(TriMesh::from_shape(mesh)), to_world)
+            }
+            "serialized" => {
+                let (name, span, file) =
+                    props.string(self.files, "filename")?.ok_or_else(|| {
+                        self.element_error(element, "`serialized` needs a `filename`")
+                    })?;
+                let index = props.integer(self.files, "shape_index", 0)?;
+                let index = u32::try_from(index).map_err(|_| {
+                    let p = props.get("shape_index").expect("a bad index was given");
+                    self.error(p.file, p.span, "the shape index must be 0 or more")
+                })?;
+                let face_normals = props.boolean(self.files, "face_normals", false)?;
+                let path = self.find(&name);
+                let bytes = self.read(&path, file, span, &name)?;
+                let shape = serialized::read_serialized(&bytes, index, self.limits)
+                    .map_err(|e| self.shape_file_error(element, &name, &path, &e))?;
+                // Mitsuba 3 skips the file's colours and ignores its face-normals flag: the
+                // scene's `face_normals` alone decides.
+                let mut source = shape.mesh;
+                source.colors = None;
+                let mut mesh = TriMesh::from_shape(source);
+                if face_normals {
+                    mesh.normals = None;
+                } else if mesh.normals.is_none() {
+                    mesh.compute_vertex_normals();
+                }
+                (None, Some(mesh), to_world)
+            }
+            "sdfgrid" => {
+                let (name, span, file) =
+                    props.string(self.files, "filename")?.ok_or_else(|| {
+                        self.element_error(element, "`sdfgrid` needs a `filename` (a .vol grid)")
+                    })?;
+                if let Some((mode, span, file)) = props.string(self.files, "normals")? {
+                    if mode != "smooth" {
+                        return Err(self.error(
+                            file,
+                            span,
+                            format!(
+                                "sdfgrid normals \"{mode}\" are not supported: Glint's sdfgrid \
+                                 mesh carries the \"smooth\" ones"
+                            ),
+                        ));
+                    }
+                }
+                let path = self.find(&name);
+                let bytes = self.read(&path, file, span, &name)?;
+                let mesh = sdfgrid::read_sdfgrid(&bytes, self.limits)
+                    .map_err(|e| self.shape_file_error(element, &name, &path, &e))?;
+                (None, Some(TriMesh::from_shape(mesh)), to_world)
             }
             other => {
                 let hint = did_you_mean(
@@ -1766,6 +1854,11 @@ impl<'a> Builder<'a> {
                         "ply",
                         "sphere",
                         "rectangle",
+                        "cube",
+                        "disk",
+                        "cylinder",
+                        "serialized",
+                        "sdfgrid",
                         "shapegroup",
                         "instance",
                     ],
@@ -1802,7 +1895,7 @@ impl<'a> Builder<'a> {
                     mesh.use_attribute(name)
                         .map_err(|why| self.element_error(element, why))?;
                 }
-                if flip_normals {
+                if flip_normals != mirrored {
                     mesh.flip();
                 }
                 let shapes = (0..mesh.triangles.len())
@@ -1844,6 +1937,21 @@ impl<'a> Builder<'a> {
             geometry,
             transform: object_to_world,
         }])
+    }
+
+    /// A shape file refused by its reader, located at the shape element and naming the file
+    /// (and the byte offset, when the reader has one).
+    fn shape_file_error(
+        &self,
+        element: &Element,
+        name: &str,
+        path: &Path,
+        error: &shapes::ShapeError,
+    ) -> SceneError {
+        self.element_error(
+            element,
+            format!("cannot read \"{name}\" ({}): {error}", path.display()),
+        )
     }
 
     // ---- emitters ----------------------------------------------------------------------
@@ -2138,6 +2246,14 @@ impl<'a> Builder<'a> {
 }
 
 /// Mitsuba's `max_depth` (−1 unbounded) in Glint's count of scattering events.
+/// The determinant of `m`'s linear part (negative for a mirror).
+fn determinant3(m: &Matrix4) -> f64 {
+    let a = &m.m;
+    a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+        - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+        + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+}
+
 fn glint_depth(
     max_depth: i64,
     props: &Props,

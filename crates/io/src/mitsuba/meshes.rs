@@ -301,6 +301,25 @@ impl TriMesh {
 }
 
 impl TriMesh {
+    /// A shape source's mesh (per-vertex attributes) with per-corner attributes; colours
+    /// become `vertex_colors`.
+    pub fn from_shape(mesh: super::shapes::ShapeMesh) -> TriMesh {
+        fn corners<T: Copy>(triangles: &[[u32; 3]], values: &[T]) -> Vec<[T; 3]> {
+            triangles
+                .iter()
+                .map(|t| t.map(|i| values[i as usize]))
+                .collect()
+        }
+        TriMesh {
+            normals: mesh.normals.as_deref().map(|v| corners(&mesh.triangles, v)),
+            uvs: mesh.uvs.as_deref().map(|v| corners(&mesh.triangles, v)),
+            vertex_colors: mesh.colors.as_deref().map(|v| corners(&mesh.triangles, v)),
+            positions: mesh.positions,
+            triangles: mesh.triangles,
+            ..Default::default()
+        }
+    }
+
     /// Smooth normals as Mitsuba makes them for a mesh without any: each triangle's unit
     /// normal added to its corners' positions weighted by the corner's angle (Thürmer and
     /// Wüthrich), then normalised; a position no valid triangle touches gets (1, 0, 0).
