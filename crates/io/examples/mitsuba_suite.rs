@@ -73,8 +73,17 @@ fn scenes(root: &Path, filter: Option<&str>) -> Vec<PathBuf> {
     found
 }
 
-/// Renders one scene by the rule: Ok(verdict, film, reference, seconds) or why it could not.
-fn run(scene_path: &Path) -> Result<(Verdict, Film, Vec<[f64; 3]>, u32, f64), String> {
+/// One scene rendered and judged.
+struct Outcome {
+    verdict: Verdict,
+    film: Film,
+    reference: Vec<[f64; 3]>,
+    spp: u32,
+    seconds: f64,
+}
+
+/// Renders one scene by the rule, or says why it could not.
+fn run(scene_path: &Path) -> Result<Outcome, String> {
     let (reference_path, variance_path) = reference_paths(scene_path).ok_or("no reference name")?;
     let (width, height, reference) = read_exr(&reference_path)?;
     let (_, _, variance) = read_exr(&variance_path)?;
@@ -109,13 +118,13 @@ fn run(scene_path: &Path) -> Result<(Verdict, Film, Vec<[f64; 3]>, u32, f64), St
             film.width, film.height
         ));
     }
-    Ok((
-        judge(&rendered, &reference, &variance, spp),
+    Ok(Outcome {
+        verdict: judge(&rendered, &reference, &variance, spp),
         film,
         reference,
         spp,
         seconds,
-    ))
+    })
 }
 
 fn write_failure(out: &Path, name: &str, film: &Film, reference: &[[f64; 3]], verdict: &Verdict) {
@@ -168,7 +177,13 @@ fn main() -> ExitCode {
             .to_string_lossy()
             .replace('/', "__");
         match run(path) {
-            Ok((verdict, film, reference, spp, seconds)) => {
+            Ok(Outcome {
+                verdict,
+                film,
+                reference,
+                spp,
+                seconds,
+            }) => {
                 let ok = verdict.passes();
                 passed += ok as usize;
                 println!(

@@ -470,16 +470,17 @@ impl PathIntegrator {
                 if let Some(sample) = self.lights.sample(scene, si.point, u_light) {
                     let wi = frame.to_local(sample.direction);
                     let (f, scattering_pdf) = bsdf.eval_and_pdf(wo, wi);
-                    if f != Color::ZERO && sample.radiance != Color::ZERO {
-                        if unoccluded(scene, si.point, &sample, rays) {
-                            let weight = if sample.is_delta || !sample.reachable_by_bsdf {
-                                1.0
-                            } else {
-                                power_heuristic(sample.pdf, scattering_pdf)
-                            };
-                            radiance += throughput.mul_elem(f).mul_elem(sample.radiance)
-                                * (wi.z.abs() * weight / sample.pdf);
-                        }
+                    if f != Color::ZERO
+                        && sample.radiance != Color::ZERO
+                        && unoccluded(scene, si.point, &sample, rays)
+                    {
+                        let weight = if sample.is_delta || !sample.reachable_by_bsdf {
+                            1.0
+                        } else {
+                            power_heuristic(sample.pdf, scattering_pdf)
+                        };
+                        radiance += throughput.mul_elem(f).mul_elem(sample.radiance)
+                            * (wi.z.abs() * weight / sample.pdf);
                     }
                 }
             }

@@ -1674,6 +1674,22 @@ impl CubeDistribution {
     }
 }
 
+/// Radiance texture `texture` at barycentrics (b1, b2) of a triangle with corner uvs `uvs`.
+fn textured_radiance(
+    scene: &Scene,
+    texture: u32,
+    uvs: &[(f32, f32); 3],
+    b1: f32,
+    b2: f32,
+) -> Color {
+    let b0 = 1.0 - b1 - b2;
+    let uv = (
+        uvs[0].0 * b0 + uvs[1].0 * b1 + uvs[2].0 * b2,
+        uvs[0].1 * b0 + uvs[1].1 * b1 + uvs[2].1 * b2,
+    );
+    texture_value(scene, texture, uv)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -1781,20 +1797,4 @@ mod tests {
             "{sum}"
         );
     }
-}
-
-/// Radiance texture `texture` at barycentrics (b1, b2) of a triangle with corner uvs `uvs`.
-fn textured_radiance(
-    scene: &Scene,
-    texture: u32,
-    uvs: &[(f32, f32); 3],
-    b1: f32,
-    b2: f32,
-) -> Color {
-    let b0 = 1.0 - b1 - b2;
-    let uv = (
-        uvs[0].0 * b0 + uvs[1].0 * b1 + uvs[2].0 * b2,
-        uvs[0].1 * b0 + uvs[1].1 * b1 + uvs[2].1 * b2,
-    );
-    texture_value(scene, texture, uv)
 }

@@ -36,6 +36,9 @@ pub const MAX_LEAVES: usize = 4;
 const MAX_NESTING: u32 = 16;
 
 /// One BSDF family with its parameters resolved.
+// A rough plastic carries its 64-entry transmittance table; the leaves live on the stack per
+// hit, where boxing the large variant would allocate on every hit.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Family {
     Diffuse(Diffuse),
@@ -139,7 +142,7 @@ impl Leaf {
             if parent_wi.z * sample.wi.z <= 0.0 {
                 return None;
             }
-            sample.weight = sample.weight * tilt.shadowing(parent_wi);
+            sample.weight *= tilt.shadowing(parent_wi);
         }
         sample.wi = wi;
         Some(sample)
