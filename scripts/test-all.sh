@@ -5,8 +5,8 @@
 #   scripts/test-all.sh --no-install test with what is installed (a suite missing something fails
 #                                    under CI=1 and says SKIPPED otherwise)
 # Suites: the Rust workspace (`cargo test --workspace`: unit, reference-image, corpus, Mitsuba,
-# software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh), the
-# release binary's SIMD intrinsics inlined (scripts/inlined-intrinsics.sh), every
+# software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh),
+# Mitsuba's own test scenes by its rule (scripts/mitsuba-suite.sh), the release binary's SIMD intrinsics inlined (scripts/inlined-intrinsics.sh), every
 # README command in a fresh clone (scripts/readme-examples.sh), and each
 # front end's own script (`ci.sh install|test`, listed in SUITES below).
 set -euo pipefail
@@ -73,6 +73,12 @@ scripts/same-images.sh 2>&1 | tee "$logs/same-images.log" || status=$?
 result[same-images]=$(tail -n 1 "$logs/same-images.log")
 [ "$status" = 0 ] || failed=1
 
+echo "== Mitsuba's test suite by its rule (scripts/mitsuba-suite.sh)"
+status=0
+scripts/mitsuba-suite.sh 2>&1 | tee "$logs/mitsuba.log" || status=$?
+result[mitsuba-suite]=$(tail -n 1 "$logs/mitsuba.log")
+[ "$status" = 0 ] || failed=1
+
 echo "== SIMD intrinsics inlined in the release glint (scripts/inlined-intrinsics.sh)"
 status=0
 scripts/inlined-intrinsics.sh 2>&1 | tee "$logs/intrinsics.log" || status=$?
@@ -95,7 +101,7 @@ done
 
 echo
 echo "== summary"
-for name in cargo same-images intrinsics readme "${SUITES[@]}"; do
+for name in cargo same-images mitsuba-suite intrinsics readme "${SUITES[@]}"; do
   printf '%-26s %s\n' "$name" "${result[$name]}"
 done
 if [ "$failed" != 0 ]; then
