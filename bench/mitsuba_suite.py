@@ -68,7 +68,7 @@ def film_size(scene):
 def time_glint(glint, scene, spp, out):
     start = time.perf_counter()
     subprocess.run(
-        [str(glint), "render", "-i", str(scene), "-o", str(out), "--spp", str(spp)],
+        [str(glint), "render", str(scene), "-o", str(out), "--spp", str(spp)],
         check=True,
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,

@@ -131,7 +131,35 @@ pub fn scene_hash(parts: &SceneParts) -> String {
     }
     // Course scenes have no physical parts, and keep the digests earlier builds wrote.
     if parts.physical != glint_render::PhysicalParts::default() {
-        hasher.text("physical", &parts.physical);
+        let physical = &parts.physical;
+        hasher.text("bsdfs", &physical.bsdfs);
+        hasher.text("textures", &physical.textures);
+        hasher.text("defaults", &physical.defaults);
+        // Mesh attributes hold floats per triangle: their bits, not their Debug text (which
+        // took most of a second on the suite's 16k-triangle sphere).
+        for (geometry, attributes) in physical.attributes.iter().enumerate() {
+            let Some(a) = attributes else { continue };
+            hasher.text("attributes", &(geometry, a.mitsuba_sphere_uv));
+            let vec3s = |v: &[glint_render::Vec3; 3]| {
+                [
+                    v[0].x, v[0].y, v[0].z, v[1].x, v[1].y, v[1].z, v[2].x, v[2].y, v[2].z,
+                ]
+            };
+            for (tag, list) in [(10, &a.normals), (11, &a.vertex_colors)] {
+                hasher.text("count", &list.as_ref().map(Vec::len));
+                for corners in list.iter().flatten() {
+                    hasher.shape(tag, &vec3s(corners));
+                }
+            }
+            hasher.text("count", &a.uvs.as_ref().map(Vec::len));
+            for [a0, a1, a2] in a.uvs.iter().flatten() {
+                hasher.shape(12, &[a0.0, a0.1, a1.0, a1.1, a2.0, a2.1]);
+            }
+            hasher.text("count", &a.face_colors.as_ref().map(Vec::len));
+            for c in a.face_colors.iter().flatten() {
+                hasher.shape(13, &[c.x, c.y, c.z]);
+            }
+        }
     }
     for geometry in &parts.geometries {
         hasher.ids("geometry", &geometry.materials, geometry.shapes.len());

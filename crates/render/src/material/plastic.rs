@@ -243,11 +243,11 @@ impl RoughPlastic {
 /// direction, by the product Gauss-Legendre rule Mitsuba uses.
 fn coating_integral(microfacet: &Microfacet, w: Vec3, eta: f32, reflection: bool) -> f32 {
     let n = if eta > 1.0 { 32 } else { 128 };
+    // The nodes once (each takes Newton's method on an n-term recurrence), not per pair.
+    let nodes: Vec<(f64, f64)> = (0..n).map(|i| gauss_legendre(n, i)).collect();
     let mut sum = 0.0f64;
-    for i in 0..n {
-        let (xi, wx) = gauss_legendre(n, i);
-        for j in 0..n {
-            let (xj, wy) = gauss_legendre(n, j);
+    for &(xi, wx) in &nodes {
+        for &(xj, wy) in &nodes {
             let u = ((0.5 * xi + 0.5) as f32, (0.5 * xj + 0.5) as f32);
             let (m, _) = microfacet.sample(w, u);
             let dot = w.dot(m);
