@@ -16,6 +16,7 @@ first compilation of its kernels: one warm-up render per scene is discarded, as 
 
 import argparse
 import json
+import os
 import statistics
 import subprocess
 import sys
@@ -58,7 +59,7 @@ def film_size(scene):
     """The reference's size, which is the film's."""
     name = scene.stem.rsplit("_", 1)[0]
     ref = scene.parent / "refs" / f"{name}_ref_rgb.exr"
-    import mitsuba as mi  # noqa: PLC0415 (only the parent's size query needs it)
+    import mitsuba as mi
 
     mi.set_variant("scalar_rgb")
     bitmap = mi.Bitmap(str(ref))
@@ -76,12 +77,28 @@ def time_glint(glint, scene, spp, out):
     return time.perf_counter() - start
 
 
+def llvm_environment():
+    """Dr.Jit's LLVM back end needs LLVM 19 (14-16 abort): Debian's libllvm19, found by ldconfig
+    unless DRJIT_LIBLLVM_PATH names one (as ../shared/bench/setup-peers.sh sets it)."""
+    env = dict(os.environ)
+    if "DRJIT_LIBLLVM_PATH" not in env:
+        listing = subprocess.run(
+            ["ldconfig", "-p"], check=False, capture_output=True, text=True
+        ).stdout
+        for line in listing.splitlines():
+            if "libLLVM.so.19" in line and "=>" in line:
+                env["DRJIT_LIBLLVM_PATH"] = line.split("=>")[1].strip()
+                break
+    return env
+
+
 def time_mitsuba(variant, scene, spp):
     result = subprocess.run(
         [sys.executable, "-c", MITSUBA_WORKER, variant, str(scene), str(spp), "1"],
         check=True,
         capture_output=True,
         text=True,
+        env=llvm_environment(),
     )
     return json.loads(result.stdout.strip().splitlines()[-1])[0]
 
