@@ -23,6 +23,9 @@ pub struct Camera {
     pub image_plane_width: f32,
     /// Depth of field: `None` is the course's pinhole (every ray leaves from the position).
     pub lens: Option<ThinLens>,
+    /// Mitsuba's `near_clip` and `far_clip`: the path tracer's camera rays see only what lies
+    /// between these distances along the view direction (-W); `None` sees everything.
+    pub clip: Option<(f32, f32)>,
 }
 
 /// A thin lens (pbrt's `PerspectiveCamera` lens, Mitsuba 3's `thinlens` sensor): rays leave
@@ -76,6 +79,7 @@ impl Camera {
             focal_length,
             image_plane_width,
             lens: None,
+            clip: None,
         }
     }
 
@@ -95,6 +99,20 @@ impl Camera {
             }
             Projection::Orthographic => Ray::new(self.position + b.u * u + b.v * v, -b.w),
         }
+    }
+
+    /// A camera ray with a unit direction limited to the clipping planes: the distances along
+    /// the view direction become distances along the ray.
+    #[inline]
+    pub fn clipped(&self, mut ray: Ray) -> Ray {
+        if let Some((near, far)) = self.clip {
+            let along = -ray.direction.dot(self.basis.w);
+            if along > 0.0 {
+                ray.t_min = near / along;
+                ray.t_max = far / along;
+            }
+        }
+        ray
     }
 
     /// `ray`, leaving from the point of the lens that `lens_sample` in [0, 1)² maps to (the
@@ -127,5 +145,31 @@ impl Camera {
             pinhole.origin + offset,
             pinhole.direction - offset * (1.0 / t_focus),
         )
+    }
+}
+
+#[cfg(test)]
+mod clip_tests {
+    use super::*;
+
+    /// The clipping planes are distances along the view direction: an oblique ray's window
+    /// is longer by 1/cos, and a camera without planes leaves rays as they are.
+    #[test]
+    fn clipping_planes_are_distances_along_the_view() {
+        let mut camera = Camera::new(
+            Projection::Perspective,
+            Vec3::ZERO,
+            Vec3::new(0.0, 0.0, -1.0),
+            1.0,
+            1.0,
+        );
+        let straight = Ray::new(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0));
+        let oblique = Ray::new(Vec3::ZERO, Vec3::new(0.6, 0.0, -0.8));
+        assert_eq!(camera.clipped(oblique), oblique);
+        camera.clip = Some((1.0, 10.0));
+        let s = camera.clipped(straight);
+        assert_eq!((s.t_min, s.t_max), (1.0, 10.0));
+        let o = camera.clipped(oblique);
+        assert!((o.t_min - 1.25).abs() < 1e-6 && (o.t_max - 12.5).abs() < 1e-5);
     }
 }

@@ -458,19 +458,18 @@ impl<'a> Builder<'a> {
         let to_world = props
             .transform(self.files, "to_world")?
             .unwrap_or(Matrix4::IDENTITY);
-        for name in ["near_clip", "far_clip"] {
+        let mut clip = [0.01f32, 10_000.0];
+        for (slot, name) in clip.iter_mut().zip(["near_clip", "far_clip"]) {
             if let Some(value) = props.float_opt(self.files, name)? {
-                let p = props.get(name).expect("read above");
-                if value <= 0.0 {
+                if !(value > 0.0 && value.is_finite()) {
+                    let p = props.get(name).expect("read above");
                     return Err(self.error(p.file, p.span, format!("`{name}` must be positive")));
                 }
-                let (file, span) = (p.file, p.span);
-                self.files.warn(
-                    file,
-                    span,
-                    format!("`{name}` is read but Glint does not clip camera rays"),
-                );
+                *slot = value as f32;
             }
+        }
+        if clip[0] >= clip[1] {
+            return Err(self.element_error(element, "`near_clip` must be less than `far_clip`"));
         }
         let (x, y, z) = (
             column(&to_world, 0),
@@ -498,6 +497,7 @@ impl<'a> Builder<'a> {
             Camera::new(Projection::Orthographic, origin, z, 1.0, 2.0 * sx)
         };
         let mut camera = camera;
+        camera.clip = Some((clip[0], clip[1]));
         // Mitsuba's camera looks along local +z with the image's x along local -x and its y
         // along local +y; Glint's looks along -w with x along u and y along v.
         camera.basis.u = -x.normalized();

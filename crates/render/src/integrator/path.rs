@@ -532,7 +532,9 @@ impl Integrator for PathIntegrator {
                 Some(_) => sampler.sample_2d(LENS_DIMENSION),
                 None => (0.5, 0.5),
             };
-            let ray = unit_ray(&pixel.camera_ray(scene, ox, oy, lens));
+            let ray = scene
+                .camera
+                .clipped(unit_ray(&pixel.camera_ray(scene, ox, oy, lens)));
             sampler.prepare(dimension);
             (ray, sampler)
         };
