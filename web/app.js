@@ -34,6 +34,8 @@ let scenePath = 'scene.xml';
 let pool = [];
 let render = null; // the render in progress or the last one finished
 let jobCounter = 0;
+// What the scene last asked of its render (JSON; '{}' for nothing, as course scenes ask).
+let sceneAsked = '{}';
 
 const workerCount = Number(new URLSearchParams(location.search).get('workers'))
   || navigator.hardwareConcurrency || 1;
@@ -140,8 +142,38 @@ function checkScene() {
   ui.diagnostics.textContent = loaded.messages.map((message) => message.text).join('\n');
   ui.diagnostics.dataset.state = loaded.ok ? 'ok' : 'error';
   const ok = loaded.ok;
+  if (ok) followScene(loaded.scene_settings());
   loaded.free();
   return ok;
+}
+
+// The controls show what is rendered, so a scene's own settings (a Mitsuba scene's film size,
+// sample count, integrator and depth) go into them, rather than being applied behind values the
+// user sees. That happens only when what the scene asks changes (another scene, its film
+// edited): a value typed into a control stays until then. Controls the scene leaves alone
+// return to the page's defaults, so a course scene opened after a Mitsuba one renders as before.
+function followScene(asked) {
+  const wanted = {
+    width: asked.width,
+    height: asked.height,
+    spp: asked.samples_per_pixel,
+    integrator: asked.integrator,
+    maxDepth: asked.max_depth,
+  };
+  asked.free();
+  const key = JSON.stringify(wanted);
+  if (key === sceneAsked) return;
+  sceneAsked = key;
+  const set = (input, value) => {
+    input.value = value === undefined ? input.defaultValue : String(value);
+  };
+  set(ui.width, wanted.width);
+  set(ui.height, wanted.height);
+  set(ui.spp, wanted.spp);
+  set(ui.maxDepth, wanted.maxDepth);
+  const options = [...ui.integrator.options];
+  ui.integrator.value = wanted.integrator
+    ?? (options.find((option) => option.defaultSelected) ?? options[0]).value;
 }
 
 // ---- Rendering ----

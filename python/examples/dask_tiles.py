@@ -2,6 +2,9 @@
 
     python examples/dask_tiles.py SCENE [--width W --height H --spp N --tile T --workers K]
 
+Size, samples and integrator not given are the scene's, as for `glint.render` and the CLI (a
+Mitsuba scene's film, sampler and integrator; a course scene's 100 x 100, 1 sample, `course`).
+
 Each tile is one task: `glint.render(scene, crop=tile, ...)` on whichever worker Dask picks.
 The scene is sent to the workers once (`client.scatter`); a `glint.Scene` pickles as where it
 came from and each worker loads it again, so the workers need the scene's files (a shared file
@@ -21,8 +24,11 @@ import numpy as np
 import glint
 
 
-def render_tiles(client, scene, width, height, tile=64, **settings) -> np.ndarray:
-    """Renders `scene` as tiles on the Dask `client`'s workers and assembles the frame."""
+def render_tiles(client, scene, width=None, height=None, tile=64, **settings) -> np.ndarray:
+    """Renders `scene` as tiles on the Dask `client`'s workers and assembles the frame; a size
+    not given is the scene's own, as for `glint.render`."""
+    settled = scene.render_settings(width=width, height=height)
+    width, height = settled["width"], settled["height"]
     [remote_scene] = client.scatter([scene], broadcast=True)
     crops = glint.tiles(width, height, size=tile)
     futures = [
@@ -46,10 +52,10 @@ def render_tiles(client, scene, width, height, tile=64, **settings) -> np.ndarra
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("scene")
-    parser.add_argument("--width", type=int, default=320)
-    parser.add_argument("--height", type=int, default=240)
-    parser.add_argument("--spp", type=int, default=16)
-    parser.add_argument("--integrator", default="path")
+    parser.add_argument("--width", type=int)
+    parser.add_argument("--height", type=int)
+    parser.add_argument("--spp", type=int)
+    parser.add_argument("--integrator")
     parser.add_argument("--tile", type=int, default=64)
     parser.add_argument("--workers", type=int, default=2)
     parser.add_argument("--compare", action="store_true")

@@ -1,4 +1,5 @@
-"""Glint from Python: load the course's ray-tracing scenes and render them into numpy arrays.
+"""Glint from Python: load the course's ray-tracing scenes, or Mitsuba 3's, and render them into
+numpy arrays.
 
 The same renderer as the ``glint`` command: for the same scene, settings and seed,
 :func:`render` returns exactly the pixels the CLI writes to an EXR file.
@@ -97,12 +98,19 @@ def _issue_warnings(scene: Scene) -> None:
         warnings.warn(warning, stacklevel=3)
 
 
-def load_scene(path: PathLike, background: RGB | None = None) -> Scene:
-    """Loads a course scene file, XML or JSON, and builds it for rendering.
+def load_scene(
+    path: PathLike, background: RGB | None = None, defines: Mapping[str, str] | None = None
+) -> Scene:
+    """Loads a scene file, the course's XML or JSON or a Mitsuba 3 scene, and builds it for
+    rendering.
 
     Meshes, textures and environment maps are found relative to the file's directory.
     ``background=(r, g, b)`` replaces the scene's background, as the CLI's ``--background``
-    does (the course's reference renders used ``(0.2, 0.2, 0.2)``). What the
+    does (the course's reference renders used ``(0.2, 0.2, 0.2)``). ``defines`` gives a
+    Mitsuba scene's parameters, ``{"name": "value"}``, as the CLI's ``-D name=value``: they win
+    over the scene's ``<default>`` s (course scenes have none and ignore them). A Mitsuba scene
+    brings its own film size, sample count and integrator, which :func:`render` uses wherever
+    it is not given them. What the
     loader works around (unknown keys, missing textures...) is issued as a :class:`SceneWarning`
     naming ``file:line:col``; a scene that cannot be loaded raises :class:`SceneError` (with
     ``file``, ``line``, ``column`` and ``message``), a file that cannot be read ``OSError``
@@ -112,9 +120,20 @@ def load_scene(path: PathLike, background: RGB | None = None) -> Scene:
     Traceback (most recent call last):
     FileNotFoundError: [Errno 2] No such file or directory: 'no/such/scene.xml'
     """
-    scene = _glint.load_scene(os.fspath(path), _rgb(background))
+    scene = _glint.load_scene(os.fspath(path), _rgb(background), _defines(defines))
     _issue_warnings(scene)
     return scene
+
+
+def _defines(defines: Mapping[str, str] | None) -> list[tuple[str, str]] | None:
+    if defines is None:
+        return None
+    if not isinstance(defines, Mapping):
+        raise TypeError(f"defines must be a dict of str to str, not {type(defines).__name__}")
+    for name, value in defines.items():
+        if not (isinstance(name, str) and isinstance(value, str)):
+            raise TypeError(f"defines must map str to str, not {name!r} to {value!r}")
+    return list(defines.items())
 
 
 def _rgb(background: RGB | None) -> RGB | None:
@@ -137,12 +156,14 @@ def load_scene_text(
     base_dir: PathLike | None = None,
     name: str | None = None,
     background: RGB | None = None,
+    defines: Mapping[str, str] | None = None,
 ) -> Scene:
-    """Loads a scene from its text, in the course's JSON (``format="json"``) or XML.
+    """Loads a scene from its text, in the course's JSON (``format="json"``) or XML (the
+    course's or Mitsuba 3's).
 
     Diagnostics name the text ``name`` (default ``<text>.json`` or ``<text>.xml``) inside
     ``base_dir``, and assets are found relative to ``base_dir`` (default: the current
-    directory). ``background``, warnings and errors as for :func:`load_scene`.
+    directory). ``background``, ``defines``, warnings and errors as for :func:`load_scene`.
 
     >>> import warnings
     >>> with warnings.catch_warnings(record=True) as caught:
@@ -165,7 +186,8 @@ def load_scene_text(
     first = text.lstrip("\ufeff \t\r\n")[:1]
     if (format == "xml" and first in ("{", "[")) or (format == "json" and first == "<"):
         raise ValueError(f"format={format!r}, but the text starts with {first!r}")
-    scene = _glint.load_scene_text(text, _text_path(format, base_dir, name), _rgb(background))
+    path = _text_path(format, base_dir, name)
+    scene = _glint.load_scene_text(text, path, _rgb(background), _defines(defines))
     _issue_warnings(scene)
     return scene
 
@@ -214,10 +236,10 @@ def _bounds(crop: Crop, width: int, height: int) -> tuple[int, int, int, int]:
 
 def render(
     scene: Scene,
-    width: int = 100,
-    height: int = 100,
-    spp: int = 1,
-    integrator: str = "course",
+    width: int | None = None,
+    height: int | None = None,
+    spp: int | None = None,
+    integrator: str | None = None,
     seed: int = 0,
     threads: int | None = None,
     max_depth: int | None = None,
@@ -234,6 +256,11 @@ def render(
     all cores), ``max_depth`` (``-k``; default 4 for the course, unbounded for ``path``),
     ``aspect`` (``-a``; default width / height). The same arguments give the same pixels as the
     CLI, on any number of threads.
+
+    Where ``width``, ``height``, ``spp``, ``integrator`` or ``max_depth`` is not given, the
+    scene's own choice is used, as the CLI uses it without the flag: a Mitsuba scene's film
+    size, sample count, integrator (``path``) and depth; otherwise the course's defaults, 100 x
+    100, 1 sample, ``course``. :meth:`Scene.render_settings` says what they come to.
 
     ``crop`` renders only part of the image, given as numpy indexes it
     (``np.s_[y0:y1, x0:x1]``): ``render(s, crop=c)`` equals ``render(s)[c]``, bit for bit.
@@ -258,16 +285,19 @@ def render(
     >>> corner.shape, seen[-1]
     ((4, 4, 3), 1.0)
     """
-    bounds = None if crop is None else _bounds(crop, width, height)
+    settled = scene.render_settings(
+        width=width, height=height, spp=spp, integrator=integrator, max_depth=max_depth
+    )
+    bounds = None if crop is None else _bounds(crop, settled["width"], settled["height"])
     return _glint.render(
         scene,
-        width,
-        height,
-        spp,
-        integrator,
+        settled["width"],
+        settled["height"],
+        settled["spp"],
+        settled["integrator"],
         seed,
         threads,
-        max_depth,
+        settled["max_depth"],
         aspect,
         bounds,
         features,

@@ -38,15 +38,36 @@ class Scene:
     def name(self) -> str: ...
     @property
     def warnings(self) -> list[SceneWarning]: ...
+    def render_settings(
+        self,
+        width: int | None = None,
+        height: int | None = None,
+        spp: int | None = None,
+        integrator: str | None = None,
+        max_depth: int | None = None,
+    ) -> dict[str, Any]: ...
     def __reduce__(
         self,
-    ) -> tuple[Any, tuple[str, str | None, tuple[float, float, float] | None]]: ...
+    ) -> tuple[
+        Any,
+        tuple[str, str | None, tuple[float, float, float] | None, list[tuple[str, str]]],
+    ]: ...
 
 _RGB = tuple[float, float, float]
+_Defines = list[tuple[str, str]]
 
-def load_scene(path: str, background: _RGB | None = None) -> Scene: ...
-def load_scene_text(text: str, path: str, background: _RGB | None = None) -> Scene: ...
-def _restore(path: str, text: str | None = None, background: _RGB | None = None) -> Scene: ...
+def load_scene(
+    path: str, background: _RGB | None = None, defines: _Defines | None = None
+) -> Scene: ...
+def load_scene_text(
+    text: str, path: str, background: _RGB | None = None, defines: _Defines | None = None
+) -> Scene: ...
+def _restore(
+    path: str,
+    text: str | None = None,
+    background: _RGB | None = None,
+    defines: _Defines | None = None,
+) -> Scene: ...
 def render(
     scene: Scene,
     width: int,

@@ -1,6 +1,7 @@
 //! `glint._glint`: the native half of Glint's Python module. It wraps the renderer's public API
-//! and nothing else (`glint_io::load_scene` / `load_scene_from_text`, `glint_render::Scene`,
-//! `RenderSettings`, `render`, `glint_io::write_image`); `glint/__init__.py` puts the
+//! and nothing else (`glint_io::load_scene_limited_with_defines` / `load_scene_with_defines`,
+//! `glint_render::Scene`, `RequestedSettings`, `RenderSettings`, `render`,
+//! `glint_io::write_image`); `glint/__init__.py` puts the
 //! documented, keyword-friendly functions in front of it (crop slices, feature dicts, sRGB).
 //!
 //! Threads and the GIL: loading, building the acceleration structure, rendering and writing
@@ -14,10 +15,10 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
-use glint_io::{Diagnostic, ImageWriteError, LoadedScene};
+use glint_io::{Diagnostic, FileSystem, ImageWriteError, Limits, LoadedScene};
 use glint_render::{
-    Background, Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderError,
-    RenderSettings, RenderStats, Vec3,
+    Background, Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderDefaults,
+    RenderError, RenderSettings, RenderStats, RequestedSettings, Vec3,
 };
 use numpy::ndarray::{Array2, Array3, ArrayView2, ArrayView3};
 use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
@@ -62,11 +63,17 @@ enum Source {
     Text { text: String, path: PathBuf },
 }
 
+/// A Mitsuba scene's `-D name=value` defines, in the order given.
+type Defines = Vec<(String, String)>;
+
 impl Source {
-    fn load(&self) -> Result<LoadedScene, glint_io::SceneError> {
+    fn load(&self, defines: &[(String, String)]) -> Result<LoadedScene, glint_io::SceneError> {
+        let limits = Limits::default();
         match self {
-            Source::File(path) => glint_io::load_scene(path),
-            Source::Text { text, path } => glint_io::load_scene_from_text(text, path),
+            Source::File(path) => glint_io::load_scene_limited_with_defines(path, &limits, defines),
+            Source::Text { text, path } => {
+                glint_io::load_scene_with_defines(text, path, &FileSystem, &limits, defines)
+            }
         }
     }
 
@@ -99,6 +106,10 @@ struct PyScene {
     absolute_path: PathBuf,
     /// The background that replaced the scene's, if one did.
     background: Option<[f32; 3]>,
+    /// The defines it was loaded with, to load it again with them.
+    defines: Defines,
+    /// What the scene file asks of its render (a Mitsuba scene's film, sampler, integrator).
+    defaults: RenderDefaults,
     warnings: Vec<Diagnostic>,
 }
 
@@ -119,6 +130,42 @@ impl PyScene {
             .collect()
     }
 
+    /// The settings ``glint.render`` uses when called with these arguments: each one given,
+    /// else what the scene file asks for (a Mitsuba scene's film size, sample count,
+    /// integrator and depth), else the course's defaults (100 x 100, 1 sample, ``course``).
+    /// A scene that names an integrator renders with ``path``; its depth applies only then.
+    /// Returns a dict with ``width``, ``height``, ``spp``, ``integrator`` and ``max_depth``
+    /// (``None``: the integrator's default), the ``glint`` CLI's rule for its flags.
+    #[pyo3(signature = (width=None, height=None, spp=None, integrator=None, max_depth=None))]
+    fn render_settings<'py>(
+        &self,
+        py: Python<'py>,
+        width: Option<u32>,
+        height: Option<u32>,
+        spp: Option<u32>,
+        integrator: Option<&str>,
+        max_depth: Option<u32>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        // The caller's depth has the CLI's `-k` limit; a scene's depth is for the path tracer,
+        // which does not recurse, so it has none.
+        check_depth(max_depth)?;
+        let requested = RequestedSettings {
+            width,
+            height,
+            samples_per_pixel: spp,
+            integrator: integrator.map(integrator_named).transpose()?,
+            max_depth,
+        };
+        let settings = requested.settle(&self.defaults);
+        let settled = PyDict::new(py);
+        settled.set_item("width", settings.width)?;
+        settled.set_item("height", settings.height)?;
+        settled.set_item("spp", settings.samples_per_pixel)?;
+        settled.set_item("integrator", settings.integrator.name())?;
+        settled.set_item("max_depth", settings.max_depth)?;
+        Ok(settled)
+    }
+
     fn __repr__(&self) -> String {
         format!("<glint.Scene {:?}>", self.name())
     }
@@ -127,14 +174,15 @@ impl PyScene {
         let restore = py.import("glint._glint")?.getattr("_restore")?;
         let path = path_string(&self.absolute_path)?;
         let text = self.source.text().map(str::to_owned);
-        Ok((restore, (path, text, self.background)))
+        Ok((restore, (path, text, self.background, self.defines.clone())))
     }
 }
 
-/// What `Scene.__reduce__` returns: `_restore` and its arguments (path, text, background).
+/// What `Scene.__reduce__` returns: `_restore` and its arguments (path, text, background,
+/// defines).
 type Reduced<'py> = (
     Bound<'py, PyAny>,
-    (String, Option<String>, Option<[f32; 3]>),
+    (String, Option<String>, Option<[f32; 3]>, Defines),
 );
 
 fn path_string(path: &Path) -> PyResult<String> {
@@ -144,8 +192,13 @@ fn path_string(path: &Path) -> PyResult<String> {
 }
 
 /// Loads and builds a scene with the GIL released; `background` replaces the scene's (the
-/// CLI's `--background`).
-fn load(py: Python<'_>, source: Source, background: Option<[f32; 3]>) -> PyResult<PyScene> {
+/// CLI's `--background`), `defines` are a Mitsuba scene's `-D name=value`.
+fn load(
+    py: Python<'_>,
+    source: Source,
+    background: Option<[f32; 3]>,
+    defines: Defines,
+) -> PyResult<PyScene> {
     if let Some(rgb) = background {
         if rgb.iter().any(|c| !c.is_finite() || *c < 0.0) {
             return Err(PyValueError::new_err(format!(
@@ -154,7 +207,7 @@ fn load(py: Python<'_>, source: Source, background: Option<[f32; 3]>) -> PyResul
         }
     }
     let loaded = py
-        .detach(|| source.load())
+        .detach(|| source.load(&defines))
         .map_err(|error| scene_error(py, error))?;
     let LoadedScene {
         mut parts,
@@ -163,6 +216,7 @@ fn load(py: Python<'_>, source: Source, background: Option<[f32; 3]>) -> PyResul
     if let Some([r, g, b]) = background {
         parts.background = Background::Color(Color::new(r, g, b));
     }
+    let defaults = parts.physical.defaults;
     let scene = py.detach(|| glint_render::Scene::new(parts));
     let absolute_path = std::path::absolute(source.name())?;
     Ok(PyScene {
@@ -170,43 +224,59 @@ fn load(py: Python<'_>, source: Source, background: Option<[f32; 3]>) -> PyResul
         source,
         absolute_path,
         background,
+        defines,
+        defaults,
         warnings,
     })
 }
 
-/// Loads the scene file at `path` (XML or JSON). Warnings are returned in `Scene.warnings`
-/// for the caller to issue.
+/// Loads the scene file at `path` (the course's XML or JSON, or Mitsuba 3's XML with
+/// `defines`). Warnings are returned in `Scene.warnings` for the caller to issue.
 #[pyfunction]
-#[pyo3(signature = (path, background=None))]
-fn load_scene(py: Python<'_>, path: PathBuf, background: Option<[f32; 3]>) -> PyResult<PyScene> {
-    load(py, Source::File(path), background)
+#[pyo3(signature = (path, background=None, defines=None))]
+fn load_scene(
+    py: Python<'_>,
+    path: PathBuf,
+    background: Option<[f32; 3]>,
+    defines: Option<Defines>,
+) -> PyResult<PyScene> {
+    load(
+        py,
+        Source::File(path),
+        background,
+        defines.unwrap_or_default(),
+    )
 }
 
 /// Loads a scene from its text; `path` names it in diagnostics and locates its assets.
 #[pyfunction]
-#[pyo3(signature = (text, path, background=None))]
+#[pyo3(signature = (text, path, background=None, defines=None))]
 fn load_scene_text(
     py: Python<'_>,
     text: String,
     path: PathBuf,
     background: Option<[f32; 3]>,
+    defines: Option<Defines>,
 ) -> PyResult<PyScene> {
-    load(py, Source::Text { text, path }, background)
+    let source = Source::Text { text, path };
+    load(py, source, background, defines.unwrap_or_default())
 }
 
-/// Unpickles a `Scene`: loads it again from where it came from.
+/// Unpickles a `Scene`: loads it again from where it came from, with the same defines.
 #[pyfunction]
-#[pyo3(signature = (path, text=None, background=None))]
+#[pyo3(signature = (path, text=None, background=None, defines=None))]
 fn _restore(
     py: Python<'_>,
     path: PathBuf,
     text: Option<String>,
     background: Option<[f32; 3]>,
+    defines: Option<Defines>,
 ) -> PyResult<PyScene> {
-    match text {
-        None => load(py, Source::File(path), background),
-        Some(text) => load(py, Source::Text { text, path }, background),
-    }
+    let source = match text {
+        None => Source::File(path),
+        Some(text) => Source::Text { text, path },
+    };
+    load(py, source, background, defines.unwrap_or_default())
 }
 
 /// What the CLI prints after `error: ` or `warning: ` (glint-io's `Diagnostic::located`).
@@ -331,13 +401,7 @@ fn render<'py>(
     features: bool,
     progress: Option<Bound<'py, PyAny>>,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let integrator = IntegratorKind::from_name(integrator).ok_or_else(|| {
-        let names: Vec<&str> = IntegratorKind::ALL.iter().map(|kind| kind.name()).collect();
-        PyValueError::new_err(format!(
-            "unknown integrator {integrator:?}: use one of {}",
-            names.join(", ")
-        ))
-    })?;
+    let integrator = integrator_named(integrator)?;
     if width > MAX_SIDE || height > MAX_SIDE {
         return Err(PyValueError::new_err(format!(
             "the image is {width}x{height}: each side must be at most {MAX_SIDE}"
@@ -346,10 +410,8 @@ fn render<'py>(
     if spp == 0 {
         return Err(PyValueError::new_err("spp must be at least 1"));
     }
-    if let Some(depth) = max_depth.filter(|&depth| depth > MAX_DEPTH) {
-        return Err(PyValueError::new_err(format!(
-            "max_depth {depth} is too deep: at most {MAX_DEPTH}"
-        )));
+    if integrator != IntegratorKind::Path {
+        check_depth(max_depth)?;
     }
     if let Some(threads) = threads.filter(|&t| t == 0 || t > MAX_THREADS) {
         return Err(PyValueError::new_err(format!(
@@ -377,6 +439,27 @@ fn render<'py>(
         warn_nonfinite(py, &stats)?;
     }
     film_to_python(py, film)
+}
+
+/// Refuses a path length past `MAX_DEPTH`.
+fn check_depth(max_depth: Option<u32>) -> PyResult<()> {
+    match max_depth.filter(|&depth| depth > MAX_DEPTH) {
+        Some(depth) => Err(PyValueError::new_err(format!(
+            "max_depth {depth} is too deep: at most {MAX_DEPTH}"
+        ))),
+        None => Ok(()),
+    }
+}
+
+/// The integrator called `name`, or a `ValueError` listing them.
+fn integrator_named(name: &str) -> PyResult<IntegratorKind> {
+    IntegratorKind::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = IntegratorKind::ALL.iter().map(|kind| kind.name()).collect();
+        PyValueError::new_err(format!(
+            "unknown integrator {name:?}: use one of {}",
+            names.join(", ")
+        ))
+    })
 }
 
 /// The CLI's warning about samples that were NaN or infinite (and left out of their pixels),

@@ -8,12 +8,10 @@ use std::time::Duration;
 
 use glint_io::{DisplayTransform, PngEncoding, ToneMap, Transfer};
 use glint_render::{
-    Color, IntegratorKind, RenderDefaults, RenderSettings, SceneIntegrator, SplitMethod,
+    Color, IntegratorKind, RenderDefaults, RenderSettings, RequestedSettings, SplitMethod,
 };
 
-use crate::args::{
-    Cli, Command, DeviceArg, IntegratorArg, Options, Rgb, ToneMapArg, TransferArg, MAX_SIDE,
-};
+use crate::args::{Cli, Command, DeviceArg, Options, Rgb, ToneMapArg, TransferArg, MAX_SIDE};
 
 /// Arguments that parsed but make no sense together: exit status 2, like clap's own errors.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -230,23 +228,18 @@ impl Options {
     /// (100 × 100, one sample, the course integrator).
     fn settle(&self, output: &Path, defaults: &RenderDefaults) -> Result<Settled, UsageError> {
         let mut notes = Vec::new();
-        let width = self.width.or(defaults.width).unwrap_or(100);
-        let height = self.height.or(defaults.height).unwrap_or(100);
-        let rpp = self.rpp.or(defaults.samples_per_pixel).unwrap_or(1);
-        // A scene that names an integrator is meant for the path tracer.
-        let integrator_arg = self.integrator.unwrap_or(match defaults.integrator {
-            Some(_) => IntegratorArg::Path,
-            None => IntegratorArg::Course,
-        });
-        // The scene's depth counts scattering events, the path tracer's count.
-        let max_depth = self.recursion_depth.or(match integrator_arg {
-            IntegratorArg::Path => match defaults.integrator {
-                Some(SceneIntegrator::Direct) => Some(1),
-                Some(SceneIntegrator::Path) => defaults.max_depth,
-                None => None,
-            },
-            _ => None,
-        });
+        // glint-render holds the rule, so that Python and the page settle scenes the same way.
+        let scene_settled = RequestedSettings {
+            width: self.width,
+            height: self.height,
+            samples_per_pixel: self.rpp,
+            integrator: self.integrator.map(IntegratorKind::from),
+            max_depth: self.recursion_depth,
+        }
+        .settle(defaults);
+        let (width, height) = (scene_settled.width, scene_settled.height);
+        let rpp = scene_settled.samples_per_pixel;
+        let integrator = scene_settled.integrator;
         // One side given: the other keeps the image's aspect ratio.
         let scaled = |side: u32, from: u32, to: u32| {
             ((side as u64 * to as u64).div_ceil(from as u64)).clamp(1, MAX_SIDE as u64) as u32
@@ -263,7 +256,6 @@ impl Options {
             (_, _, Some(tile)) => Some(tile.pixel_bounds(width, height)?),
             _ => None,
         };
-        let integrator = IntegratorKind::from(integrator_arg);
         let sample_range = self
             .sample_range
             .as_ref()
@@ -277,19 +269,14 @@ impl Options {
             )));
         }
         let settings = RenderSettings {
-            width,
-            height,
-            samples_per_pixel: rpp,
-            max_depth,
             aspect: self.aspect,
             seed: self.seed,
-            integrator,
             // Feature layers cost a first-hit ray per sample; only an EXR keeps them, and
             // only a whole range of samples averages them (merge cannot add them up).
             features: output_is_exr(output) && sample_range.is_none(),
             pixel_bounds,
             sample_range,
-            ..RenderSettings::default()
+            ..scene_settled
         };
         settings.validate().map_err(UsageError)?;
         // The path tracer takes exactly RPP samples; the course's grid takes N².
@@ -303,7 +290,7 @@ impl Options {
         Ok(Settled {
             settings,
             preview,
-            png: png_encoding(integrator_arg, self.exposure, self.tonemap, self.transfer),
+            png: png_encoding(integrator, self.exposure, self.tonemap, self.transfer),
             notes,
         })
     }
@@ -315,13 +302,13 @@ impl Options {
 /// `albedo` view, which are colours, get the display transform's defaults (clamp, sRGB), as
 /// pbrt and Mitsuba write PNGs.
 pub fn png_encoding(
-    integrator: IntegratorArg,
+    integrator: IntegratorKind,
     exposure: Option<f32>,
     tonemap: Option<ToneMapArg>,
     transfer: Option<TransferArg>,
 ) -> PngEncoding {
     if exposure.is_none() && tonemap.is_none() && transfer.is_none() {
-        return PngEncoding::default_for(integrator.into());
+        return PngEncoding::default_for(integrator);
     }
     let defaults = DisplayTransform::default();
     PngEncoding::Display(DisplayTransform {

@@ -102,5 +102,5 @@ pub use texture::{
 pub use film::{Features, Film, SampleSums};
 pub use pipeline::{
     measure_traversal, render, IntegratorKind, PixelBounds, Progress, RenderError, RenderSettings,
-    RenderStats, TraversalStats, TILE_SIZE,
+    RenderStats, RequestedSettings, TraversalStats, TILE_SIZE,
 };

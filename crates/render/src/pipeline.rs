@@ -23,6 +23,7 @@ use crate::integrator::debug::{DebugIntegrator, DebugView};
 use crate::integrator::path::{PathIntegrator, PathSettings, DEFAULT_MAX_DEPTH};
 use crate::integrator::{Integrator, PixelContext, Sample, TileCounters};
 use crate::math::{Color, Vec3};
+use crate::scene::physical::{RenderDefaults, SceneIntegrator};
 use crate::scene::Scene;
 
 /// Which integrator computes a sample.
@@ -242,6 +243,66 @@ impl RenderSettings {
             }
         }
         Ok(())
+    }
+}
+
+/// The settings a scene file may choose (`RenderDefaults`), as someone asked for them: a front
+/// end's user (the CLI's flags, Python's keywords, the page's controls) or the scene itself
+/// (`from_scene`). `None` where nothing was asked. Every front end settles them with `settle`,
+/// so a scene renders the same way from each.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RequestedSettings {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub samples_per_pixel: Option<u32>,
+    pub integrator: Option<IntegratorKind>,
+    /// In Glint's count: `RenderSettings::max_depth`.
+    pub max_depth: Option<u32>,
+}
+
+impl RequestedSettings {
+    /// What the scene asks for, in Glint's terms: a scene that names an integrator is meant for
+    /// the path tracer, and `direct` is the path tracer with one scattering event.
+    pub fn from_scene(defaults: &RenderDefaults) -> RequestedSettings {
+        RequestedSettings {
+            width: defaults.width,
+            height: defaults.height,
+            samples_per_pixel: defaults.samples_per_pixel,
+            integrator: defaults.integrator.map(|_| IntegratorKind::Path),
+            max_depth: match defaults.integrator {
+                Some(SceneIntegrator::Direct) => Some(1),
+                Some(SceneIntegrator::Path) => defaults.max_depth,
+                None => None,
+            },
+        }
+    }
+
+    /// What is asked here, else what the scene asks, else the course's defaults (100 × 100,
+    /// one sample, the course integrator), as `RenderSettings` with the other fields at their
+    /// defaults. The scene's depth counts scattering events, so it applies only when the
+    /// path tracer renders; another integrator asked for here keeps its own default depth.
+    pub fn settle(self, defaults: &RenderDefaults) -> RenderSettings {
+        let scene = RequestedSettings::from_scene(defaults);
+        let fallback = RenderSettings::default();
+        let integrator = self
+            .integrator
+            .or(scene.integrator)
+            .unwrap_or(fallback.integrator);
+        let max_depth = self.max_depth.or(match integrator {
+            IntegratorKind::Path => scene.max_depth,
+            _ => None,
+        });
+        RenderSettings {
+            width: self.width.or(scene.width).unwrap_or(fallback.width),
+            height: self.height.or(scene.height).unwrap_or(fallback.height),
+            samples_per_pixel: self
+                .samples_per_pixel
+                .or(scene.samples_per_pixel)
+                .unwrap_or(fallback.samples_per_pixel),
+            integrator,
+            max_depth,
+            ..fallback
+        }
     }
 }
 

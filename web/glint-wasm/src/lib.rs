@@ -2,8 +2,9 @@
 //! `wasm32-unknown-unknown` and bound to JavaScript with wasm-bindgen (`web/`).
 //!
 //! - [`Files`] holds the files a user dropped (scene assets), by path;
-//! - [`load`] reads a scene from its text with those files and returns a [`Loaded`]: the scene,
-//!   or the located diagnostics exactly as the `glint` CLI prints them;
+//! - [`load`] reads a scene from its text (the course's XML or JSON, or Mitsuba 3's XML) with
+//!   those files and returns a [`Loaded`]: the scene, or the located diagnostics exactly as the
+//!   `glint` CLI prints them, and [`Loaded::scene_settings`], what the scene asks of its render;
 //! - [`Loaded::render_tile`] renders one rectangle of the image with `RenderSettings::pixel_bounds`,
 //!   so tiles rendered by separate Web Workers are the pixels of the whole render;
 //! - [`encode`] turns the assembled film into PNG or EXR bytes with glint-io's own encoder, so the
@@ -22,7 +23,8 @@ use glint_io::{
     Diagnostic, MemoryAssets, OutputFormat, PngEncoding, SceneError, Severity, WriteOptions,
 };
 use glint_render::{
-    Color, Features, Film, IntegratorKind, PixelBounds, RenderSettings, Scene, Vec3,
+    Color, Features, Film, IntegratorKind, PixelBounds, RenderDefaults, RenderSettings,
+    RequestedSettings, Scene, Vec3,
 };
 use wasm_bindgen::prelude::*;
 
@@ -91,6 +93,24 @@ fn located(diagnostic: &Diagnostic) -> String {
 pub struct Loaded {
     scene: Option<Scene>,
     messages: Vec<Message>,
+    /// What the scene file asks of its render (a Mitsuba scene's film, sampler, integrator).
+    defaults: RenderDefaults,
+}
+
+/// What a scene asks of its render, in the page's terms (`RequestedSettings::from_scene`):
+/// each field `undefined` where the scene leaves it to the page. A Mitsuba scene gives its
+/// film size and sample count, and `path` with its depth when it names an integrator; a
+/// course scene gives nothing.
+#[wasm_bindgen(getter_with_clone)]
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneSettings {
+    pub width: Option<u32>,
+    pub height: Option<u32>,
+    pub samples_per_pixel: Option<u32>,
+    /// An integrator's name (see `Settings::new`).
+    pub integrator: Option<String>,
+    /// In Glint's count, as the page's depth (`-k`).
+    pub max_depth: Option<u32>,
 }
 
 /// Loads the scene `text` named `path` (which locates its assets among `files`). Never throws:
@@ -109,6 +129,7 @@ pub fn load(text: &str, path: &str, files: &Files) -> Loaded {
                 }
             }
             Loaded {
+                defaults: loaded.parts.physical.defaults,
                 scene: Some(Scene::new(loaded.parts)),
                 messages,
             }
@@ -116,6 +137,7 @@ pub fn load(text: &str, path: &str, files: &Files) -> Loaded {
         Err(SceneError::Invalid(diagnostic)) => Loaded {
             scene: None,
             messages: vec![Message::from_diagnostic(&diagnostic)],
+            defaults: RenderDefaults::default(),
         },
         Err(error) => Loaded {
             scene: None,
@@ -128,6 +150,7 @@ pub fn load(text: &str, path: &str, files: &Files) -> Loaded {
                 excerpt: String::new(),
                 text: format!("error: {error}"),
             }],
+            defaults: RenderDefaults::default(),
         },
     }
 }
@@ -208,6 +231,18 @@ impl Loaded {
     #[wasm_bindgen(getter)]
     pub fn messages(&self) -> Vec<Message> {
         self.messages.clone()
+    }
+
+    /// What the scene asks of its render; nothing for a course scene or one that did not load.
+    pub fn scene_settings(&self) -> SceneSettings {
+        let asked = RequestedSettings::from_scene(&self.defaults);
+        SceneSettings {
+            width: asked.width,
+            height: asked.height,
+            samples_per_pixel: asked.samples_per_pixel,
+            integrator: asked.integrator.map(|kind| kind.name().to_owned()),
+            max_depth: asked.max_depth,
+        }
     }
 
     /// Renders pixels `x0..x1` by `y0..y1` of the image `settings` describe: exactly those

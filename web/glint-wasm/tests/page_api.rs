@@ -1,10 +1,11 @@
 //! The page's API, natively: tiles rendered one by one and encoded here give the CLI's PNG and
-//! EXR byte for byte, and a broken scene gives the CLI's located error text.
+//! EXR byte for byte, a broken scene gives the CLI's located error text, and a Mitsuba scene
+//! loads from memory with the settings it asks for.
 
 use std::path::Path;
 
 use glint_render::RenderSettings;
-use glint_wasm::{encode, load, Files, Settings};
+use glint_wasm::{encode, load, Files, SceneSettings, Settings};
 
 const WEB: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
 
@@ -168,4 +169,79 @@ fn bad_settings_and_formats_are_refused() {
         .contains("course, path"));
     assert!(encode("jpg", "course", 1, 1, &[0.0; 3], None, None, None).is_err());
     assert!(encode("png", "course", 2, 1, &[0.0; 3], None, None, None).is_err());
+}
+
+/// A diffuse triangle from an OBJ among the page's files under a constant environment; a
+/// `res` x 8 film (12 unless defined), 4 samples, the path tracer at Mitsuba's max_depth 3.
+const MITSUBA: &str = r#"<scene version="3.0.0">
+  <default name="res" value="12"/>
+  <integrator type="path"><integer name="max_depth" value="3"/></integrator>
+  <sensor type="perspective">
+    <transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="4"/></sampler>
+    <film type="hdrfilm">
+      <integer name="width" value="$res"/><integer name="height" value="8"/>
+    </film>
+  </sensor>
+  <emitter type="constant"/>
+  <shape type="obj">
+    <string name="filename" value="meshes/tri.obj"/>
+    <bsdf type="diffuse"/>
+  </shape>
+</scene>
+"#;
+
+#[test]
+fn a_mitsuba_scene_loads_from_memory_and_asks_for_its_settings() {
+    let mut files = Files::new();
+    files.add(
+        "dropped/meshes/tri.obj",
+        b"v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
+    );
+    let loaded = load(MITSUBA, "dropped/scene.xml", &files);
+    assert!(loaded.ok(), "{:?}", loaded.messages());
+    assert!(loaded.messages().is_empty(), "{:?}", loaded.messages());
+    let asked = loaded.scene_settings();
+    assert_eq!(
+        asked,
+        SceneSettings {
+            width: Some(12),
+            height: Some(8),
+            samples_per_pixel: Some(4),
+            integrator: Some("path".to_owned()),
+            max_depth: Some(2),
+        }
+    );
+    // Those settings on the page give the pixels the CLI renders without flags.
+    let settings = Settings::new(12, 8, 4, "path", 0, Some(2), false).unwrap();
+    let tile = loaded.render_tile(&settings, 0, 0, 12, 8).unwrap();
+    let native = glint_io::load_scene_with_assets(MITSUBA, Path::new("dropped/scene.xml"), &{
+        let mut assets = glint_io::MemoryAssets::new();
+        assets.insert(
+            "dropped/meshes/tri.obj",
+            b"v -1 -1 0\nv 1 -1 0\nv 0 1 0\nf 1 2 3\n".to_vec(),
+        );
+        assets
+    })
+    .unwrap()
+    .parts;
+    let cli_settings = glint_render::RequestedSettings::default().settle(&native.physical.defaults);
+    let (film, _) =
+        glint_render::render(&glint_render::Scene::new(native), &cli_settings, &|_| true).unwrap();
+    let cli: Vec<f32> = film.pixels.iter().flat_map(|p| p.to_array()).collect();
+    assert_eq!(tile.pixels, cli);
+    assert!(tile.pixels.iter().any(|&v| v > 0.0));
+
+    // Without the asset the OBJ is a located error naming it.
+    let missing = load(MITSUBA, "dropped/scene.xml", &Files::new());
+    assert!(!missing.ok());
+    assert!(
+        missing.messages()[0].text.contains("tri.obj"),
+        "{:?}",
+        missing.messages()
+    );
+    // Course scenes ask for nothing: the page keeps its own settings.
+    let (text, files) = example_files();
+    let course = load(&text, "textured/textured.xml", &files);
+    assert_eq!(course.scene_settings(), SceneSettings::default());
 }

@@ -284,3 +284,59 @@ fn cancelling_stops_the_render() {
     });
     assert_eq!(result.unwrap_err(), crate::RenderError::Cancelled);
 }
+
+/// The one rule every front end settles a scene's defaults by: asked values win, then the
+/// scene's, then the course's; the scene's depth only for the path tracer.
+#[test]
+fn requested_settings_settle_over_the_scenes_defaults() {
+    use crate::{RenderDefaults, RequestedSettings, SceneIntegrator};
+    let course = RequestedSettings::default().settle(&RenderDefaults::default());
+    assert_eq!(course, RenderSettings::default());
+    let scene = RenderDefaults {
+        width: Some(12),
+        height: Some(8),
+        samples_per_pixel: Some(4),
+        integrator: Some(SceneIntegrator::Path),
+        max_depth: Some(2),
+        ..RenderDefaults::default()
+    };
+    let settled = RequestedSettings::default().settle(&scene);
+    assert_eq!(
+        (settled.width, settled.height, settled.samples_per_pixel),
+        (12, 8, 4)
+    );
+    assert_eq!(
+        (settled.integrator, settled.max_depth),
+        (IntegratorKind::Path, Some(2))
+    );
+    let asked = RequestedSettings {
+        width: Some(6),
+        samples_per_pixel: Some(9),
+        integrator: Some(IntegratorKind::Normals),
+        ..RequestedSettings::default()
+    }
+    .settle(&scene);
+    assert_eq!(
+        (asked.width, asked.height, asked.samples_per_pixel),
+        (6, 8, 9)
+    );
+    // The scene's depth counts the path tracer's scattering events: not the normals view's.
+    assert_eq!(
+        (asked.integrator, asked.max_depth),
+        (IntegratorKind::Normals, None)
+    );
+    let direct = RenderDefaults {
+        integrator: Some(SceneIntegrator::Direct),
+        ..RenderDefaults::default()
+    };
+    let settled = RequestedSettings::default().settle(&direct);
+    assert_eq!(
+        (settled.integrator, settled.max_depth),
+        (IntegratorKind::Path, Some(1))
+    );
+    let deeper = RequestedSettings {
+        max_depth: Some(5),
+        ..RequestedSettings::default()
+    };
+    assert_eq!(deeper.settle(&direct).max_depth, Some(5));
+}
