@@ -58,7 +58,7 @@ fn wo_at(theta_degrees: f32) -> Vec3 {
 
 /// Runs the harness, prints the figure line, checks the p-value against the family's level
 /// when any continuous sample came back, and returns the figures.
-fn check(name: &str, bsdf: &dyn Scatter, wo: Vec3) -> Figures {
+fn check(name: &str, bsdf: &(dyn Scatter + Sync), wo: Vec3) -> Figures {
     let figures = examine(name, bsdf, wo, 0.0).unwrap_or_else(|e| panic!("{e}"));
     eprintln!(
         "FIGURE {name}: p = {:.4}, furnace albedo {:.4} ± {:.4} (sampled), {:.4} \
@@ -248,7 +248,7 @@ fn thin_is_two_sided() {
 /// `quadrature` is set, by quadrature (channel mean, 2e-3), with `expected`.
 fn check_known_albedo(
     name: &str,
-    bsdf: &dyn Scatter,
+    bsdf: &(dyn Scatter + Sync),
     wo: Vec3,
     expected: Color,
     bias: f64,

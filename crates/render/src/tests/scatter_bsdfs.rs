@@ -14,6 +14,8 @@ use crate::material::plastic::{Plastic, RoughPlastic};
 use crate::material::scatter::Scatter;
 use crate::math::{Color, Vec3};
 
+use rayon::prelude::*;
+
 /// Polar angles of ωo above the surface: near normal, oblique, grazing.
 const ANGLES: [f32; 3] = [10.0, 60.0, 85.0];
 
@@ -89,8 +91,12 @@ fn rough_dielectric() {
 
 #[test]
 fn rough_plastic() {
-    for mf in microfacets().into_iter().filter(|m| m.is_isotropic()) {
-        for theta in ANGLES {
+    // Each plastic tabulates its coating (about a million microfacet samples, seconds in a
+    // test build): built once for all its angles, and on every core.
+    let plastics: Vec<(Microfacet, RoughPlastic)> = microfacets()
+        .into_par_iter()
+        .filter(|m| m.is_isotropic())
+        .map(|mf| {
             let bsdf = RoughPlastic::new(
                 mf.distribution,
                 mf.alpha_u,
@@ -100,6 +106,11 @@ fn rough_plastic() {
                 Color::ONE,
                 false,
             );
+            (mf, bsdf)
+        })
+        .collect();
+    for (mf, bsdf) in plastics {
+        for theta in ANGLES {
             let name = format!("roughplastic η 1.49 {} θo {theta}", label(&mf));
             let f = check(&name, &bsdf, direction_at(theta, 30.0), slack(Some(&mf)));
             assert_lossless(&name, f.energy, f.standard_error);
