@@ -200,7 +200,11 @@ impl PathIntegrator {
                 .map(|id| PreparedMaterial::new(scene, id))
                 .collect(),
             filter: FilterSampler::new(scene.physical.defaults.filter),
-            rough_plastics: prepare_rough_plastics(&scene.physical, &scene.textures),
+            rough_plastics: prepare_rough_plastics(
+                &scene.physical.bsdfs,
+                &scene.physical.textures,
+                &scene.textures,
+            ),
         }
     }
 
@@ -365,7 +369,8 @@ impl PathIntegrator {
                 let surface = scene.physical_surface(&ray, &hit);
                 let wo = -ray.direction;
                 let bsdf = SurfaceBsdf::new(
-                    &scene.physical,
+                    &scene.physical.bsdfs,
+                    &scene.physical.textures,
                     &self.rough_plastics,
                     &scene.textures,
                     id,

@@ -26,8 +26,43 @@ use crate::material::plastic::{specular_sampling_weight, Plastic, RoughPlastic};
 use crate::material::principled::{Principled, PrincipledThin};
 use crate::material::scatter::Scatter;
 use crate::math::{Color, Frame, Vec3};
-use crate::scene::physical::{PhysicalParts, PhysicalSurface};
-use crate::texture::Image;
+use crate::texture::{Image, TextureNode, TexturePoint};
+
+/// Shading data of a hit on a physically based material, as Mitsuba 3.9 computes it
+/// (`Scene::physical_surface`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PhysicalSurface {
+    pub point: Vec3,
+    /// Unit geometric normal (world): by the winding for triangles, outward for spheres.
+    pub normal: Vec3,
+    /// The shading frame: `w` the interpolated vertex normal (or the geometric normal), `u`
+    /// along ∂p/∂u made orthogonal to it, `v` = w × u.
+    pub frame: Frame,
+    /// ∂p/∂u and ∂p/∂v in world space (bump mapping needs them).
+    pub dp_du: Vec3,
+    pub dp_dv: Vec3,
+    /// What textures read here.
+    pub texture: TexturePoint,
+}
+
+impl PhysicalSurface {
+    /// Mitsuba's shading frame from the shading normal `n` and ∂p/∂u: the tangent is ∂p/∂u
+    /// made orthogonal to `n`, or any tangent where that vanishes.
+    pub fn shading_frame(n: Vec3, dp_du: Vec3) -> Frame {
+        let s = dp_du - n * n.dot(dp_du);
+        let length = s.length();
+        if length > 0.0 && length.is_finite() {
+            let s = s / length;
+            Frame {
+                u: s,
+                v: n.cross(s),
+                w: n,
+            }
+        } else {
+            Frame::from_normal(n)
+        }
+    }
+}
 
 /// The most leaves a resolved tree keeps; deeper mixtures drop their lightest leaves.
 pub const MAX_LEAVES: usize = 4;
@@ -166,7 +201,8 @@ pub struct SurfaceBsdf {
 
 /// What resolving a tree reads.
 struct Resolver<'a> {
-    parts: &'a PhysicalParts,
+    bsdfs: &'a [BsdfNode],
+    textures: &'a [TextureNode],
     prepared: &'a [Option<RoughPlastic>],
     images: &'a [Image],
     surface: &'a PhysicalSurface,
@@ -174,17 +210,17 @@ struct Resolver<'a> {
     wo: Vec3,
 }
 
-/// The tables of every rough plastic of `parts` by BSDF id (`None` elsewhere): Mitsuba's
+/// The tables of every rough plastic of `bsdfs` by BSDF id (`None` elsewhere): Mitsuba's
 /// rough transmittance, tabulated once per material because it takes a million microfacet
 /// evaluations. Its colours are the hit's; its roughness and index must be constants
 /// (Mitsuba's are), read at uv (0, 0).
 pub fn prepare_rough_plastics(
-    parts: &PhysicalParts,
+    bsdfs: &[BsdfNode],
+    textures: &[TextureNode],
     images: &[Image],
 ) -> Vec<Option<RoughPlastic>> {
-    let at = crate::texture::TexturePoint::default();
-    parts
-        .bsdfs
+    let at = TexturePoint::default();
+    bsdfs
         .iter()
         .map(|node| match node {
             BsdfNode::Plastic {
@@ -197,7 +233,7 @@ pub fn prepare_rough_plastics(
                     DistributionKind::Beckmann => Distribution::Beckmann,
                     DistributionKind::Ggx => Distribution::Ggx,
                 },
-                r.alpha_u.eval_float(&parts.textures, images, &at),
+                r.alpha_u.eval_float(textures, images, &at),
                 r.sample_visible,
                 *eta,
                 Color::splat(0.5),
@@ -210,10 +246,12 @@ pub fn prepare_rough_plastics(
 }
 
 impl SurfaceBsdf {
-    /// The BSDF of tree `id` at `surface`, seen from world direction `wo`; `prepared` is
-    /// `prepare_rough_plastics` of the same parts.
+    /// The BSDF of tree `id` of `bsdfs` (whose `Param::Texture`s index `textures`) at
+    /// `surface`, seen from world direction `wo`; `prepared` is `prepare_rough_plastics` of
+    /// the same trees.
     pub fn new(
-        parts: &PhysicalParts,
+        bsdfs: &[BsdfNode],
+        textures: &[TextureNode],
         prepared: &[Option<RoughPlastic>],
         images: &[Image],
         id: BsdfId,
@@ -230,7 +268,8 @@ impl SurfaceBsdf {
             count: 0,
         };
         let resolver = Resolver {
-            parts,
+            bsdfs,
+            textures,
             prepared,
             images,
             surface,
@@ -317,11 +356,11 @@ impl SurfaceBsdf {
 
 impl Resolver<'_> {
     fn float(&self, p: &Param) -> f32 {
-        p.eval_float(&self.parts.textures, self.images, &self.surface.texture)
+        p.eval_float(self.textures, self.images, &self.surface.texture)
     }
 
     fn color(&self, p: &Param) -> Color {
-        p.eval(&self.parts.textures, self.images, &self.surface.texture)
+        p.eval(self.textures, self.images, &self.surface.texture)
     }
 
     fn microfacet(&self, r: &Roughness) -> Microfacet {
@@ -365,7 +404,7 @@ impl Resolver<'_> {
         tilt: Option<Tilt>,
         depth: u32,
     ) {
-        let Some(node) = self.parts.bsdfs.get(id as usize) else {
+        let Some(node) = self.bsdfs.get(id as usize) else {
             return;
         };
         if depth > MAX_NESTING || weight <= 0.0 {
@@ -551,7 +590,6 @@ impl Resolver<'_> {
             }
             BsdfNode::NormalMap { normals, nested } => {
                 let texel = self
-                    .parts
                     .textures
                     .get(*normals as usize)
                     .map_or(Vec3::new(0.5, 0.5, 1.0), |node| {
@@ -589,7 +627,7 @@ impl Resolver<'_> {
                 scale,
                 nested,
             } => {
-                let Some(node) = self.parts.textures.get(*height as usize) else {
+                let Some(node) = self.textures.get(*height as usize) else {
                     return;
                 };
                 let (gu, gv) = node.gradient(self.images, &self.surface.texture);

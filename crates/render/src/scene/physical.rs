@@ -83,38 +83,4 @@ pub struct RenderDefaults {
     pub uniform_light_selection: bool,
 }
 
-/// Shading data of a hit on a physically based material, as Mitsuba 3.9 computes it
-/// (`Scene::physical_surface`).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct PhysicalSurface {
-    pub point: Vec3,
-    /// Unit geometric normal (world): by the winding for triangles, outward for spheres.
-    pub normal: Vec3,
-    /// The shading frame: `w` the interpolated vertex normal (or the geometric normal), `u`
-    /// along ∂p/∂u made orthogonal to it, `v` = w × u.
-    pub frame: crate::math::Frame,
-    /// ∂p/∂u and ∂p/∂v in world space (bump mapping needs them).
-    pub dp_du: Vec3,
-    pub dp_dv: Vec3,
-    /// What textures read here.
-    pub texture: crate::texture::TexturePoint,
-}
-
-impl PhysicalSurface {
-    /// Mitsuba's shading frame from the shading normal `n` and ∂p/∂u: the tangent is ∂p/∂u
-    /// made orthogonal to `n`, or any tangent where that vanishes.
-    pub fn shading_frame(n: Vec3, dp_du: Vec3) -> crate::math::Frame {
-        let s = dp_du - n * n.dot(dp_du);
-        let length = s.length();
-        if length > 0.0 && length.is_finite() {
-            let s = s / length;
-            crate::math::Frame {
-                u: s,
-                v: n.cross(s),
-                w: n,
-            }
-        } else {
-            crate::math::Frame::from_normal(n)
-        }
-    }
-}
+pub use crate::material::surface::PhysicalSurface;
