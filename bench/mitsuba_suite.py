@@ -93,6 +93,18 @@ def llvm_environment():
 
 
 def time_mitsuba(variant, scene, spp):
+    """Seconds, or None when the Mitsuba process fails (its stderr is printed)."""
+    try:
+        return run_mitsuba(variant, scene, spp)
+    except (subprocess.CalledProcessError, ValueError, IndexError) as error:
+        stderr = getattr(error, "stderr", "") or ""
+        print(
+            f"  {variant} failed on {scene.name}: {error} {stderr[-300:]}", flush=True
+        )
+        return None
+
+
+def run_mitsuba(variant, scene, spp):
     result = subprocess.run(
         [sys.executable, "-c", MITSUBA_WORKER, variant, str(scene), str(spp), "1"],
         check=True,
@@ -122,19 +134,25 @@ def main():
                 times["glint"].append(time_glint(args.glint, scene, spp, out))
                 for variant in variants:
                     times[variant].append(time_mitsuba(variant, scene, spp))
-            medians = {k: statistics.median(v) for k, v in times.items()}
+            medians = {
+                k: statistics.median(v) if None not in v else None
+                for k, v in times.items()
+            }
             name = f"{scene.parent.name}/{scene.stem}"
             rows.append((name, spp, medians))
+            peers = [
+                f"{v} {medians[v]:.2f} s ({medians[v] / medians['glint']:.2f}x)"
+                if medians[v] is not None
+                else f"{v} failed"
+                for v in variants
+            ]
             print(
                 f"{name}: {spp} spp, glint {medians['glint']:.2f} s, "
-                + ", ".join(
-                    f"{v} {medians[v]:.2f} s ({medians[v] / medians['glint']:.2f}x)"
-                    for v in variants
-                ),
+                + ", ".join(peers),
                 flush=True,
             )
     for variant in variants:
-        ratios = [m[variant] / m["glint"] for _, _, m in rows]
+        ratios = [m[variant] / m["glint"] for _, _, m in rows if m[variant] is not None]
         if ratios:
             print(
                 f"{variant} / glint: median {statistics.median(ratios):.2f}x, "
