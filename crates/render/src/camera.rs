@@ -14,7 +14,7 @@ pub enum Projection {
 /// A course camera: position e, frame (U, V, W) from the gaze and up = (0,1,0), focal length
 /// f and image-plane width w. The image-plane height is w · ny / nx (square pixels,
 /// FORMAT.md A2) unless an aspect ratio is given.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, PartialEq)]
 pub struct Camera {
     pub projection: Projection,
     pub position: Vec3,
@@ -26,6 +26,25 @@ pub struct Camera {
     /// Mitsuba's `near_clip` and `far_clip`: the path tracer's camera rays see only what lies
     /// between these distances along the view direction (-W); `None` sees everything.
     pub clip: Option<(f32, f32)>,
+}
+
+/// The derived text, with `clip` only where there are clipping planes: the scene hash reads
+/// a camera's `Debug` text, and course cameras (which have none) keep the digests earlier
+/// builds wrote.
+impl std::fmt::Debug for Camera {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut s = f.debug_struct("Camera");
+        s.field("projection", &self.projection)
+            .field("position", &self.position)
+            .field("basis", &self.basis)
+            .field("focal_length", &self.focal_length)
+            .field("image_plane_width", &self.image_plane_width)
+            .field("lens", &self.lens);
+        if let Some(clip) = &self.clip {
+            s.field("clip", clip);
+        }
+        s.finish()
+    }
 }
 
 /// A thin lens (pbrt's `PerspectiveCamera` lens, Mitsuba 3's `thinlens` sensor): rays leave
