@@ -5,6 +5,7 @@
 
 mod accel_watertight;
 mod chi2_sampling;
+mod composite_bsdfs;
 mod depth_of_field;
 mod lecture_math;
 mod mitsuba_emitters;
