@@ -63,7 +63,7 @@ fi
 
 echo "== cargo test --workspace"
 status=0
-cargo test --workspace --locked 2>&1 | tee "$logs/cargo.log" || status=$?
+cargo test --workspace --locked --no-fail-fast 2>&1 | tee "$logs/cargo.log" || status=$?
 result[cargo]="$(cargo_totals "$logs/cargo.log")$([ "$status" = 0 ] || echo " (exit $status)")"
 failed=$status
 
