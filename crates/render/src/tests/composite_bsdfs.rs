@@ -271,7 +271,12 @@ fn normal_and_bump_maps() {
         let name = format!("bumpmap over rough plastic, θo {theta}");
         check(
             &name,
-            &Tree::new(&nodes, std::slice::from_ref(&height), &[image.clone()], wo),
+            &Tree::new(
+                &nodes,
+                std::slice::from_ref(&height),
+                std::slice::from_ref(&image),
+                wo,
+            ),
             wo,
         );
     }
