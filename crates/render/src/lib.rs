@@ -26,6 +26,8 @@
 //!         materials: vec![0],
 //!     }],
 //!     instances: vec![Instance { geometry: 0, transform: None, material: None, casts_shadow: true }],
+//!     // What Mitsuba scenes add (BSDF trees, textures, render defaults): none here.
+//!     physical: PhysicalParts::default(),
 //! };
 //! let scene = Scene::new(parts);
 //! let settings = RenderSettings { width: 32, height: 24, samples_per_pixel: 4, ..RenderSettings::default() };
