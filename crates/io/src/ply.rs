@@ -106,20 +106,7 @@ pub fn parse(bytes: &[u8]) -> Result<PlyMesh, PlyError> {
 /// `parse`, with or without the binary fast paths (without: the general reader alone, their
 /// tests' reference).
 fn parse_with(bytes: &[u8], fast: bool) -> Result<PlyMesh, PlyError> {
-    let (encoding, elements, body_start) = parse_header(bytes)?;
-    let body = &bytes[body_start..];
-    let binary = |big_endian| {
-        Reader::Binary(BinaryReader {
-            bytes: body,
-            position: 0,
-            big_endian,
-        })
-    };
-    let mut reader = match encoding {
-        Encoding::Ascii => Reader::Ascii(AsciiReader::new(body)),
-        Encoding::BinaryLittleEndian => binary(false),
-        Encoding::BinaryBigEndian => binary(true),
-    };
+    let (elements, body, mut reader) = open(bytes)?;
     let mut positions: Vec<[f32; 3]> = Vec::new();
     let mut triangles: Vec<[u32; 3]> = Vec::new();
     let mut polygon: Vec<i64> = Vec::new();
@@ -250,20 +237,7 @@ pub(crate) fn parse_attributes(
     bytes: &[u8],
     max_triangles: u64,
 ) -> Result<PlyAttributes, PlyError> {
-    let (encoding, elements, body_start) = parse_header(bytes)?;
-    let body = &bytes[body_start..];
-    let binary = |big_endian| {
-        Reader::Binary(BinaryReader {
-            bytes: body,
-            position: 0,
-            big_endian,
-        })
-    };
-    let mut reader = match encoding {
-        Encoding::Ascii => Reader::Ascii(AsciiReader::new(body)),
-        Encoding::BinaryLittleEndian => binary(false),
-        Encoding::BinaryBigEndian => binary(true),
-    };
+    let (elements, body, mut reader) = open(bytes)?;
     let mut out = PlyAttributes::default();
     let mut polygon: Vec<i64> = Vec::new();
     for element in &elements {
@@ -543,6 +517,25 @@ fn push_strips(
         }
     }
     Ok(())
+}
+
+/// The header's elements, the body after it, and a reader of the body in its encoding.
+fn open(bytes: &[u8]) -> Result<(Vec<Element>, &[u8], Reader<'_>), PlyError> {
+    let (encoding, elements, body_start) = parse_header(bytes)?;
+    let body = &bytes[body_start..];
+    let binary = |big_endian| {
+        Reader::Binary(BinaryReader {
+            bytes: body,
+            position: 0,
+            big_endian,
+        })
+    };
+    let reader = match encoding {
+        Encoding::Ascii => Reader::Ascii(AsciiReader::new(body)),
+        Encoding::BinaryLittleEndian => binary(false),
+        Encoding::BinaryBigEndian => binary(true),
+    };
+    Ok((elements, body, reader))
 }
 
 fn parse_header(bytes: &[u8]) -> Result<(Encoding, Vec<Element>, usize), PlyError> {
