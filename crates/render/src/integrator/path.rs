@@ -26,7 +26,7 @@ use crate::accel::PACKET;
 use crate::integrator::{camera_ray_packets, FirstHit, Integrator, PixelContext, Sample};
 use crate::light::sampler::LightSample;
 use crate::light::sampler::LightSampler;
-use crate::material::bsdf::Bsdf;
+use crate::material::bsdf::{Bsdf, BsdfSample};
 use crate::material::physical::BsdfId;
 use crate::material::plastic::RoughPlastic;
 use crate::material::surface::{prepare_rough_plastics, SurfaceBsdf};
@@ -363,7 +363,9 @@ impl PathIntegrator {
                 }
             }
 
-            if let (Some(id), false) = (material.physical, behind_emitter) {
+            // The vertex scatters by its physically based tree or by the course's lobes;
+            // either way the path goes on from `point` along the world direction `next.wi`.
+            let (point, next) = if let (Some(id), false) = (material.physical, behind_emitter) {
                 // A physically based material: its tree resolved at this point, in world
                 // directions.
                 let surface = scene.physical_surface(&ray, &hit);
@@ -408,90 +410,79 @@ impl PathIntegrator {
                         }
                     }
                 }
-                let Some(sample) = continuation else {
-                    break;
-                };
-                throughput = throughput.mul_elem(sample.weight);
-                if throughput == Color::ZERO || !throughput.is_finite() {
-                    break;
-                }
-                specular_bounce = sample.is_specular;
-                bsdf_pdf = sample.pdf;
-                eta_scale *= sample.eta * sample.eta;
-                ray = Ray::spawn(surface.point, sample.wi);
-                depth += 1;
-                if depth >= self.settings.russian_roulette_depth {
-                    let survival = ((throughput * eta_scale).max_component()).min(0.95);
-                    if sampler.sample_1d(dimension + 5) >= survival {
-                        break;
-                    }
-                    throughput = throughput / survival;
-                }
-                continue;
-            }
-
-            let frame = Frame::from_normal(si.normal);
-            let wo = frame.to_local(-ray.direction);
-            let textured;
-            let bsdf = match &material.bsdf {
-                _ if behind_emitter => &Bsdf::BLACK,
-                Some(bsdf) => bsdf,
-                None => {
-                    let uv = scene.surface(&ray, &hit, SurfaceNeeds::Uv).uv;
-                    textured =
-                        Bsdf::from_material(&scene.materials, &scene.textures, si.material, uv);
-                    &textured
-                }
-            };
-            if depth == 0 {
-                first_hit.normal = if wo.z < 0.0 { -si.normal } else { si.normal };
-                first_hit.depth = hit.t;
-                if !bsdf.is_black() {
-                    first_hit.albedo = bsdf.albedo();
-                }
-            }
-            if depth >= self.settings.max_depth || bsdf.is_black() || wo.z == 0.0 {
-                break;
-            }
-
-            // The vertex's random numbers, drawn in a fixed order (the stream beyond the
-            // stratified dimensions is consumed in call order), and the continuation, which
-            // does not depend on the light sample: all of it ahead of the shadow ray, so that
-            // its arithmetic overlaps the light sample's instead of waiting for the shadow
-            // ray's traversal.
-            // The direction and the light sample are one four-dimensional point (stratified
-            // together, and one index shuffle for both), drawn whether or not the light
-            // sample is used.
-            let [u_direction, u_light] = sampler.sample_4d(dimension);
-            let u_lobe = if bsdf.uses_lobe_sample() {
-                sampler.sample_1d(dimension + 4)
+                (surface.point, continuation)
             } else {
-                0.5
-            };
-            let continuation = bsdf.sample(wo, u_lobe, u_direction);
-
-            // Next-event estimation: one light, chosen by power, one point on it.
-            if bsdf.has_non_specular() {
-                if let Some(sample) = self.lights.sample(scene, si.point, u_light) {
-                    let wi = frame.to_local(sample.direction);
-                    let (f, scattering_pdf) = bsdf.eval_and_pdf(wo, wi);
-                    if f != Color::ZERO
-                        && sample.radiance != Color::ZERO
-                        && unoccluded(scene, si.point, &sample, rays)
-                    {
-                        let weight = if sample.is_delta || !sample.reachable_by_bsdf {
-                            1.0
-                        } else {
-                            power_heuristic(sample.pdf, scattering_pdf)
-                        };
-                        radiance += throughput.mul_elem(f).mul_elem(sample.radiance)
-                            * (wi.z.abs() * weight / sample.pdf);
+                let frame = Frame::from_normal(si.normal);
+                let wo = frame.to_local(-ray.direction);
+                let textured;
+                let bsdf = match &material.bsdf {
+                    _ if behind_emitter => &Bsdf::BLACK,
+                    Some(bsdf) => bsdf,
+                    None => {
+                        let uv = scene.surface(&ray, &hit, SurfaceNeeds::Uv).uv;
+                        textured =
+                            Bsdf::from_material(&scene.materials, &scene.textures, si.material, uv);
+                        &textured
+                    }
+                };
+                if depth == 0 {
+                    first_hit.normal = if wo.z < 0.0 { -si.normal } else { si.normal };
+                    first_hit.depth = hit.t;
+                    if !bsdf.is_black() {
+                        first_hit.albedo = bsdf.albedo();
                     }
                 }
-            }
+                if depth >= self.settings.max_depth || bsdf.is_black() || wo.z == 0.0 {
+                    break;
+                }
+
+                // The vertex's random numbers, drawn in a fixed order (the stream beyond the
+                // stratified dimensions is consumed in call order), and the continuation, which
+                // does not depend on the light sample: all of it ahead of the shadow ray, so that
+                // its arithmetic overlaps the light sample's instead of waiting for the shadow
+                // ray's traversal.
+                // The direction and the light sample are one four-dimensional point (stratified
+                // together, and one index shuffle for both), drawn whether or not the light
+                // sample is used.
+                let [u_direction, u_light] = sampler.sample_4d(dimension);
+                let u_lobe = if bsdf.uses_lobe_sample() {
+                    sampler.sample_1d(dimension + 4)
+                } else {
+                    0.5
+                };
+                let continuation = bsdf.sample(wo, u_lobe, u_direction);
+
+                // Next-event estimation: one light, chosen by power, one point on it.
+                if bsdf.has_non_specular() {
+                    if let Some(sample) = self.lights.sample(scene, si.point, u_light) {
+                        let wi = frame.to_local(sample.direction);
+                        let (f, scattering_pdf) = bsdf.eval_and_pdf(wo, wi);
+                        if f != Color::ZERO
+                            && sample.radiance != Color::ZERO
+                            && unoccluded(scene, si.point, &sample, rays)
+                        {
+                            let weight = if sample.is_delta || !sample.reachable_by_bsdf {
+                                1.0
+                            } else {
+                                power_heuristic(sample.pdf, scattering_pdf)
+                            };
+                            radiance += throughput.mul_elem(f).mul_elem(sample.radiance)
+                                * (wi.z.abs() * weight / sample.pdf);
+                        }
+                    }
+                }
+
+                (
+                    si.point,
+                    continuation.map(|sample| BsdfSample {
+                        wi: frame.to_world(sample.wi),
+                        ..sample
+                    }),
+                )
+            };
 
             // Continue the path along the BSDF sample.
-            let Some(sample) = continuation else {
+            let Some(sample) = next else {
                 break;
             };
             throughput = throughput.mul_elem(sample.weight);
@@ -501,7 +492,7 @@ impl PathIntegrator {
             specular_bounce = sample.is_specular;
             bsdf_pdf = sample.pdf;
             eta_scale *= sample.eta * sample.eta;
-            ray = Ray::spawn(si.point, frame.to_world(sample.wi));
+            ray = Ray::spawn(point, sample.wi);
             depth += 1;
 
             // Russian roulette (Mitsuba 3: survive with min(max throughput · η², 0.95)).
