@@ -57,6 +57,7 @@ mod integrator;
 mod light;
 mod material;
 mod math;
+mod medium;
 mod pages;
 mod pipeline;
 mod ray;
@@ -90,6 +91,7 @@ pub use material::physical::{
 pub use material::principled::eta_from_specular;
 pub use material::{Material, MaterialId};
 pub use math::{Color, Matrix4, Transform, Vec3};
+pub use medium::{Medium, MediumBoundary, MediumId, PhaseFunction, Volume, VolumeGrid};
 pub use ray::Ray;
 pub use scene::physical::{
     MeshAttributes, PhysicalParts, PixelFilter, RenderDefaults, SceneIntegrator,

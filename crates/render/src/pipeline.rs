@@ -21,6 +21,7 @@ use crate::integrator::course::grid_size;
 use crate::integrator::course::CourseIntegrator;
 use crate::integrator::debug::{DebugIntegrator, DebugView};
 use crate::integrator::path::{PathIntegrator, PathSettings, DEFAULT_MAX_DEPTH};
+use crate::integrator::volpath::VolPathIntegrator;
 use crate::integrator::{Integrator, PixelContext, Sample, TileCounters};
 use crate::math::{Color, Vec3};
 use crate::scene::physical::{RenderDefaults, SceneIntegrator};
@@ -36,6 +37,9 @@ pub enum IntegratorKind {
     /// The physically based path tracer: exactly `samples_per_pixel` samples, next-event
     /// estimation with MIS, Russian roulette.
     Path,
+    /// The volumetric path tracer: the path tracer with participating media between
+    /// surfaces (Mitsuba's `volpath`); physically based materials only.
+    VolPath,
     /// Debug view: the world-space normal of the first hit as colour, (n + 1) / 2.
     Normals,
     /// Debug view: the first hit's albedo (the feature layer a denoiser takes).
@@ -47,20 +51,22 @@ pub enum IntegratorKind {
 
 impl IntegratorKind {
     /// Every integrator, in the order the CLI lists them.
-    pub const ALL: [IntegratorKind; 5] = [
+    pub const ALL: [IntegratorKind; 6] = [
         IntegratorKind::Course,
         IntegratorKind::Path,
+        IntegratorKind::VolPath,
         IntegratorKind::Normals,
         IntegratorKind::Albedo,
         IntegratorKind::Depth,
     ];
 
-    /// The name the CLI, Python and the web page use: `course`, `path`, `normals`, `albedo`,
-    /// `depth`.
+    /// The name the CLI, Python and the web page use: `course`, `path`, `volpath`, `normals`,
+    /// `albedo`, `depth`.
     pub fn name(self) -> &'static str {
         match self {
             IntegratorKind::Course => "course",
             IntegratorKind::Path => "path",
+            IntegratorKind::VolPath => "volpath",
             IntegratorKind::Normals => "normals",
             IntegratorKind::Albedo => "albedo",
             IntegratorKind::Depth => "depth",
@@ -79,7 +85,7 @@ impl IntegratorKind {
     /// unbounded in practice (Russian roulette ends paths long before).
     pub fn default_max_depth(self) -> u32 {
         match self {
-            IntegratorKind::Path => DEFAULT_MAX_DEPTH,
+            IntegratorKind::Path | IntegratorKind::VolPath => DEFAULT_MAX_DEPTH,
             _ => 4,
         }
     }
@@ -89,7 +95,7 @@ impl IntegratorKind {
     /// (FORMAT.md A18).
     pub fn samples_per_pixel(self, requested: u32) -> u32 {
         match self {
-            IntegratorKind::Path => requested.max(1),
+            IntegratorKind::Path | IntegratorKind::VolPath => requested.max(1),
             _ => grid_size(requested).pow(2),
         }
     }
@@ -268,10 +274,13 @@ impl RequestedSettings {
             width: defaults.width,
             height: defaults.height,
             samples_per_pixel: defaults.samples_per_pixel,
-            integrator: defaults.integrator.map(|_| IntegratorKind::Path),
+            integrator: defaults.integrator.map(|integrator| match integrator {
+                SceneIntegrator::VolPath => IntegratorKind::VolPath,
+                SceneIntegrator::Path | SceneIntegrator::Direct => IntegratorKind::Path,
+            }),
             max_depth: match defaults.integrator {
                 Some(SceneIntegrator::Direct) => Some(1),
-                Some(SceneIntegrator::Path) => defaults.max_depth,
+                Some(SceneIntegrator::Path | SceneIntegrator::VolPath) => defaults.max_depth,
                 None => None,
             },
         }
@@ -289,7 +298,7 @@ impl RequestedSettings {
             .or(scene.integrator)
             .unwrap_or(fallback.integrator);
         let max_depth = self.max_depth.or(match integrator {
-            IntegratorKind::Path => scene.max_depth,
+            IntegratorKind::Path | IntegratorKind::VolPath => scene.max_depth,
             _ => None,
         });
         RenderSettings {
@@ -400,6 +409,12 @@ fn render_on_current_pool(
             &PathIntegrator::new(scene, PathSettings::for_scene(scene, settings.max_depth())),
             progress,
         ),
+        IntegratorKind::VolPath => {
+            let integrator =
+                VolPathIntegrator::new(scene, PathSettings::for_scene(scene, settings.max_depth()))
+                    .map_err(|why| RenderError::Invalid(why.0))?;
+            render_with(scene, settings, &integrator, progress)
+        }
         IntegratorKind::Normals => render_with(
             scene,
             settings,

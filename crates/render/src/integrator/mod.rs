@@ -10,6 +10,7 @@
 pub mod course;
 pub mod debug;
 pub mod path;
+pub mod volpath;
 
 use std::ops::Range;
 

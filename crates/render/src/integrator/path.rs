@@ -111,7 +111,7 @@ struct PreparedMaterial {
     /// The BSDF where no texture enters it (then it is the same at every point); `None` where
     /// one does, and the hit builds it from its texture coordinates.
     bsdf: Option<Bsdf>,
-    emitter: Emitter,
+    emitter: PreparedEmitter,
     /// A dielectric's attenuation per unit distance (Beer's law for segments inside it).
     attenuation: Option<Color>,
     /// The physically based BSDF tree that scatters here (built per hit: `SurfaceBsdf`);
@@ -119,8 +119,9 @@ struct PreparedMaterial {
     physical: Option<BsdfId>,
 }
 
+/// What a material emits, as the path tracers see it at a hit.
 #[derive(Clone, Copy, Debug)]
-enum Emitter {
+pub(crate) enum PreparedEmitter {
     None,
     /// Emits as light `index` of `Scene::lights`, which light sampling also finds.
     Light(usize),
@@ -128,9 +129,63 @@ enum Emitter {
     Unsampled(Color),
 }
 
-impl Emitter {
-    fn is_some(&self) -> bool {
-        !matches!(self, Emitter::None)
+impl PreparedEmitter {
+    /// The emitter of material `id` (`None` for ids out of range).
+    pub(crate) fn new(scene: &Scene, id: MaterialId) -> PreparedEmitter {
+        match scene.materials.get(id as usize) {
+            Some(Material::Emissive {
+                radiance, light, ..
+            }) => match light
+                .map(|index| index as usize)
+                .filter(|&index| index < scene.lights.len())
+            {
+                Some(index) => PreparedEmitter::Light(index),
+                None => PreparedEmitter::Unsampled(*radiance),
+            },
+            _ => PreparedEmitter::None,
+        }
+    }
+
+    #[inline]
+    pub(crate) fn is_some(&self) -> bool {
+        !matches!(self, PreparedEmitter::None)
+    }
+
+    /// The radiance emitted towards the origin of `ray`, which hits it at `hit` with geometric
+    /// normal `normal`; `None` where the ray meets an emitter's back (which emits nothing and
+    /// reflects nothing either).
+    #[inline]
+    pub(crate) fn emitted(
+        &self,
+        lights: &LightSampler,
+        scene: &Scene,
+        ray: &Ray,
+        hit: &PreliminaryHit,
+        normal: crate::math::Vec3,
+    ) -> Option<Color> {
+        match *self {
+            PreparedEmitter::Light(index) => lights
+                .emission_towards(index, ray.direction, normal)
+                .map(|emitted| match lights.radiance_texture(index) {
+                    // A textured radiance, read at the hit's uv.
+                    Some(texture) => {
+                        let at = scene.physical_surface(ray, hit).texture;
+                        scene
+                            .physical
+                            .textures
+                            .get(texture as usize)
+                            .map_or(Color::ZERO, |node| {
+                                emitted.mul_elem(node.eval(&scene.textures, &at))
+                            })
+                    }
+                    None => emitted,
+                }),
+            // An emitter no light samples: one-sided along its geometric normal.
+            PreparedEmitter::Unsampled(emitted) => {
+                (ray.direction.dot(normal) < 0.0).then_some(emitted)
+            }
+            PreparedEmitter::None => None,
+        }
     }
 }
 
@@ -139,18 +194,7 @@ impl PreparedMaterial {
         let material = scene.materials.get(id as usize);
         let bsdf = (!Bsdf::depends_on_uv(&scene.materials, id))
             .then(|| Bsdf::from_material(&scene.materials, &scene.textures, id, (0.0, 0.0)));
-        let emitter = match material {
-            Some(Material::Emissive {
-                radiance, light, ..
-            }) => match light
-                .map(|index| index as usize)
-                .filter(|&index| index < scene.lights.len())
-            {
-                Some(index) => Emitter::Light(index),
-                None => Emitter::Unsampled(*radiance),
-            },
-            _ => Emitter::None,
-        };
+        let emitter = PreparedEmitter::new(scene, id);
         let attenuation = match material {
             Some(Material::Dielectric { attenuation, .. }) => Some(*attenuation),
             _ => None,
@@ -177,7 +221,7 @@ impl PreparedMaterial {
 
 /// Veach's power heuristic with β = 2 for one sample from each strategy.
 #[inline]
-fn power_heuristic(pdf: f32, other_pdf: f32) -> f32 {
+pub(crate) fn power_heuristic(pdf: f32, other_pdf: f32) -> f32 {
     let a = pdf * pdf;
     let b = other_pdf * other_pdf;
     if a.is_infinite() {
@@ -307,35 +351,14 @@ impl PathIntegrator {
             // one-sided unless wrapped in `twosided`), and it matters where the back of a light
             // can be seen, such as the gap between the Cornell box's light and its ceiling.
             let mut behind_emitter = false;
-            if let Emitter::Light(_) | Emitter::Unsampled(_) = material.emitter {
-                let emitted = match material.emitter {
-                    Emitter::Light(index) => self
-                        .lights
-                        .emission_towards(index, ray.direction, si.normal)
-                        .map(|emitted| match self.lights.radiance_texture(index) {
-                            // A textured radiance, read at the hit's uv.
-                            Some(texture) => {
-                                let at = scene.physical_surface(&ray, &hit).texture;
-                                scene
-                                    .physical
-                                    .textures
-                                    .get(texture as usize)
-                                    .map_or(Color::ZERO, |node| {
-                                        emitted.mul_elem(node.eval(&scene.textures, &at))
-                                    })
-                            }
-                            None => emitted,
-                        }),
-                    // An emitter no light samples: one-sided along its geometric normal.
-                    Emitter::Unsampled(emitted) => {
-                        (ray.direction.dot(si.normal) < 0.0).then_some(emitted)
-                    }
-                    Emitter::None => None,
-                };
+            if material.emitter.is_some() {
+                let emitted = material
+                    .emitter
+                    .emitted(&self.lights, scene, &ray, &hit, si.normal);
                 match emitted {
                     Some(emitted) if emitted != Color::ZERO => {
                         let weight = match material.emitter {
-                            Emitter::Light(index) if !specular_bounce => {
+                            PreparedEmitter::Light(index) if !specular_bounce => {
                                 let light_pdf = self
                                     .lights
                                     .pdf_emitter_hit(index, ray.origin, si.point, si.normal);
@@ -591,7 +614,7 @@ fn unoccluded(
 /// axis at a time (the filters are separable), so that a pixel's mean is the filter-weighted
 /// mean of the radiance around its centre, as Mitsuba's film computes it.
 #[derive(Clone, Debug)]
-struct FilterSampler {
+pub(crate) struct FilterSampler {
     /// Half-width in pixels; 0 for the box, whose offsets are the uniform numbers themselves.
     radius: f32,
     /// The filter's cumulative distribution over `BINS` equal bins of [−radius, radius].
@@ -601,7 +624,7 @@ struct FilterSampler {
 impl FilterSampler {
     const BINS: usize = 1024;
 
-    fn new(filter: PixelFilter) -> FilterSampler {
+    pub(crate) fn new(filter: PixelFilter) -> FilterSampler {
         let (radius, weight): (f32, Box<dyn Fn(f32) -> f64>) = match filter {
             PixelFilter::Box => {
                 return FilterSampler {
@@ -648,7 +671,7 @@ impl FilterSampler {
     /// The offset in [0, 1)² of the pixel's corner (outside it for wide filters) for the
     /// uniform numbers `u`.
     #[inline]
-    fn offset(&self, u: (f32, f32)) -> (f32, f32) {
+    pub(crate) fn offset(&self, u: (f32, f32)) -> (f32, f32) {
         if self.cdf.is_empty() {
             return u;
         }
@@ -668,7 +691,7 @@ impl FilterSampler {
 /// `ray` with its direction made unit: every hit's t is then a distance (Beer's law, light
 /// pdfs).
 #[inline]
-fn unit_ray(ray: &Ray) -> Ray {
+pub(crate) fn unit_ray(ray: &Ray) -> Ray {
     Ray {
         direction: ray.direction.normalized(),
         ..*ray

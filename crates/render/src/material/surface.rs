@@ -187,6 +187,31 @@ impl Leaf {
         each_family!(&self.family, s => s.has_non_delta(), false)
     }
 
+    /// Whether `sample` (world ωi) of this leaf passes straight through it: a null leaf, or a
+    /// thin dielectric's transmission (Mitsuba's `Null` events).
+    #[inline]
+    fn is_null(&self, wo: Vec3, sample: &BsdfSample) -> bool {
+        match &self.family {
+            Family::Null => true,
+            Family::ThinDielectric(_) => sample.wi.dot(wo) < 0.0,
+            _ => false,
+        }
+    }
+
+    /// What passes straight through the leaf towards −ωo (Mitsuba's
+    /// `eval_null_transmission`).
+    #[inline]
+    fn null_transmission(&self, wo: Vec3) -> Color {
+        match &self.family {
+            Family::Null => Color::ONE,
+            Family::ThinDielectric(thin) => {
+                let cos = self.frame.to_local(wo).z;
+                thin.specular_transmittance * (1.0 - thin.reflectance(cos))
+            }
+            _ => Color::ZERO,
+        }
+    }
+
     fn albedo(&self) -> Color {
         each_family!(&self.family, s => s.albedo(), Color::ZERO)
     }
@@ -318,10 +343,37 @@ impl SurfaceBsdf {
         (f, pdf)
     }
 
+    /// What passes straight through the surface towards −ωo without changing direction (the
+    /// null leaves and thin dielectrics' transmission, weighted): what a shadow ray keeps
+    /// when it crosses the surface.
+    pub fn null_transmission(&self, wo: Vec3) -> Color {
+        self.leaves[..self.count]
+            .iter()
+            .fold(Color::ZERO, |sum, leaf| {
+                sum + leaf.null_transmission(wo) * leaf.weight
+            })
+    }
+
+    /// `sample`, and whether the sample passes straight through the surface (a null event:
+    /// the volumetric path tracer does not count it as a bounce).
+    pub fn sample_event(&self, wo: Vec3, u_lobe: f32, u: (f32, f32)) -> Option<(BsdfSample, bool)> {
+        let (leaf, u_leaf) = self.choose(u_lobe)?;
+        let sample = self.sample_leaf(leaf, wo, u_leaf, u)?;
+        let null = sample.is_specular && self.leaves[leaf].is_null(wo, &sample);
+        Some((sample, null))
+    }
+
     /// Draws a world direction ωi for `wo`; `BsdfSample::wi` is in world space.
     pub fn sample(&self, wo: Vec3, u_lobe: f32, u: (f32, f32)) -> Option<BsdfSample> {
+        let (leaf, u_leaf) = self.choose(u_lobe)?;
+        self.sample_leaf(leaf, wo, u_leaf, u)
+    }
+
+    /// The leaf `u_lobe` picks (by weight) and the number left for the leaf's own choice.
+    #[inline]
+    fn choose(&self, u_lobe: f32) -> Option<(usize, f32)> {
         if self.count == 1 {
-            return self.leaves[0].sample(wo, u_lobe, u);
+            return Some((0, u_lobe));
         }
         let mut start = 0.0;
         let mut chosen = self.count.checked_sub(1)?;
@@ -337,6 +389,22 @@ impl SurfaceBsdf {
             return None;
         }
         let u_leaf = ((u_lobe - start) / leaf.weight).clamp(0.0, 1.0 - f32::EPSILON / 2.0);
+        Some((chosen, u_leaf))
+    }
+
+    /// A sample of leaf `index` (chosen by `choose`), weighed against the whole BSDF.
+    #[inline]
+    fn sample_leaf(
+        &self,
+        index: usize,
+        wo: Vec3,
+        u_leaf: f32,
+        u: (f32, f32),
+    ) -> Option<BsdfSample> {
+        let leaf = &self.leaves[index];
+        if self.count == 1 {
+            return leaf.sample(wo, u_leaf, u);
+        }
         let mut sample = leaf.sample(wo, u_leaf, u)?;
         if sample.is_specular {
             // A delta is not in the other leaves' densities: its weight stands, and its

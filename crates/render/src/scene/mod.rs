@@ -332,6 +332,20 @@ impl Scene {
     /// Shading data of a hit as Mitsuba computes it for its BSDFs: texture coordinates from the
     /// mesh's own (or the barycentrics), the interpolated shading normal, ∂p/∂u and ∂p/∂v, and
     /// the mesh's colours, all from `physical.attributes`.
+    /// The media the surface of `hit`'s geometry separates, if it bounds any.
+    #[inline]
+    pub fn medium_boundary(&self, hit: &impl AnyHit) -> Option<crate::medium::MediumBoundary> {
+        if self.physical.boundaries.is_empty() {
+            return None;
+        }
+        let inst = &self.accel.instances[hit.preliminary().instance as usize];
+        self.physical
+            .boundaries
+            .get(inst.geometry as usize)
+            .copied()
+            .flatten()
+    }
+
     pub fn physical_surface(&self, ray: &Ray, hit: &impl AnyHit) -> PhysicalSurface {
         let prelim = hit.preliminary();
         let inst = &self.accel.instances[prelim.instance as usize];

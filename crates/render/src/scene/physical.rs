@@ -4,6 +4,7 @@
 
 use crate::material::physical::BsdfNode;
 use crate::math::{Color, Vec3};
+use crate::medium::{Medium, MediumBoundary, MediumId};
 use crate::texture::TextureNode;
 
 /// The physically based parts of a scene; empty for course scenes.
@@ -19,6 +20,13 @@ pub struct PhysicalParts {
     /// What the scene file asks of its render; front ends use these where the user gives no
     /// flag.
     pub defaults: RenderDefaults,
+    /// Participating media; `MediumId`s index it.
+    pub media: Vec<Medium>,
+    /// Per geometry (same index as `attributes`), the media its surface separates; shorter
+    /// than `geometries` when the last ones bound none.
+    pub boundaries: Vec<Option<MediumBoundary>>,
+    /// The medium the camera sits in.
+    pub camera_medium: Option<MediumId>,
 }
 
 /// Per-triangle corner attributes of one geometry, indexed like `GeometryDesc::shapes`
@@ -59,6 +67,8 @@ pub enum SceneIntegrator {
     /// direct lighting only).
     Path,
     Direct,
+    /// `volpath` and `volpathmis`: the volumetric path tracer.
+    VolPath,
 }
 
 /// What the scene file asks of its render.

@@ -1,0 +1,614 @@
+//! The volumetric path tracer (`--integrator volpath`; Mitsuba's `volpath` and `volpathmis`):
+//! the path tracer of `path.rs` with participating media between its surfaces.
+//!
+//! Inside a medium, the distance to the next collision is sampled against the medium's
+//! majorant (delta tracking). In a heterogeneous medium a collision is real with probability
+//! mean(σt/σ̄) and null otherwise, the path weighed by σs or σn over that probability per
+//! channel; a null collision moves the ray on and changes nothing else. In a homogeneous
+//! medium whose σt differs between channels, each distance is drawn with the σt of a channel
+//! chosen uniformly, and weighed against the mean of the three channels' densities
+//! (one-sample multiple importance sampling over the channels: the spectral MIS of Mitsuba's
+//! `volpathmis`, done per collision), so no channel's estimate blows up.
+//!
+//! A real collision scatters by the medium's phase function, with next-event estimation
+//! weighed against phase sampling (power heuristic), as a surface does with its BSDF.
+//! Shadow rays carry transmittance, not a yes or no: through a homogeneous medium in closed
+//! form (Beer–Lambert), through a heterogeneous one by ratio tracking, and across surfaces
+//! that let light straight through (`null`, a thin dielectric's transmission, a mask's
+//! transparent part) by that surface's null transmission.
+//!
+//! Media are Mitsuba's: a surface bounding media sends a ray crossing it into its exterior
+//! medium along the geometric normal, its interior against it, and a surface that bounds none
+//! leaves the ray's medium as it is. Straight-through events at surfaces and null collisions
+//! are not bounces: they neither count towards the depth cap nor end a run of specular
+//! bounces.
+//!
+//! Like the path tracer, every random number is a function of (seed, pixel, sample,
+//! dimension), so images are bit-identical for any thread count.
+
+use std::ops::Range;
+
+use crate::integrator::path::{
+    first_path_dimension, power_heuristic, unit_ray, FilterSampler, PathSettings, PreparedEmitter,
+    LENS_DIMENSION,
+};
+use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
+use crate::light::sampler::{LightSample, LightSampler};
+use crate::material::physical::BsdfId;
+use crate::material::plastic::RoughPlastic;
+use crate::material::surface::{prepare_rough_plastics, SurfaceBsdf};
+use crate::material::Material;
+use crate::math::{Color, Vec3};
+use crate::medium::{Medium, MediumId};
+use crate::ray::{Ray, SPAWN_EPSILON};
+use crate::sampling::sobol::{PathSampler, SobolPixel};
+use crate::scene::Scene;
+
+/// The most surfaces a shadow ray crosses before it counts as blocked (a bound on the work of
+/// one light sample through a stack of null surfaces).
+const MAX_SHADOW_CROSSINGS: u32 = 256;
+/// The most null collisions and straight-through surface crossings one path makes, beyond
+/// which it ends (it would take a medium of absurd density, or a loop of null surfaces).
+const MAX_NULL_EVENTS: u32 = 1 << 16;
+
+/// Why the volumetric path tracer cannot render a scene.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct VolPathUnsupported(pub String);
+
+/// The volumetric path tracer with its per-render preprocessing.
+#[derive(Clone, Debug)]
+pub struct VolPathIntegrator {
+    lights: LightSampler,
+    settings: PathSettings,
+    /// By material id: the physically based BSDF tree, if any, and the emitter.
+    materials: Vec<(Option<BsdfId>, PreparedEmitter)>,
+    filter: FilterSampler,
+    rough_plastics: Vec<Option<RoughPlastic>>,
+    /// Per medium, its majorant.
+    majorants: Vec<Color>,
+}
+
+/// The random numbers of one path, dimension after dimension in the order they are drawn.
+struct Dimensions<'a, S: PathSampler> {
+    sampler: &'a mut S,
+    next: u32,
+}
+
+impl<S: PathSampler> Dimensions<'_, S> {
+    #[inline]
+    fn one(&mut self) -> f32 {
+        let u = self.sampler.sample_1d(self.next);
+        self.next += 1;
+        u
+    }
+    #[inline]
+    fn two(&mut self) -> (f32, f32) {
+        let u = self.sampler.sample_2d(self.next);
+        self.next += 2;
+        u
+    }
+}
+
+/// The last real scattering event: where it was and the density its direction was drawn
+/// with (for the MIS weight of emission found there); `None` after a specular bounce or at
+/// the camera, where emission counts in full.
+#[derive(Clone, Copy)]
+struct Scattered {
+    point: Vec3,
+    pdf: f32,
+}
+
+impl VolPathIntegrator {
+    /// Prepares `scene`; every material must be physically based (the course's materials have
+    /// no null transmission or media semantics: render those with `path`).
+    pub fn new(
+        scene: &Scene,
+        settings: PathSettings,
+    ) -> Result<VolPathIntegrator, VolPathUnsupported> {
+        let mut materials = Vec::with_capacity(scene.materials.len() + 1);
+        for (id, material) in scene.materials.iter().enumerate() {
+            let physical = match material {
+                Material::Physical(bsdf) => Some(*bsdf),
+                Material::Emissive { surface, .. } => {
+                    match surface.map(|s| scene.materials.get(s as usize)) {
+                        Some(Some(Material::Physical(bsdf))) => Some(*bsdf),
+                        None => None,
+                        Some(_) => {
+                            return Err(VolPathUnsupported(format!(
+                                "material {id} is an emitter on a course material; the \
+                             volumetric path tracer renders physically based materials \
+                             (Mitsuba, glTF): render this scene with `path`"
+                            )))
+                        }
+                    }
+                }
+                _ => {
+                    return Err(VolPathUnsupported(format!(
+                        "material {id} is a course material; the volumetric path tracer \
+                         renders physically based materials (Mitsuba, glTF): render this \
+                         scene with `path`"
+                    )))
+                }
+            };
+            materials.push((physical, PreparedEmitter::new(scene, id as u32)));
+        }
+        // Ids out of range render black, as the path tracer's fallback does.
+        materials.push((None, PreparedEmitter::None));
+        Ok(VolPathIntegrator {
+            lights: LightSampler::new(scene),
+            settings,
+            materials,
+            filter: FilterSampler::new(scene.physical.defaults.filter),
+            rough_plastics: prepare_rough_plastics(
+                &scene.physical.bsdfs,
+                &scene.physical.textures,
+                &scene.textures,
+            ),
+            majorants: scene.physical.media.iter().map(Medium::majorant).collect(),
+        })
+    }
+
+    #[inline]
+    fn material(&self, id: u32) -> &(Option<BsdfId>, PreparedEmitter) {
+        let last = self.materials.len() - 1;
+        &self.materials[(id as usize).min(last)]
+    }
+
+    #[inline]
+    fn surface_bsdf(
+        &self,
+        scene: &Scene,
+        bsdf: BsdfId,
+        surface: &crate::material::surface::PhysicalSurface,
+        wo: Vec3,
+    ) -> SurfaceBsdf {
+        SurfaceBsdf::new(
+            &scene.physical.bsdfs,
+            &scene.physical.textures,
+            &self.rough_plastics,
+            &scene.textures,
+            bsdf,
+            surface,
+            wo,
+        )
+    }
+
+    /// Radiance along `ray` (unit direction) starting in `medium`, with random numbers from
+    /// `sampler` (dimensions from `first_path_dimension` on).
+    pub fn trace<S: PathSampler>(
+        &self,
+        scene: &Scene,
+        mut ray: Ray,
+        mut medium: Option<MediumId>,
+        sampler: &mut S,
+        rays: &mut u64,
+        first_hit: &mut FirstHit,
+    ) -> Color {
+        let mut dims = Dimensions {
+            sampler,
+            next: first_path_dimension(scene),
+        };
+        let settings = &self.settings;
+        let mut radiance = Color::ZERO;
+        let mut beta = Color::ONE;
+        let mut eta_scale = 1.0f32;
+        let mut depth = 0u32;
+        let mut last: Option<Scattered> = None;
+        let mut null_events = 0u32;
+        // The closest hit along `ray`, kept across null collisions (the ray's origin moves
+        // along it; the hit's distance shrinks by as much).
+        let mut pending: Option<Option<crate::accel::instances::PreliminaryHit>> = None;
+        loop {
+            let hit = match pending.take() {
+                Some(hit) => hit,
+                None => {
+                    *rays += 1;
+                    scene.intersect_preliminary(&ray)
+                }
+            };
+            let surface_t = hit.map_or(f32::INFINITY, |h| h.t);
+
+            // ---- The medium between the ray's origin and the surface.
+            if let Some(id) = medium {
+                let m = &scene.physical.media[id as usize];
+                let majorant = self.majorants[id as usize];
+                if let Some((near, far)) = m.interval(&ray) {
+                    let far = far.min(surface_t);
+                    let (collided, t) = if m.is_homogeneous() {
+                        let channel = ((dims.one() * 3.0) as usize).min(2);
+                        let sigma = majorant.to_array()[channel];
+                        let u = dims.one();
+                        let t = near - (1.0 - u).ln() / sigma;
+                        if t < far && sigma > 0.0 {
+                            // Density of this distance under each channel's σt, and their mean:
+                            // the density it was drawn with.
+                            let d = t - near;
+                            let tr = majorant.map(|s| (-s * d).exp());
+                            let pdf = tr.mul_elem(majorant);
+                            let mean = (pdf.x + pdf.y + pdf.z) / 3.0;
+                            let c = m.coefficients(ray.at(t), majorant);
+                            beta = beta.mul_elem(tr).mul_elem(c.sigma_s) / mean;
+                            (true, t)
+                        } else {
+                            let d = (far - near).max(0.0);
+                            let tr = majorant.map(|s| (-s * d).exp());
+                            let mean = (tr.x + tr.y + tr.z) / 3.0;
+                            if mean <= 0.0 {
+                                break;
+                            }
+                            beta = beta.mul_elem(tr) / mean;
+                            (false, far)
+                        }
+                    } else {
+                        // One majorant for all channels: the distance's density is the same
+                        // for each, and cancels.
+                        let sigma = majorant.x;
+                        let u = dims.one();
+                        let t = near - (1.0 - u).ln() / sigma;
+                        if t < far && sigma > 0.0 {
+                            let c = m.coefficients(ray.at(t), majorant);
+                            let ratio = c.sigma_n / sigma;
+                            let p_null = (ratio.x + ratio.y + ratio.z) / 3.0;
+                            if dims.one() < p_null {
+                                // A null collision: move on along the same ray.
+                                beta = beta.mul_elem(c.sigma_n) / (sigma * p_null);
+                                null_events += 1;
+                                if null_events > MAX_NULL_EVENTS || beta == Color::ZERO {
+                                    break;
+                                }
+                                ray.origin = ray.at(t);
+                                ray.t_min = 0.0;
+                                pending = Some(hit.map(|mut h| {
+                                    h.t -= t;
+                                    h
+                                }));
+                                continue;
+                            }
+                            beta = beta.mul_elem(c.sigma_s) / (sigma * (1.0 - p_null));
+                            (true, t)
+                        } else {
+                            (false, far)
+                        }
+                    };
+                    if collided {
+                        // ---- A real scattering event in the medium.
+                        if depth >= settings.max_depth || beta == Color::ZERO || !beta.is_finite() {
+                            break;
+                        }
+                        depth += 1;
+                        let point = ray.at(t);
+                        let forward = ray.direction;
+                        let phase = m.phase();
+                        if m.sample_emitters() {
+                            let u_light = dims.two();
+                            if let Some(sample) = self.lights.sample(scene, point, u_light) {
+                                let phase_value = phase.eval(forward, sample.direction);
+                                if phase_value > 0.0 && sample.radiance != Color::ZERO {
+                                    let tr = self.transmittance(
+                                        scene, point, &sample, medium, false, &mut dims, rays,
+                                    );
+                                    if tr != Color::ZERO {
+                                        let weight = if sample.is_delta || !sample.reachable_by_bsdf
+                                        {
+                                            1.0
+                                        } else {
+                                            power_heuristic(sample.pdf, phase_value)
+                                        };
+                                        radiance += beta.mul_elem(tr).mul_elem(sample.radiance)
+                                            * (phase_value * weight / sample.pdf);
+                                    }
+                                }
+                            }
+                        }
+                        let (direction, pdf) = phase.sample(forward, dims.two());
+                        last = m.sample_emitters().then_some(Scattered { point, pdf });
+                        ray = Ray {
+                            origin: point,
+                            direction,
+                            t_min: 0.0,
+                            t_max: f32::INFINITY,
+                        };
+                        if depth >= settings.russian_roulette_depth {
+                            let survival = ((beta * eta_scale).max_component()).min(0.95);
+                            if dims.one() >= survival {
+                                break;
+                            }
+                            beta = beta / survival;
+                        }
+                        continue;
+                    }
+                }
+            }
+
+            // ---- The surface (or the environment).
+            let Some(hit) = hit else {
+                let hidden = depth == 0 && settings.hide_emitters;
+                let background = if hidden {
+                    Color::ZERO
+                } else {
+                    scene.background_radiance(ray.direction)
+                };
+                if depth == 0 {
+                    first_hit.albedo = background.clamp01();
+                }
+                if background != Color::ZERO {
+                    let weight = match last {
+                        Some(s) => {
+                            power_heuristic(s.pdf, self.lights.pdf_environment(ray.direction))
+                        }
+                        None => 1.0,
+                    };
+                    radiance += beta.mul_elem(background) * weight;
+                }
+                break;
+            };
+            let si = scene.surface(&ray, &hit, crate::scene::SurfaceNeeds::Geometry);
+            let (physical, emitter) = *self.material(si.material);
+            if depth == 0 && settings.hide_emitters && emitter.is_some() {
+                ray = Ray::spawn(si.point, ray.direction);
+                continue;
+            }
+            let mut behind_emitter = false;
+            if emitter.is_some() {
+                let emitted = emitter.emitted(&self.lights, scene, &ray, &hit, si.normal);
+                if depth == 0 {
+                    first_hit.albedo = emitted.unwrap_or(Color::ZERO).clamp01();
+                }
+                match emitted {
+                    Some(emitted) if emitted != Color::ZERO => {
+                        let weight = match (emitter, last) {
+                            (PreparedEmitter::Light(index), Some(s)) => {
+                                let light_pdf = self
+                                    .lights
+                                    .pdf_emitter_hit(index, s.point, si.point, si.normal);
+                                power_heuristic(s.pdf, light_pdf)
+                            }
+                            _ => 1.0,
+                        };
+                        radiance += beta.mul_elem(emitted) * weight;
+                    }
+                    Some(_) => {}
+                    None => behind_emitter = true,
+                }
+            }
+            let Some(bsdf_id) = physical.filter(|_| !behind_emitter) else {
+                break;
+            };
+            let surface = scene.physical_surface(&ray, &hit);
+            let wo = -ray.direction;
+            let bsdf = self.surface_bsdf(scene, bsdf_id, &surface, wo);
+            if depth == 0 {
+                let n = surface.frame.w;
+                first_hit.normal = if n.dot(wo) < 0.0 { -n } else { n };
+                first_hit.depth = hit.t;
+                if !bsdf.is_black() {
+                    first_hit.albedo = bsdf.albedo();
+                }
+            }
+            if bsdf.is_black() {
+                break;
+            }
+            let boundary = scene.medium_boundary(&hit);
+            // Next-event estimation through whatever media and null surfaces lie between.
+            if bsdf.has_non_delta() && depth < settings.max_depth {
+                let u_light = dims.two();
+                if let Some(sample) = self.lights.sample(scene, surface.point, u_light) {
+                    let (f, scattering_pdf) = bsdf.eval_pdf(wo, sample.direction);
+                    if f != Color::ZERO && sample.radiance != Color::ZERO {
+                        let start = match boundary {
+                            Some(b) => b.target(surface.normal, sample.direction),
+                            None => medium,
+                        };
+                        let tr = self.transmittance(
+                            scene,
+                            surface.point,
+                            &sample,
+                            start,
+                            true,
+                            &mut dims,
+                            rays,
+                        );
+                        if tr != Color::ZERO {
+                            let weight = if sample.is_delta || !sample.reachable_by_bsdf {
+                                1.0
+                            } else {
+                                power_heuristic(sample.pdf, scattering_pdf)
+                            };
+                            radiance += beta.mul_elem(f).mul_elem(tr).mul_elem(sample.radiance)
+                                * (weight / sample.pdf);
+                        }
+                    }
+                }
+            }
+            let u_lobe = dims.one();
+            let u_direction = dims.two();
+            let Some((sample, null)) = bsdf.sample_event(wo, u_lobe, u_direction) else {
+                break;
+            };
+            if null {
+                null_events += 1;
+                if null_events > MAX_NULL_EVENTS {
+                    break;
+                }
+            } else {
+                if depth >= settings.max_depth {
+                    break;
+                }
+                depth += 1;
+                last = (!sample.is_specular).then_some(Scattered {
+                    point: surface.point,
+                    pdf: sample.pdf,
+                });
+            }
+            beta = beta.mul_elem(sample.weight);
+            if beta == Color::ZERO || !beta.is_finite() {
+                break;
+            }
+            eta_scale *= sample.eta * sample.eta;
+            if let Some(b) = boundary {
+                medium = b.target(surface.normal, sample.wi);
+            }
+            ray = Ray::spawn(surface.point, sample.wi);
+            if !null && depth >= settings.russian_roulette_depth {
+                let survival = ((beta * eta_scale).max_component()).min(0.95);
+                if dims.one() >= survival {
+                    break;
+                }
+                beta = beta / survival;
+            }
+        }
+        radiance
+    }
+
+    /// What reaches `point` of the light sample's radiance through the media and the
+    /// surfaces in between (which pass on their null transmission), starting in `medium`;
+    /// `from_surface`: the ray leaves a surface at `point` (and skips it).
+    #[allow(clippy::too_many_arguments)]
+    fn transmittance<S: PathSampler>(
+        &self,
+        scene: &Scene,
+        point: Vec3,
+        sample: &LightSample,
+        mut medium: Option<MediumId>,
+        from_surface: bool,
+        dims: &mut Dimensions<'_, S>,
+        rays: &mut u64,
+    ) -> Color {
+        let mut tr = Color::ONE;
+        // The light sits at `distance`; hits within the spawn offset of it are its own.
+        let end = if sample.distance.is_finite() {
+            sample.distance * (1.0 - SPAWN_EPSILON)
+        } else {
+            f32::INFINITY
+        };
+        let mut ray = Ray {
+            origin: point,
+            direction: sample.direction,
+            t_min: if from_surface { SPAWN_EPSILON } else { 0.0 },
+            t_max: end,
+        };
+        for _ in 0..MAX_SHADOW_CROSSINGS {
+            *rays += 1;
+            let hit = scene.intersect_preliminary(&ray);
+            let segment = hit.map_or(ray.t_max, |h| h.t);
+            if let Some(id) = medium {
+                tr = tr.mul_elem(self.medium_transmittance(scene, id, &ray, segment, dims));
+                if tr == Color::ZERO {
+                    return tr;
+                }
+            }
+            let Some(hit) = hit else {
+                return tr;
+            };
+            let (physical, _) = *self.material(
+                scene
+                    .surface(&ray, &hit, crate::scene::SurfaceNeeds::Geometry)
+                    .material,
+            );
+            let Some(bsdf_id) = physical else {
+                return Color::ZERO;
+            };
+            let surface = scene.physical_surface(&ray, &hit);
+            let pass = self
+                .surface_bsdf(scene, bsdf_id, &surface, -ray.direction)
+                .null_transmission(-ray.direction);
+            tr = tr.mul_elem(pass);
+            if tr == Color::ZERO {
+                return tr;
+            }
+            if let Some(b) = scene.medium_boundary(&hit) {
+                medium = b.target(surface.normal, ray.direction);
+            }
+            ray = Ray {
+                origin: surface.point,
+                direction: ray.direction,
+                t_min: SPAWN_EPSILON,
+                t_max: ray.t_max - hit.t,
+            };
+            if ray.t_max <= ray.t_min {
+                return tr;
+            }
+        }
+        Color::ZERO
+    }
+
+    /// The transmittance of medium `id` along `ray` from its origin to `until`: Beer–Lambert
+    /// for a homogeneous medium, ratio tracking (an unbiased estimate) for a heterogeneous one.
+    fn medium_transmittance<S: PathSampler>(
+        &self,
+        scene: &Scene,
+        id: MediumId,
+        ray: &Ray,
+        until: f32,
+        dims: &mut Dimensions<'_, S>,
+    ) -> Color {
+        let m = &scene.physical.media[id as usize];
+        let majorant = self.majorants[id as usize];
+        let Some((near, far)) = m.interval(ray) else {
+            return Color::ONE;
+        };
+        let far = far.min(until);
+        if far <= near {
+            return Color::ONE;
+        }
+        if m.is_homogeneous() {
+            let d = far - near;
+            return majorant.map(|s| (-s * d).exp());
+        }
+        let sigma = majorant.x;
+        if sigma <= 0.0 {
+            return Color::ONE;
+        }
+        let mut tr = Color::ONE;
+        let mut t = near;
+        for _ in 0..MAX_NULL_EVENTS {
+            t -= (1.0 - dims.one()).ln() / sigma;
+            if t >= far {
+                return tr;
+            }
+            let c = m.coefficients(ray.at(t), majorant);
+            tr = tr.mul_elem(c.sigma_n) / sigma;
+            if tr == Color::ZERO {
+                return tr;
+            }
+        }
+        Color::ZERO
+    }
+}
+
+impl Integrator for VolPathIntegrator {
+    fn pixel_samples(
+        &self,
+        scene: &Scene,
+        pixel: &PixelContext,
+        samples: Range<u32>,
+        rays: &mut u64,
+        sink: &mut impl FnMut(Sample),
+    ) {
+        let sobol = SobolPixel::new(pixel.seed, pixel.index(), pixel.samples_per_pixel);
+        for s in samples {
+            let mut sampler = sobol.sampler(s);
+            let (ox, oy) = self.filter.offset(sampler.sample_2d(0));
+            let lens = match scene.camera.lens {
+                Some(_) => sampler.sample_2d(LENS_DIMENSION),
+                None => (0.5, 0.5),
+            };
+            let ray = scene
+                .camera
+                .clipped(unit_ray(&pixel.camera_ray(scene, ox, oy, lens)));
+            let mut first_hit = FirstHit::default();
+            let radiance = self.trace(
+                scene,
+                ray,
+                scene.physical.camera_medium,
+                &mut sampler,
+                rays,
+                &mut first_hit,
+            );
+            sink(Sample {
+                radiance,
+                features: pixel.features.then_some(first_hit),
+            });
+        }
+    }
+}
