@@ -1,11 +1,11 @@
 #!/usr/bin/env python3
 """Glint against Mitsuba 3 on Mitsuba's own test scenes, side by side in one run.
 
-Each scene of ../shared/mitsuba/tests/scenes (but the media folder) is rendered at the sample
-count of Mitsuba's rule (2,000,000 / pixels) by Glint's CLI and by Mitsuba 3 in the variants
-`scalar_rgb` and `llvm_ad_rgb`, in alternating rounds; the script prints each one's median time
-(scene load and render, as each front end does it) and the ratios Mitsuba / Glint (above 1:
-Glint is faster).
+Each scene of ../shared/mitsuba/tests/scenes (`--filter participating_media`: the volume
+scenes) is rendered at the sample count of Mitsuba's rule (2,000,000 / pixels) by Glint's CLI
+and by Mitsuba 3 in the variants `scalar_rgb` and `llvm_ad_rgb`, in alternating rounds; the
+script prints each one's median time (scene load and render, as each front end does it) and
+the ratios Mitsuba / Glint (above 1: Glint is faster).
 
     python3 bench/mitsuba_suite.py --glint target/release/glint [--rounds 3] [--filter text]
 
@@ -48,7 +48,7 @@ print(json.dumps(times))
 
 def scenes(filter_text):
     for folder in sorted(SUITE.iterdir()):
-        if not folder.is_dir() or folder.name == "participating_media":
+        if not folder.is_dir():
             continue
         for scene in sorted(folder.glob("*.xml")):
             if filter_text is None or filter_text in str(scene):

@@ -20,8 +20,6 @@ use std::time::Instant;
 use glint_render::testing::mitsuba_rule::{judge, Verdict};
 use glint_render::{render, Film, IntegratorKind, RenderSettings, Scene, SceneIntegrator};
 
-/// Folders of the suite that another part of the renderer (media) has to bring.
-const EXCLUDED_FOLDERS: &[&str] = &["participating_media"];
 const SAMPLE_BUDGET: u64 = 2_000_000;
 const SEED: u64 = 0;
 
@@ -56,7 +54,7 @@ fn scenes(root: &Path, filter: Option<&str>) -> Vec<PathBuf> {
     folders.sort();
     for folder in folders {
         let name = folder.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if !folder.is_dir() || EXCLUDED_FOLDERS.contains(&name) {
+        if !folder.is_dir() || name.starts_with('.') {
             continue;
         }
         let Ok(entries) = std::fs::read_dir(&folder) else {
@@ -94,13 +92,22 @@ fn run(scene_path: &Path) -> Result<Outcome, String> {
         _ => defaults.max_depth,
     };
     let spp = (SAMPLE_BUDGET / (width as u64 * height as u64)).max(1) as u32;
+    // The integrator the scene names; `GLINT_SUITE_INTEGRATOR` renders every scene with
+    // another (`volpath` on the surface scenes shows it agrees with `path` there).
+    let integrator = match std::env::var("GLINT_SUITE_INTEGRATOR") {
+        Ok(name) => IntegratorKind::from_name(&name).ok_or(format!("no integrator {name}"))?,
+        Err(_) => match defaults.integrator {
+            Some(SceneIntegrator::VolPath) => IntegratorKind::VolPath,
+            _ => IntegratorKind::Path,
+        },
+    };
     let settings = RenderSettings {
         width,
         height,
         samples_per_pixel: spp,
         max_depth,
         seed: SEED,
-        integrator: IntegratorKind::Path,
+        integrator,
         ..RenderSettings::default()
     };
     let start = Instant::now();
