@@ -38,7 +38,7 @@ pub enum IntegratorKind {
     /// estimation with MIS, Russian roulette.
     Path,
     /// The volumetric path tracer: the path tracer with participating media between
-    /// surfaces (Mitsuba's `volpath`); physically based materials only.
+    /// surfaces (Mitsuba's `volpath`).
     VolPath,
     /// Debug view: the world-space normal of the first hit as colour, (n + 1) / 2.
     Normals,
@@ -411,8 +411,7 @@ fn render_on_current_pool(
         ),
         IntegratorKind::VolPath => {
             let integrator =
-                VolPathIntegrator::new(scene, PathSettings::for_scene(scene, settings.max_depth()))
-                    .map_err(|why| RenderError::Invalid(why.0))?;
+                VolPathIntegrator::new(scene, PathSettings::for_scene(scene, settings.max_depth()));
             render_with(scene, settings, &integrator, progress)
         }
         IntegratorKind::Normals => render_with(

@@ -28,21 +28,23 @@
 
 use std::ops::Range;
 
+use crate::accel::instances::PreliminaryHit;
 use crate::integrator::path::{
     first_path_dimension, power_heuristic, unit_ray, FilterSampler, PathSettings, PreparedEmitter,
     LENS_DIMENSION,
 };
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 use crate::light::sampler::{LightSample, LightSampler};
+use crate::material::bsdf::{Bsdf, BsdfSample};
 use crate::material::physical::BsdfId;
 use crate::material::plastic::RoughPlastic;
-use crate::material::surface::{prepare_rough_plastics, SurfaceBsdf};
+use crate::material::surface::{prepare_rough_plastics, PhysicalSurface, SurfaceBsdf};
 use crate::material::Material;
-use crate::math::{Color, Vec3};
+use crate::math::{Color, Frame, Vec3};
 use crate::medium::{Medium, MediumId};
 use crate::ray::{Ray, SPAWN_EPSILON};
 use crate::sampling::sobol::{PathSampler, SobolPixel};
-use crate::scene::Scene;
+use crate::scene::{Scene, SurfaceNeeds};
 
 /// The most surfaces a shadow ray crosses before it counts as blocked (a bound on the work of
 /// one light sample through a stack of null surfaces).
@@ -51,17 +53,13 @@ const MAX_SHADOW_CROSSINGS: u32 = 256;
 /// which it ends (it would take a medium of absurd density, or a loop of null surfaces).
 const MAX_NULL_EVENTS: u32 = 1 << 16;
 
-/// Why the volumetric path tracer cannot render a scene.
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub struct VolPathUnsupported(pub String);
-
 /// The volumetric path tracer with its per-render preprocessing.
 #[derive(Clone, Debug)]
 pub struct VolPathIntegrator {
     lights: LightSampler,
     settings: PathSettings,
-    /// By material id: the physically based BSDF tree, if any, and the emitter.
-    materials: Vec<(Option<BsdfId>, PreparedEmitter)>,
+    /// By material id, then one more entry for ids out of range.
+    materials: Vec<VolMaterial>,
     filter: FilterSampler,
     rough_plastics: Vec<Option<RoughPlastic>>,
     /// Per medium, its majorant.
@@ -98,43 +96,118 @@ struct Scattered {
     pdf: f32,
 }
 
-impl VolPathIntegrator {
-    /// Prepares `scene`; every material must be physically based (the course's materials have
-    /// no null transmission or media semantics: render those with `path`).
-    pub fn new(
-        scene: &Scene,
-        settings: PathSettings,
-    ) -> Result<VolPathIntegrator, VolPathUnsupported> {
-        let mut materials = Vec::with_capacity(scene.materials.len() + 1);
-        for (id, material) in scene.materials.iter().enumerate() {
-            let physical = match material {
-                Material::Physical(bsdf) => Some(*bsdf),
-                Material::Emissive { surface, .. } => {
-                    match surface.map(|s| scene.materials.get(s as usize)) {
-                        Some(Some(Material::Physical(bsdf))) => Some(*bsdf),
-                        None => None,
-                        Some(_) => {
-                            return Err(VolPathUnsupported(format!(
-                                "material {id} is an emitter on a course material; the \
-                             volumetric path tracer renders physically based materials \
-                             (Mitsuba, glTF): render this scene with `path`"
-                            )))
-                        }
-                    }
-                }
-                _ => {
-                    return Err(VolPathUnsupported(format!(
-                        "material {id} is a course material; the volumetric path tracer \
-                         renders physically based materials (Mitsuba, glTF): render this \
-                         scene with `path`"
-                    )))
-                }
-            };
-            materials.push((physical, PreparedEmitter::new(scene, id as u32)));
+/// What the volumetric path tracer needs of one material at a hit.
+#[derive(Clone, Copy, Debug)]
+struct VolMaterial {
+    /// The physically based BSDF tree; `None` for the course's materials, whose lobes are
+    /// built per hit (`Bsdf::from_material`).
+    physical: Option<BsdfId>,
+    emitter: PreparedEmitter,
+    /// A course dielectric's attenuation per unit distance (Beer's law inside it).
+    attenuation: Option<Color>,
+}
+
+/// The BSDF at a vertex, in world directions: a physically based tree or the course's lobes.
+// It lives on the stack for one vertex, as each kind does on its own in the path tracer.
+#[allow(clippy::large_enum_variant)]
+enum VertexBsdf {
+    Physical(SurfaceBsdf),
+    Course { bsdf: Bsdf, frame: Frame },
+}
+
+impl VertexBsdf {
+    fn is_black(&self) -> bool {
+        match self {
+            VertexBsdf::Physical(b) => b.is_black(),
+            VertexBsdf::Course { bsdf, .. } => bsdf.is_black(),
         }
-        // Ids out of range render black, as the path tracer's fallback does.
-        materials.push((None, PreparedEmitter::None));
-        Ok(VolPathIntegrator {
+    }
+
+    /// Whether light sampling can find some lobe.
+    fn has_non_delta(&self) -> bool {
+        match self {
+            VertexBsdf::Physical(b) => b.has_non_delta(),
+            VertexBsdf::Course { bsdf, .. } => bsdf.has_non_specular(),
+        }
+    }
+
+    fn albedo(&self) -> Color {
+        match self {
+            VertexBsdf::Physical(b) => b.albedo(),
+            VertexBsdf::Course { bsdf, .. } => bsdf.albedo(),
+        }
+    }
+
+    /// f·|cos θi| and the sampling density.
+    fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Color, f32) {
+        match self {
+            VertexBsdf::Physical(b) => b.eval_pdf(wo, wi),
+            VertexBsdf::Course { bsdf, frame } => {
+                let (lo, li) = (frame.to_local(wo), frame.to_local(wi));
+                let (f, pdf) = bsdf.eval_and_pdf(lo, li);
+                (f * li.z.abs(), pdf)
+            }
+        }
+    }
+
+    /// A world direction and whether it passes straight through (a null event).
+    fn sample_event(&self, wo: Vec3, u_lobe: f32, u: (f32, f32)) -> Option<(BsdfSample, bool)> {
+        match self {
+            VertexBsdf::Physical(b) => b.sample_event(wo, u_lobe, u),
+            VertexBsdf::Course { bsdf, frame } => {
+                let lo = frame.to_local(wo);
+                if lo.z == 0.0 {
+                    return None;
+                }
+                let sample = bsdf.sample(lo, u_lobe, u)?;
+                Some((
+                    BsdfSample {
+                        wi: frame.to_world(sample.wi),
+                        ..sample
+                    },
+                    false,
+                ))
+            }
+        }
+    }
+
+    /// What a shadow ray keeps crossing the surface (the course's materials: nothing).
+    fn null_transmission(&self, wo: Vec3) -> Color {
+        match self {
+            VertexBsdf::Physical(b) => b.null_transmission(wo),
+            VertexBsdf::Course { .. } => Color::ZERO,
+        }
+    }
+}
+
+impl VolPathIntegrator {
+    pub fn new(scene: &Scene, settings: PathSettings) -> VolPathIntegrator {
+        let count = scene.materials.len() as u32;
+        let materials = (0..=count)
+            .map(|id| {
+                let material = scene.materials.get(id as usize);
+                let physical = match material {
+                    Some(Material::Physical(bsdf)) => Some(*bsdf),
+                    Some(Material::Emissive {
+                        surface: Some(surface),
+                        ..
+                    }) => match scene.materials.get(*surface as usize) {
+                        Some(Material::Physical(bsdf)) => Some(*bsdf),
+                        _ => None,
+                    },
+                    _ => None,
+                };
+                VolMaterial {
+                    physical,
+                    emitter: PreparedEmitter::new(scene, id),
+                    attenuation: match material {
+                        Some(Material::Dielectric { attenuation, .. }) => Some(*attenuation),
+                        _ => None,
+                    },
+                }
+            })
+            .collect();
+        VolPathIntegrator {
             lights: LightSampler::new(scene),
             settings,
             materials,
@@ -145,32 +218,58 @@ impl VolPathIntegrator {
                 &scene.textures,
             ),
             majorants: scene.physical.media.iter().map(Medium::majorant).collect(),
-        })
+        }
     }
 
     #[inline]
-    fn material(&self, id: u32) -> &(Option<BsdfId>, PreparedEmitter) {
+    fn material(&self, id: u32) -> &VolMaterial {
         let last = self.materials.len() - 1;
         &self.materials[(id as usize).min(last)]
     }
 
-    #[inline]
-    fn surface_bsdf(
+    /// The BSDF at `hit` (material `material`) seen from world direction `wo`, with the
+    /// point, the geometric normal and the shading normal it scatters at.
+    fn vertex_bsdf(
         &self,
         scene: &Scene,
-        bsdf: BsdfId,
-        surface: &crate::material::surface::PhysicalSurface,
+        ray: &Ray,
+        hit: &PreliminaryHit,
+        material: u32,
         wo: Vec3,
-    ) -> SurfaceBsdf {
-        SurfaceBsdf::new(
-            &scene.physical.bsdfs,
-            &scene.physical.textures,
-            &self.rough_plastics,
-            &scene.textures,
-            bsdf,
-            surface,
-            wo,
-        )
+    ) -> (VertexBsdf, Vec3, Vec3, Vec3) {
+        match self.material(material).physical {
+            Some(id) => {
+                let surface: PhysicalSurface = scene.physical_surface(ray, hit);
+                let bsdf = SurfaceBsdf::new(
+                    &scene.physical.bsdfs,
+                    &scene.physical.textures,
+                    &self.rough_plastics,
+                    &scene.textures,
+                    id,
+                    &surface,
+                    wo,
+                );
+                (
+                    VertexBsdf::Physical(bsdf),
+                    surface.point,
+                    surface.normal,
+                    surface.frame.w,
+                )
+            }
+            None => {
+                let si = scene.surface(ray, hit, SurfaceNeeds::Uv);
+                let bsdf = Bsdf::from_material(&scene.materials, &scene.textures, material, si.uv);
+                (
+                    VertexBsdf::Course {
+                        bsdf,
+                        frame: Frame::from_normal(si.normal),
+                    },
+                    si.point,
+                    si.normal,
+                    si.normal,
+                )
+            }
+        }
     }
 
     /// Radiance along `ray` (unit direction) starting in `medium`, with random numbers from
@@ -197,7 +296,7 @@ impl VolPathIntegrator {
         let mut null_events = 0u32;
         // The closest hit along `ray`, kept across null collisions (the ray's origin moves
         // along it; the hit's distance shrinks by as much).
-        let mut pending: Option<Option<crate::accel::instances::PreliminaryHit>> = None;
+        let mut pending: Option<Option<PreliminaryHit>> = None;
         loop {
             let hit = match pending.take() {
                 Some(hit) => hit,
@@ -342,13 +441,13 @@ impl VolPathIntegrator {
                 }
                 break;
             };
-            let si = scene.surface(&ray, &hit, crate::scene::SurfaceNeeds::Geometry);
-            let (physical, emitter) = *self.material(si.material);
+            let si = scene.surface(&ray, &hit, SurfaceNeeds::Geometry);
+            let material = *self.material(si.material);
+            let emitter = material.emitter;
             if depth == 0 && settings.hide_emitters && emitter.is_some() {
                 ray = Ray::spawn(si.point, ray.direction);
                 continue;
             }
-            let mut behind_emitter = false;
             if emitter.is_some() {
                 let emitted = emitter.emitted(&self.lights, scene, &ray, &hit, si.normal);
                 if depth == 0 {
@@ -368,18 +467,25 @@ impl VolPathIntegrator {
                         radiance += beta.mul_elem(emitted) * weight;
                     }
                     Some(_) => {}
-                    None => behind_emitter = true,
+                    // An emitter's back emits and reflects nothing.
+                    None => break,
                 }
             }
-            let Some(bsdf_id) = physical.filter(|_| !behind_emitter) else {
-                break;
-            };
-            let surface = scene.physical_surface(&ray, &hit);
+            // Beer's law for a segment inside a course dielectric.
+            if let Some(attenuation) = material.attenuation {
+                if ray.direction.dot(si.normal) > 0.0 {
+                    beta = beta.mul_elem(attenuation.map(|a| a.max(0.0).powf(hit.t)));
+                }
+            }
             let wo = -ray.direction;
-            let bsdf = self.surface_bsdf(scene, bsdf_id, &surface, wo);
+            let (bsdf, point, normal, shading_normal) =
+                self.vertex_bsdf(scene, &ray, &hit, si.material, wo);
             if depth == 0 {
-                let n = surface.frame.w;
-                first_hit.normal = if n.dot(wo) < 0.0 { -n } else { n };
+                first_hit.normal = if shading_normal.dot(wo) < 0.0 {
+                    -shading_normal
+                } else {
+                    shading_normal
+                };
                 first_hit.depth = hit.t;
                 if !bsdf.is_black() {
                     first_hit.albedo = bsdf.albedo();
@@ -392,22 +498,15 @@ impl VolPathIntegrator {
             // Next-event estimation through whatever media and null surfaces lie between.
             if bsdf.has_non_delta() && depth < settings.max_depth {
                 let u_light = dims.two();
-                if let Some(sample) = self.lights.sample(scene, surface.point, u_light) {
+                if let Some(sample) = self.lights.sample(scene, point, u_light) {
                     let (f, scattering_pdf) = bsdf.eval_pdf(wo, sample.direction);
                     if f != Color::ZERO && sample.radiance != Color::ZERO {
                         let start = match boundary {
-                            Some(b) => b.target(surface.normal, sample.direction),
+                            Some(b) => b.target(normal, sample.direction),
                             None => medium,
                         };
-                        let tr = self.transmittance(
-                            scene,
-                            surface.point,
-                            &sample,
-                            start,
-                            true,
-                            &mut dims,
-                            rays,
-                        );
+                        let tr =
+                            self.transmittance(scene, point, &sample, start, true, &mut dims, rays);
                         if tr != Color::ZERO {
                             let weight = if sample.is_delta || !sample.reachable_by_bsdf {
                                 1.0
@@ -436,7 +535,7 @@ impl VolPathIntegrator {
                 }
                 depth += 1;
                 last = (!sample.is_specular).then_some(Scattered {
-                    point: surface.point,
+                    point,
                     pdf: sample.pdf,
                 });
             }
@@ -446,9 +545,9 @@ impl VolPathIntegrator {
             }
             eta_scale *= sample.eta * sample.eta;
             if let Some(b) = boundary {
-                medium = b.target(surface.normal, sample.wi);
+                medium = b.target(normal, sample.wi);
             }
-            ray = Ray::spawn(surface.point, sample.wi);
+            ray = Ray::spawn(point, sample.wi);
             if !null && depth >= settings.russian_roulette_depth {
                 let survival = ((beta * eta_scale).max_component()).min(0.95);
                 if dims.one() >= survival {
@@ -500,27 +599,19 @@ impl VolPathIntegrator {
             let Some(hit) = hit else {
                 return tr;
             };
-            let (physical, _) = *self.material(
-                scene
-                    .surface(&ray, &hit, crate::scene::SurfaceNeeds::Geometry)
-                    .material,
-            );
-            let Some(bsdf_id) = physical else {
-                return Color::ZERO;
-            };
-            let surface = scene.physical_surface(&ray, &hit);
-            let pass = self
-                .surface_bsdf(scene, bsdf_id, &surface, -ray.direction)
-                .null_transmission(-ray.direction);
+            let material = scene.surface(&ray, &hit, SurfaceNeeds::Geometry).material;
+            let (bsdf, crossing, normal, _) =
+                self.vertex_bsdf(scene, &ray, &hit, material, -ray.direction);
+            let pass = bsdf.null_transmission(-ray.direction);
             tr = tr.mul_elem(pass);
             if tr == Color::ZERO {
                 return tr;
             }
             if let Some(b) = scene.medium_boundary(&hit) {
-                medium = b.target(surface.normal, ray.direction);
+                medium = b.target(normal, ray.direction);
             }
             ray = Ray {
-                origin: surface.point,
+                origin: crossing,
                 direction: ray.direction,
                 t_min: SPAWN_EPSILON,
                 t_max: ray.t_max - hit.t,
