@@ -41,7 +41,7 @@ LAYERS = [
     # Numbers, rays, sample sequences and memory: depend on nothing else of the crate.
     ["math", "ray", "sampling", "pages"],
     # What a scene is made of, each on its own.
-    ["geometry", "camera", "film", "texture", "material", "light", "bvh"],
+    ["geometry", "camera", "film", "texture", "material", "medium", "light", "bvh"],
     # The ray engine: kernels, trees, walks, packets and their build.
     ["accel"],
     # The scene: geometry, its trees and what shades it.

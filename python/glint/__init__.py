@@ -61,7 +61,7 @@ Crop = tuple[slice, slice]
 RGB = tuple[float, float, float]
 
 #: The integrators :func:`render` knows, as the CLI's ``--integrator`` names them.
-INTEGRATORS = ("course", "path", "normals", "albedo", "depth")
+INTEGRATORS = ("course", "path", "volpath", "normals", "albedo", "depth")
 
 #: A red ball in front of a grey background, lit by a point light: the course's JSON as a dict.
 BALL = {

@@ -82,7 +82,7 @@ def test_the_seed_changes_the_noise_but_not_the_picture(spheres):
 @pytest.mark.parametrize(
     "kwargs, error, words",
     [
-        (dict(integrator="whitted"), ValueError, "course, path, normals, albedo, depth"),
+        (dict(integrator="whitted"), ValueError, "course, path, volpath, normals, albedo, depth"),
         (dict(spp=0), ValueError, "spp"),
         (dict(width=0), ValueError, "at least one pixel"),
         (dict(width=70000), ValueError, "at most 65535"),

@@ -162,9 +162,9 @@ pub struct Settings(RenderSettings);
 
 #[wasm_bindgen]
 impl Settings {
-    /// `integrator` is `course`, `path`, `normals`, `albedo` or `depth`; `max_depth` undefined
-    /// takes the integrator's default. `features` also computes the albedo, normal and depth
-    /// layers (what the CLI's EXR holds).
+    /// `integrator` is `course`, `path`, `volpath`, `normals`, `albedo` or `depth`;
+    /// `max_depth` undefined takes the integrator's default. `features` also computes the
+    /// albedo, normal and depth layers (what the CLI's EXR holds).
     #[wasm_bindgen(constructor)]
     pub fn new(
         width: u32,
