@@ -1233,6 +1233,94 @@ fn camera_inside_a_medium() {
     ));
 }
 
+/// A medium no surface bounds, with a channel of σt = 0: (σt, what survives an infinite path
+/// through it, exp(−σt·∞) per channel, 1 where σt = 0).
+const UNBOUNDED: [(Color, Color); 2] = [
+    (Color::new(0.0, 0.5, 1.0), Color::new(1.0, 0.0, 0.0)),
+    (Color::ZERO, Color::ONE),
+];
+
+/// A scene in an unbounded absorbing medium of `sigma_t` (the camera's), under the
+/// background, with `geometry` (a null triangle out of view if none).
+fn unbounded_scene(sigma_t: Color, floor: bool) -> (Scene, MediumId) {
+    let mut setup = Setup::new(looking_down(1.0, 1.0));
+    let id = setup.medium(absorbing(sigma_t));
+    if floor {
+        let floor = setup.material(BsdfNode::Diffuse {
+            reflectance: Param::value(FLOOR_ALBEDO),
+        });
+        setup
+            .geometries
+            .push((triangles(&square(0.0, 5.0), floor), None));
+    } else {
+        let far_away = [
+            Vec3::new(50.0, 0.0, 0.0),
+            Vec3::new(51.0, 0.0, 0.0),
+            Vec3::new(50.0, 1.0, 0.0),
+        ];
+        setup.geometries.push((triangles(&[far_away], NULL), None));
+    }
+    setup.camera_medium = Some(id);
+    setup.background = BACKGROUND;
+    (setup.build(), id)
+}
+
+/// The camera in an unbounded medium under the environment: the escaping rays keep the
+/// background's radiance in the channels of σt = 0 and lose it in the others. Negative
+/// control: the background unattenuated in every channel.
+#[test]
+fn camera_in_an_unbounded_medium() {
+    for (sigma_t, survives) in UNBOUNDED {
+        let (scene, _) = unbounded_scene(sigma_t, false);
+        let image = render_volpath(&scene, 16, 16);
+        let name = format!("camera in an unbounded medium of σt {sigma_t:?}");
+        pass(judge_image(
+            &name,
+            &image,
+            16,
+            BACKGROUND.mul_elem(survives),
+        ));
+        if survives != Color::ONE {
+            reject(judge_image(
+                &format!("{name}, unattenuated"),
+                &image,
+                16,
+                BACKGROUND,
+            ));
+        }
+    }
+}
+
+/// A diffuse floor in the same unbounded medium, lit by the environment alone: shadow rays
+/// towards it are infinitely long, so the floor is ρ L in the channels of σt = 0 (the open
+/// hemisphere's irradiance π L times ρ/π) and black in the others. Negative control: ρ L in
+/// every channel.
+#[test]
+fn environment_light_through_an_unbounded_medium() {
+    for (sigma_t, survives) in UNBOUNDED {
+        let (scene, id) = unbounded_scene(sigma_t, true);
+        let p = Vec3::new(0.3, -0.2, 0.0);
+        let eye = p + Vec3::new(0.05, -0.03, 0.4);
+        let samples = trace_samples(
+            &scene,
+            PathSettings::default(),
+            Ray::new(eye, p - eye),
+            Some(id),
+            20_000,
+        );
+        let lit = BACKGROUND * FLOOR_ALBEDO;
+        let name = format!("floor in an unbounded medium of σt {sigma_t:?}");
+        pass(judge_samples(&name, &samples, lit.mul_elem(survives)));
+        if survives != Color::ONE {
+            reject(judge_samples(
+                &format!("{name}, unattenuated"),
+                &samples,
+                lit,
+            ));
+        }
+    }
+}
+
 /// An emitting square (radiance L, facing up) at z = 0 inside an absorbing box
 /// z ∈ [−1, 1], seen from above: L·exp(−σt · 1), the emission attenuated on the way out.
 /// Negative control: the emission unattenuated.
