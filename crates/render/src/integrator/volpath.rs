@@ -53,6 +53,14 @@ const MAX_SHADOW_CROSSINGS: u32 = 256;
 /// which it ends (it would take a medium of absurd density, or a loop of null surfaces).
 const MAX_NULL_EVENTS: u32 = 1 << 16;
 
+/// exp(−σ d) per channel, 1 where σ = 0 whatever d: a ray that meets no surface in a medium
+/// that no surface bounds travels d = ∞, and −0 · ∞ is NaN, which would poison the sample
+/// (the pipeline drops it, and with it the light of the channels the medium lets through).
+#[inline]
+fn beer_lambert(sigma: Color, d: f32) -> Color {
+    sigma.map(|s| if s == 0.0 { 1.0 } else { (-s * d).exp() })
+}
+
 /// The volumetric path tracer with its per-render preprocessing.
 #[derive(Clone, Debug)]
 pub struct VolPathIntegrator {
@@ -322,7 +330,7 @@ impl VolPathIntegrator {
                             // Density of this distance under each channel's σt, and their mean:
                             // the density it was drawn with.
                             let d = t - near;
-                            let tr = majorant.map(|s| (-s * d).exp());
+                            let tr = beer_lambert(majorant, d);
                             let pdf = tr.mul_elem(majorant);
                             let mean = (pdf.x + pdf.y + pdf.z) / 3.0;
                             let c = m.coefficients(ray.at(t), majorant);
@@ -330,7 +338,7 @@ impl VolPathIntegrator {
                             (true, t)
                         } else {
                             let d = (far - near).max(0.0);
-                            let tr = majorant.map(|s| (-s * d).exp());
+                            let tr = beer_lambert(majorant, d);
                             let mean = (tr.x + tr.y + tr.z) / 3.0;
                             if mean <= 0.0 {
                                 break;
@@ -644,7 +652,7 @@ impl VolPathIntegrator {
         }
         if m.is_homogeneous() {
             let d = far - near;
-            return majorant.map(|s| (-s * d).exp());
+            return beer_lambert(majorant, d);
         }
         let sigma = majorant.x;
         if sigma <= 0.0 {

@@ -8,6 +8,7 @@ mod chi2_sampling;
 mod composite_bsdfs;
 mod depth_of_field;
 mod lecture_math;
+mod media_known_answers;
 mod mitsuba_emitters;
 mod path_known_answers;
 mod path_no_allocation;
