@@ -107,16 +107,16 @@ pub struct PathIntegrator {
 /// What the path tracer needs of one material at every hit, worked out once per render so
 /// that a hit neither matches on the material nor rebuilds its BSDF.
 #[derive(Clone, Copy, Debug)]
-struct PreparedMaterial {
+pub(crate) struct PreparedMaterial {
     /// The BSDF where no texture enters it (then it is the same at every point); `None` where
     /// one does, and the hit builds it from its texture coordinates.
-    bsdf: Option<Bsdf>,
-    emitter: PreparedEmitter,
+    pub(crate) bsdf: Option<Bsdf>,
+    pub(crate) emitter: PreparedEmitter,
     /// A dielectric's attenuation per unit distance (Beer's law for segments inside it).
-    attenuation: Option<Color>,
+    pub(crate) attenuation: Option<Color>,
     /// The physically based BSDF tree that scatters here (built per hit: `SurfaceBsdf`);
     /// `bsdf` is then unused.
-    physical: Option<BsdfId>,
+    pub(crate) physical: Option<BsdfId>,
 }
 
 /// What a material emits, as the path tracers see it at a hit.
@@ -190,7 +190,7 @@ impl PreparedEmitter {
 }
 
 impl PreparedMaterial {
-    fn new(scene: &Scene, id: MaterialId) -> PreparedMaterial {
+    pub(crate) fn new(scene: &Scene, id: MaterialId) -> PreparedMaterial {
         let material = scene.materials.get(id as usize);
         let bsdf = (!Bsdf::depends_on_uv(&scene.materials, id))
             .then(|| Bsdf::from_material(&scene.materials, &scene.textures, id, (0.0, 0.0)));

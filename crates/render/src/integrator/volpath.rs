@@ -31,15 +31,14 @@ use std::ops::Range;
 use crate::accel::instances::PreliminaryHit;
 use crate::integrator::path::{
     first_path_dimension, power_heuristic, unit_ray, FilterSampler, PathSettings, PreparedEmitter,
-    LENS_DIMENSION,
+    PreparedMaterial, LENS_DIMENSION,
 };
 use crate::integrator::{FirstHit, Integrator, PixelContext, Sample};
 use crate::light::sampler::{LightSample, LightSampler};
 use crate::material::bsdf::{Bsdf, BsdfSample};
-use crate::material::physical::BsdfId;
 use crate::material::plastic::RoughPlastic;
 use crate::material::surface::{prepare_rough_plastics, PhysicalSurface, SurfaceBsdf};
-use crate::material::Material;
+use crate::material::MaterialId;
 use crate::math::{Color, Frame, Vec3};
 use crate::medium::{Medium, MediumId};
 use crate::ray::{Ray, SPAWN_EPSILON};
@@ -67,7 +66,7 @@ pub struct VolPathIntegrator {
     lights: LightSampler,
     settings: PathSettings,
     /// By material id, then one more entry for ids out of range.
-    materials: Vec<VolMaterial>,
+    materials: Vec<PreparedMaterial>,
     filter: FilterSampler,
     rough_plastics: Vec<Option<RoughPlastic>>,
     /// Per medium, its majorant.
@@ -102,17 +101,6 @@ impl<S: PathSampler> Dimensions<'_, S> {
 struct Scattered {
     point: Vec3,
     pdf: f32,
-}
-
-/// What the volumetric path tracer needs of one material at a hit.
-#[derive(Clone, Copy, Debug)]
-struct VolMaterial {
-    /// The physically based BSDF tree; `None` for the course's materials, whose lobes are
-    /// built per hit (`Bsdf::from_material`).
-    physical: Option<BsdfId>,
-    emitter: PreparedEmitter,
-    /// A course dielectric's attenuation per unit distance (Beer's law inside it).
-    attenuation: Option<Color>,
 }
 
 /// The BSDF at a vertex, in world directions: a physically based tree or the course's lobes.
@@ -190,30 +178,9 @@ impl VertexBsdf {
 
 impl VolPathIntegrator {
     pub fn new(scene: &Scene, settings: PathSettings) -> VolPathIntegrator {
-        let count = scene.materials.len() as u32;
+        let count = scene.materials.len() as MaterialId;
         let materials = (0..=count)
-            .map(|id| {
-                let material = scene.materials.get(id as usize);
-                let physical = match material {
-                    Some(Material::Physical(bsdf)) => Some(*bsdf),
-                    Some(Material::Emissive {
-                        surface: Some(surface),
-                        ..
-                    }) => match scene.materials.get(*surface as usize) {
-                        Some(Material::Physical(bsdf)) => Some(*bsdf),
-                        _ => None,
-                    },
-                    _ => None,
-                };
-                VolMaterial {
-                    physical,
-                    emitter: PreparedEmitter::new(scene, id),
-                    attenuation: match material {
-                        Some(Material::Dielectric { attenuation, .. }) => Some(*attenuation),
-                        _ => None,
-                    },
-                }
-            })
+            .map(|id| PreparedMaterial::new(scene, id))
             .collect();
         VolPathIntegrator {
             lights: LightSampler::new(scene),
@@ -230,7 +197,7 @@ impl VolPathIntegrator {
     }
 
     #[inline]
-    fn material(&self, id: u32) -> &VolMaterial {
+    fn material(&self, id: MaterialId) -> &PreparedMaterial {
         let last = self.materials.len() - 1;
         &self.materials[(id as usize).min(last)]
     }
@@ -266,7 +233,9 @@ impl VolPathIntegrator {
             }
             None => {
                 let si = scene.surface(ray, hit, SurfaceNeeds::Uv);
-                let bsdf = Bsdf::from_material(&scene.materials, &scene.textures, material, si.uv);
+                let bsdf = self.material(material).bsdf.unwrap_or_else(|| {
+                    Bsdf::from_material(&scene.materials, &scene.textures, material, si.uv)
+                });
                 (
                     VertexBsdf::Course {
                         bsdf,
