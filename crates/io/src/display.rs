@@ -23,10 +23,11 @@ impl PngEncoding {
     /// Each integrator's PNG when the user asks for nothing else, the one rule every front end
     /// follows: the course integrator and the data views (`normals`, `depth`) keep the course's
     /// conversion, which the instructor's references depend on; the path tracer and the
-    /// `albedo` view get the default display transform (clamp, sRGB), as pbrt and Mitsuba write.
+    /// `albedo` view get the default display transform (clamp, sRGB), as pbrt and Mitsuba write;
+    /// so does the volumetric path tracer, which is the path tracer with media.
     pub fn default_for(integrator: IntegratorKind) -> PngEncoding {
         match integrator {
-            IntegratorKind::Path | IntegratorKind::Albedo => {
+            IntegratorKind::Path | IntegratorKind::VolPath | IntegratorKind::Albedo => {
                 PngEncoding::Display(DisplayTransform::default())
             }
             IntegratorKind::Course | IntegratorKind::Normals | IntegratorKind::Depth => {
