@@ -298,6 +298,46 @@ fn include_cycles_are_located_errors() {
 }
 
 #[test]
+fn includes_are_found_as_mitsuba_finds_them() {
+    // As in Mitsuba's participating_media suite: the scene includes include/base.xml, which
+    // includes "include/pre.xml": not beside base.xml but beside the scene, where Mitsuba's
+    // resolver also looks.
+    let mut assets = MemoryAssets::new();
+    assets.insert(
+        "mem/include/base.xml",
+        b"<scene version=\"3.0.0\"><include filename=\"include/pre.xml\"/>\n<integrator type=\"path\"><integer name=\"max_depth\" value=\"$depth\"/></integrator></scene>".to_vec(),
+    );
+    assets.insert(
+        "mem/include/pre.xml",
+        b"<scene version=\"3.0.0\"><default name=\"depth\" value=\"4\"/></scene>".to_vec(),
+    );
+    let text = "<scene version=\"3.0.0\"><include filename=\"include/base.xml\"/></scene>";
+    let loaded = load_scene_with_defines(
+        text,
+        Path::new("mem/scene.xml"),
+        &assets,
+        &Limits::default(),
+        &[],
+    )
+    .unwrap();
+    assert_eq!(loaded.parts.physical.defaults.max_depth, Some(3));
+    // The including file's folder comes first: a pre.xml beside base.xml wins.
+    assets.insert(
+        "mem/include/include/pre.xml",
+        b"<scene version=\"3.0.0\"><default name=\"depth\" value=\"9\"/></scene>".to_vec(),
+    );
+    let loaded = load_scene_with_defines(
+        text,
+        Path::new("mem/scene.xml"),
+        &assets,
+        &Limits::default(),
+        &[],
+    )
+    .unwrap();
+    assert_eq!(loaded.parts.physical.defaults.max_depth, Some(8));
+}
+
+#[test]
 fn the_camera_follows_mitsubas_conventions() {
     let scene = r#"<scene version="3.0.0">
         <sensor type="perspective">
