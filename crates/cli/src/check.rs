@@ -1,4 +1,5 @@
-//! `glint check`: loads scenes without rendering them and reports what is wrong with them.
+//! `glint check`: loads scenes without rendering them and reports what is wrong with them, and
+//! what of them `--device gpu` could not render.
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -7,8 +8,9 @@ use crate::failure::Failure;
 use crate::report::{located, plural};
 
 /// `glint check`: loads every scene under `limits`, prints every diagnostic (warnings as
-/// errors with `strict`) and a line per scene, and returns the exit status: 0 when every scene
-/// loads (with `strict`: without warnings), 2 otherwise.
+/// errors with `strict`), a note naming the first thing the GPU back end would refuse (the CPU
+/// renders it; the note changes no status), and a line per scene, and returns the exit
+/// status: 0 when every scene loads (with `strict`: without warnings), 2 otherwise.
 pub fn run(
     scenes: &[PathBuf],
     limits: &glint_io::Limits,
@@ -23,6 +25,9 @@ pub fn run(
                 let label = if strict { "error" } else { "warning" };
                 for warning in &loaded.warnings {
                     let _ = writeln!(err, "{label}: {}", located(warning));
+                }
+                if let Some(what) = glint_gpu::unsupported_feature(&loaded.parts) {
+                    let _ = writeln!(err, "note: --device gpu cannot render {what}");
                 }
                 let count = loaded.warnings.len();
                 let verdict = if strict && count > 0 {

@@ -458,6 +458,37 @@ fn stderr_gets_only_the_closing_line_when_it_is_not_a_terminal() {
 }
 
 #[test]
+fn check_names_what_the_gpu_cannot_render() {
+    // A Mitsuba scene with a medium: it loads (exit 0, no warning), and the note names the
+    // medium, which --device gpu refuses; the course scene gets no note.
+    let dir = scene_dir();
+    std::fs::write(
+        dir.path().join("fog.xml"),
+        r#"<scene version="3.0.0">
+  <medium type="heterogeneous" id="fog"/>
+  <integrator type="volpath"/>
+  <shape type="sphere"><ref name="interior" id="fog"/></shape>
+</scene>"#,
+    )
+    .unwrap();
+    let output = glint_in(dir.path(), &["check", "fog.xml", "scene.xml"]);
+    assert_exit(&output, 0);
+    let text = stderr(&output);
+    assert!(
+        text.contains("note: --device gpu cannot render medium 0 (heterogeneous;"),
+        "{text}"
+    );
+    assert!(text.contains("fog.xml: ok (0 warnings)"), "{text}");
+    assert_eq!(text.matches("note:").count(), 1, "{text}");
+    let output = glint_in(
+        dir.path(),
+        &["render", "fog.xml", "--device", "gpu", "-o", "fog.png"],
+    );
+    assert_exit(&output, 2);
+    assert!(stderr(&output).contains("medium 0"), "{}", stderr(&output));
+}
+
+#[test]
 fn scene_warnings_are_printed_with_their_location_before_the_render() {
     let dir = scene_dir();
     let scene = SPHERE_XML.replace("<radius>1</radius>", "<radius>1</radius> <bogus>2</bogus>");

@@ -692,6 +692,12 @@ fn bad_mitsuba_scenes() -> Vec<(&'static str, String, &'static str, &'static str
         ("zlib.xml", mitsuba_with("  <shape type=\"serialized\"><string name=\"filename\" value=\"corrupt.serialized\"/></shape>"), "serialized", "corrupt.serialized"),
         ("plugin.xml", mitsuba_with("  <shape type=\"sphere\"><bsdf type=\"difuse\"/></shape>"), "difuse", "difuse"),
         ("type.xml", mitsuba_with("  <shape type=\"sphere\"><string name=\"radius\" value=\"1\"/></shape>"), "name=\"radius\"", "radius"),
+        ("cutvol.xml", mitsuba_with("  <medium type=\"heterogeneous\" id=\"m\">\n    <volume type=\"gridvolume\" name=\"sigma_t\">\n      <string name=\"filename\" value=\"cut.vol\"/>\n    </volume>\n  </medium>"), "cut.vol", "cut.vol"),
+        ("medprop.xml", mitsuba_with("  <medium type=\"homogeneous\" id=\"m\">\n    <float name=\"sigma_s\" value=\"1\"/>\n  </medium>"), "sigma_s", "sigma_s"),
+        ("phase.xml", mitsuba_with("  <medium type=\"homogeneous\" id=\"m\">\n    <phase type=\"hg\">\n      <float name=\"g\" value=\"1.5\"/>\n    </phase>\n  </medium>"), "name=\"g\"", "(-1, 1)"),
+        ("homogrid.xml", mitsuba_with("  <medium type=\"homogeneous\" id=\"m\">\n    <volume type=\"gridvolume\" name=\"sigma_t\">\n      <string name=\"filename\" value=\"grid.vol\"/>\n    </volume>\n  </medium>"), "<volume", "homogeneous"),
+        ("voltype.xml", mitsuba_with("  <medium type=\"heterogeneous\" id=\"m\">\n    <volume type=\"voxels\" name=\"sigma_t\"/>\n  </medium>"), "voxels", "voxels"),
+        ("nomedium.xml", mitsuba_with("  <shape type=\"sphere\">\n    <ref id=\"fog\" name=\"interior\"/>\n  </shape>"), "fog", "fog"),
     ]
 }
 
@@ -709,6 +715,16 @@ fn hostile_mitsuba_scenes_are_located_errors_in_bounded_memory() {
     corrupt.extend([0xFFu8; 64]);
     corrupt.extend(0u64.to_le_bytes());
     corrupt.extend(1u32.to_le_bytes());
+    // A .vol grid of 2 × 2 × 2 samples, and the same cut short inside its data.
+    let mut grid = b"VOL\x03".to_vec();
+    for value in [1i32, 2, 2, 2, 1] {
+        grid.extend(value.to_le_bytes());
+    }
+    for value in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0] {
+        grid.extend(value.to_le_bytes());
+    }
+    grid.extend([0u8; 32]);
+    let cut = grid[..60].to_vec();
     let mut checked = 0;
     for (name, scene, needle, says) in bad_mitsuba_scenes() {
         let case = Case::new()
@@ -718,7 +734,9 @@ fn hostile_mitsuba_scenes_are_located_errors_in_bounded_memory() {
                 format!("<scene version=\"3.0.0\">\n  <include filename=\"{name}\"/>\n</scene>\n"),
             )
             .file("lying.vol", &lying)
-            .file("corrupt.serialized", &corrupt);
+            .file("corrupt.serialized", &corrupt)
+            .file("grid.vol", &grid)
+            .file("cut.vol", &cut);
         // Under a cap on address space, so that a reader that believed a header would fail
         // to allocate and abort rather than pass.
         let output = Command::new("sh")
@@ -742,5 +760,5 @@ fn hostile_mitsuba_scenes_are_located_errors_in_bounded_memory() {
         }
         checked += 1;
     }
-    assert_eq!(checked, 9);
+    assert_eq!(checked, 15);
 }

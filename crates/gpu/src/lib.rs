@@ -59,15 +59,12 @@ pub enum GpuError {
     Cancelled,
 }
 
-/// Refuses, before any device is opened, what the GPU path does not do: any integrator but
-/// the path tracer (the course integrator and the debug views run on the CPU only), and
-/// settings `RenderSettings::validate` rejects. Every scene feature of `SceneParts`
-/// (triangles, spheres, boxes, instances, every material, every light, textures, both
-/// backgrounds, both projections) is supported, and so are feature layers, crop windows and
-/// sample ranges.
-///
-/// It takes the scene too, although no scene feature is refused today, so that a feature the
-/// kernel does not cover can be refused here, by name, without changing front ends.
+/// Refuses, before any device is opened, what the GPU path does not do: a thin lens, what
+/// `unsupported_feature` names in the scene, any integrator but the path tracer (the course
+/// integrator, the volumetric path tracer and the debug views run on the CPU only), and
+/// settings `RenderSettings::validate` rejects. The course's scenes (triangles, spheres,
+/// boxes, instances, every course material and light, textures, both backgrounds, both
+/// projections) are supported, and so are feature layers, crop windows and sample ranges.
 pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<(), GpuError> {
     if parts.camera.lens.is_some() {
         return Err(GpuError::Unsupported(
@@ -87,9 +84,21 @@ pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<
 }
 
 /// The first thing in `parts` that the kernel cannot render, named as the scene names it:
-/// the physically based materials, lights and environment maps of Mitsuba scenes.
-fn unsupported_feature(parts: &SceneParts) -> Option<String> {
+/// the participating media, physically based materials, lights, environment maps and pixel
+/// filters of Mitsuba scenes. Media come first: a scene with media has physically based
+/// materials too, and the medium is what a user would move to the CPU for.
+pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
     use glint_render::{Background, BsdfNode, Light, Material};
+    if let Some(medium) = parts.physical.media.first() {
+        let kind = if medium.is_homogeneous() {
+            "homogeneous"
+        } else {
+            "heterogeneous"
+        };
+        return Some(format!(
+            "medium 0 ({kind}; the GPU kernel has no participating media)"
+        ));
+    }
     for material in &parts.materials {
         if let Material::Physical(index) = material {
             let name = match parts.physical.bsdfs.get(*index as usize) {
@@ -526,6 +535,37 @@ impl GpuRenderer {
 #[cfg(test)]
 mod tests {
     use super::layout::*;
+
+    /// A scene with a medium is refused by naming the medium, before its materials.
+    #[test]
+    fn media_are_refused_by_name() {
+        use glint_render::{
+            Background, Camera, Color, Material, Medium, PhaseFunction, Projection, SceneParts,
+            Vec3,
+        };
+        let mut parts = SceneParts {
+            camera: Camera::new(Projection::Perspective, Vec3::Z, -Vec3::Z, 1.0, 1.0),
+            materials: vec![Material::Physical(0)],
+            textures: Vec::new(),
+            lights: Vec::new(),
+            background: Background::Color(Color::ZERO),
+            geometries: Vec::new(),
+            instances: Vec::new(),
+            physical: Default::default(),
+        };
+        let before = super::unsupported_feature(&parts).expect("a physical material");
+        assert!(before.contains("material"), "{before}");
+        parts.physical.media.push(Medium::Homogeneous {
+            sigma_t: Color::ONE,
+            albedo: Color::ONE,
+            phase: PhaseFunction::Isotropic,
+            sample_emitters: true,
+        });
+        let settings = glint_render::RenderSettings::default();
+        let error = super::check_supported(&parts, &settings).expect_err("refused");
+        let message = error.to_string();
+        assert!(message.contains("medium 0 (homogeneous;"), "{message}");
+    }
 
     const KERNEL: &str = include_str!("path.wgsl");
 

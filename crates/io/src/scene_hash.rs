@@ -3,7 +3,7 @@
 
 use std::fmt::Write as _;
 
-use glint_render::{Background, Image, SceneParts, Shape};
+use glint_render::{Background, Image, Medium, SceneParts, Shape, Volume};
 use xxhash_rust::xxh3::Xxh3;
 
 /// A hex XXH3-128 of the loaded scene (after `--background`): every value the renderer is
@@ -82,6 +82,31 @@ pub fn scene_hash(parts: &SceneParts) -> String {
         /// little-endian machine the texels' own bytes, hashed where they lie (gathered 256
         /// texels at a time, as big-endian machines still do, the course's 6 M-texel reef cube
         /// map took 16 ms, serial at any thread count).
+        /// Floats' bits, little-endian, as `image` writes texels.
+        fn floats(&mut self, values: &[f32]) {
+            if cfg!(target_endian = "little") {
+                self.bytes(bytemuck::cast_slice(values));
+                return;
+            }
+            for chunk in values.chunks(1024) {
+                let bytes: Vec<u8> = chunk
+                    .iter()
+                    .flat_map(|v| v.to_bits().to_le_bytes())
+                    .collect();
+                self.bytes(&bytes);
+            }
+        }
+        /// A volume: a constant as its `Debug` text, a grid's size and placement so, and its
+        /// samples as bits.
+        fn volume(&mut self, volume: &Volume) {
+            match volume {
+                Volume::Constant { .. } => self.text("volume", volume),
+                Volume::Grid { grid, to_world, .. } => {
+                    self.text("grid", &(grid.size, grid.channels, to_world));
+                    self.floats(&grid.data);
+                }
+            }
+        }
         fn image(&mut self, image: &Image) {
             self.text("image", &(image.width, image.height, image.texels.len()));
             if cfg!(target_endian = "little") {
@@ -160,6 +185,30 @@ pub fn scene_hash(parts: &SceneParts) -> String {
                 hasher.shape(13, &[c.x, c.y, c.z]);
             }
         }
+        // Only scenes with media hash them, so that the digests of the others stand.
+        if !physical.media.is_empty()
+            || !physical.boundaries.is_empty()
+            || physical.camera_medium.is_some()
+        {
+            for medium in &physical.media {
+                match medium {
+                    Medium::Homogeneous { .. } => hasher.text("medium", medium),
+                    Medium::Heterogeneous {
+                        sigma_t,
+                        albedo,
+                        scale,
+                        phase,
+                        sample_emitters,
+                    } => {
+                        hasher.text("medium", &(scale, phase, sample_emitters));
+                        hasher.volume(sigma_t);
+                        hasher.volume(albedo);
+                    }
+                }
+            }
+            hasher.text("boundaries", &physical.boundaries);
+            hasher.text("camera_medium", &physical.camera_medium);
+        }
     }
     for geometry in &parts.geometries {
         hasher.ids("geometry", &geometry.materials, geometry.shapes.len());
@@ -216,6 +265,54 @@ mod tests {
                 casts_shadow: true,
             }],
         }
+    }
+
+    #[test]
+    fn media_change_the_hash() {
+        use glint_render::{Matrix4, MediumBoundary, PhaseFunction, Transform, VolumeGrid};
+        let grid = |sample: f32| {
+            Volume::grid(
+                VolumeGrid {
+                    size: [2, 1, 1],
+                    channels: 1,
+                    data: vec![0.5, sample],
+                },
+                Transform::from_matrix(&Matrix4::IDENTITY).unwrap(),
+            )
+        };
+        let with = |sample: f32, g: f32, interior: u32, camera: Option<u32>| {
+            let mut scene = parts(1.0, 0.5);
+            scene.physical.media = vec![
+                Medium::Homogeneous {
+                    sigma_t: Color::ONE,
+                    albedo: Color::splat(0.5),
+                    phase: PhaseFunction::HenyeyGreenstein { g },
+                    sample_emitters: true,
+                },
+                Medium::Heterogeneous {
+                    sigma_t: grid(sample),
+                    albedo: Volume::constant(
+                        Color::ONE,
+                        &Transform::from_matrix(&Matrix4::IDENTITY).unwrap(),
+                    ),
+                    scale: 2.0,
+                    phase: PhaseFunction::Isotropic,
+                    sample_emitters: true,
+                },
+            ];
+            scene.physical.boundaries = vec![Some(MediumBoundary {
+                interior: Some(interior),
+                exterior: None,
+            })];
+            scene.physical.camera_medium = camera;
+            scene_hash(&scene)
+        };
+        let base = with(1.0, 0.5, 0, None);
+        assert_eq!(base, with(1.0, 0.5, 0, None));
+        assert_ne!(base, with(1.0000001, 0.5, 0, None), "a grid sample");
+        assert_ne!(base, with(1.0, 0.6, 0, None), "a phase function");
+        assert_ne!(base, with(1.0, 0.5, 1, None), "a boundary");
+        assert_ne!(base, with(1.0, 0.5, 0, Some(1)), "the camera's medium");
     }
 
     #[test]

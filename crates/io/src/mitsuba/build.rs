@@ -1,15 +1,18 @@
 //! A parsed Mitsuba scene into `SceneParts`: the sensor into a `Camera` and the render
 //! defaults, BSDFs and textures into `PhysicalParts`, shapes into geometries placed by
-//! instances, emitters into lights and the background.
+//! instances, emitters into lights and the background; participating media in `media.rs`.
+
+mod media;
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glint_render::{
     Background, BsdfNode, Camera, Color, DistributionKind, GeometryDesc, Image, Instance, Light,
-    Material, MaterialId, Matrix4, MeshAttribute, MeshAttributes, Param, PhysicalParts,
-    PixelFilter, PrincipledParams, Projection, RenderDefaults, Roughness, SceneIntegrator,
-    SceneParts, Shape, TexelFilter, TextureKind, TextureNode, Transform, Vec3, Wrap, IDENTITY_UV,
+    Material, MaterialId, Matrix4, Medium, MediumId, MeshAttribute, MeshAttributes, Param,
+    PhysicalParts, PixelFilter, PrincipledParams, Projection, RenderDefaults, Roughness,
+    SceneIntegrator, SceneParts, Shape, TexelFilter, TextureKind, TextureNode, Transform, Vec3,
+    Volume, Wrap, IDENTITY_UV,
 };
 
 use crate::assets::{AssetError, Assets, TooLarge};
@@ -64,6 +67,13 @@ struct Builder<'a> {
     collecting: Vec<String>,
     /// Depth of nested objects being built (refs can nest BSDFs in each other).
     depth: usize,
+    /// Media built (declared at the top level or met through a reference), by element.
+    built_media: HashMap<usize, Medium>,
+    /// The `PhysicalParts::media` index of each medium a shape or the sensor uses: only those
+    /// go into the parts, so that a medium declared and never used costs nothing.
+    media: HashMap<usize, MediumId>,
+    /// Volumes built, by element (a grid file is read once however often it is referred to).
+    volumes: HashMap<usize, Volume>,
 }
 
 /// Deeper object nesting than this is refused (a wrapper of a wrapper of ...).
@@ -136,6 +146,9 @@ pub(crate) fn build(
         bsdf_attributes: HashMap::new(),
         collecting: Vec::new(),
         depth: 0,
+        built_media: HashMap::new(),
+        media: HashMap::new(),
+        volumes: HashMap::new(),
     };
     let root = &parsed.root;
     let props = Props::read(root, builder.files)?;
@@ -318,13 +331,10 @@ impl<'a> Builder<'a> {
             "emitter" => self.emitter(element),
             "bsdf" => self.bsdf(element).map(|_| ()),
             "texture" => self.texture(element).map(|_| ()),
-            "medium" | "phase" | "volume" => Err(self.element_error(
-                element,
-                format!(
-                    "participating media (<{}>) are not supported yet",
-                    element.tag
-                ),
-            )),
+            // Built now so that their mistakes are reported even when nothing uses them.
+            "medium" => self.medium(element).map(|_| ()),
+            "volume" => self.volume(element).map(|_| ()),
+            "phase" => self.phase(element).map(|_| ()),
             other => Err(self.element_error(
                 element,
                 format!("<{other}> has no meaning at the top level of a scene"),
@@ -355,10 +365,19 @@ impl<'a> Builder<'a> {
         let files = &*self.files;
         let defaults = &mut self.parts.physical.defaults;
         match props.plugin.as_str() {
-            "path" | "ptracer" => {
+            plugin @ ("path" | "ptracer" | "volpath" | "volpathmis") => {
                 let max_depth = props.integer(files, "max_depth", -1)?;
                 let rr_depth = props.integer(files, "rr_depth", 5)?;
-                defaults.integrator = Some(SceneIntegrator::Path);
+                defaults.integrator = Some(if plugin.starts_with("volpath") {
+                    SceneIntegrator::VolPath
+                } else {
+                    SceneIntegrator::Path
+                });
+                if plugin == "volpathmis" {
+                    // Spectral MIS only changes how Mitsuba's estimator weighs the channels,
+                    // not the image it converges to.
+                    props.boolean(files, "use_spectral_mis", true)?;
+                }
                 defaults.max_depth = glint_depth(max_depth, &props, files, "max_depth")?;
                 if rr_depth < 1 {
                     let p = props.get("rr_depth").expect("read above");
@@ -405,15 +424,20 @@ impl<'a> Builder<'a> {
                 return self.integrator(inner);
             }
             other => {
-                let hint = did_you_mean(other, ["path", "direct", "ptracer", "moment"]);
-                let why = if other.starts_with("volpath") || other == "prbvolpath" {
-                    " (participating media are not supported yet)"
-                } else {
-                    ""
-                };
+                let hint = did_you_mean(
+                    other,
+                    [
+                        "path",
+                        "direct",
+                        "ptracer",
+                        "moment",
+                        "volpath",
+                        "volpathmis",
+                    ],
+                );
                 return Err(self.element_error(
                     element,
-                    format!("the integrator `{other}` is not supported{why}{hint}"),
+                    format!("the integrator `{other}` is not supported{hint}"),
                 ));
             }
         }
@@ -432,18 +456,34 @@ impl<'a> Builder<'a> {
             ));
         }
         let mut film = None;
-        for p in props.unnamed() {
+        // Mitsuba's sensor takes its medium under any name, or none.
+        let mut medium = None;
+        let named_media = self.named_media(&props);
+        for p in props.unnamed().into_iter().chain(named_media) {
+            p.queried.set(true);
             let child = self.resolve(p)?;
             match child.tag.as_str() {
                 "film" => film = Some(child),
                 "sampler" => self.sampler(child)?,
+                "medium" => {
+                    if medium.is_some() {
+                        return Err(self.error(p.file, p.span, "a sensor sits in one medium only"));
+                    }
+                    medium = Some(child);
+                }
                 _ => {
                     return Err(self.element_error(
                         child,
-                        format!("a sensor takes a film and a sampler, not a <{}>", child.tag),
+                        format!(
+                            "a sensor takes a film, a sampler and a medium, not a <{}>",
+                            child.tag
+                        ),
                     ))
                 }
             }
+        }
+        if let Some(medium) = medium {
+            self.parts.physical.camera_medium = Some(self.medium_id(medium)?);
         }
         let (width, height) = match film {
             Some(film) => self.film(film)?,
@@ -1594,6 +1634,16 @@ impl<'a> Builder<'a> {
             .transform(self.files, "to_world")?
             .unwrap_or(Matrix4::IDENTITY);
         if plugin == "instance" {
+            for name in ["interior", "exterior"] {
+                if let Some(p) = props.get(name) {
+                    return Err(self.error(
+                        p.file,
+                        p.span,
+                        "an instance takes no media: Mitsuba reads those of the shapes in its \
+                         shapegroup, so give them there",
+                    ));
+                }
+            }
             let mut group = None;
             for p in props.unnamed() {
                 let child = self.resolve(p)?;
@@ -1653,9 +1703,11 @@ impl<'a> Builder<'a> {
                     emitter = Some(child);
                 }
                 "medium" => {
-                    return Err(
-                        self.element_error(child, "participating media are not supported yet")
-                    )
+                    return Err(self.error(
+                        p.file,
+                        p.span,
+                        "a shape's medium must be named `interior` or `exterior`",
+                    ))
                 }
                 other => {
                     // At the reference, where the mistake is, when it is one.
@@ -1667,15 +1719,7 @@ impl<'a> Builder<'a> {
                 }
             }
         }
-        for name in ["interior", "exterior"] {
-            if let Some(p) = props.get(name) {
-                return Err(self.error(
-                    p.file,
-                    p.span,
-                    format!("`{name}` media are not supported yet"),
-                ));
-            }
-        }
+        let boundary = self.shape_media(&props)?;
         let bsdf = match bsdf {
             Some(bsdf) => bsdf,
             None => self.default_bsdf(),
@@ -1933,6 +1977,9 @@ impl<'a> Builder<'a> {
                 .resize(attributes_index + 1, None);
         }
         self.parts.physical.attributes[attributes_index] = Some(attributes);
+        if let Some(boundary) = boundary {
+            self.set_boundary(geometry, boundary, &plugin, &to_world);
+        }
         Ok(vec![BuiltShape {
             geometry,
             transform: object_to_world,
@@ -1981,6 +2028,7 @@ impl<'a> Builder<'a> {
         surface: MaterialId,
     ) -> Result<MaterialId, SceneError> {
         let props = Props::read(element, self.files)?;
+        self.ignore_emitter_media(&props)?;
         if props.plugin != "area" {
             return Err(self.element_error(
                 element,
@@ -2089,6 +2137,7 @@ impl<'a> Builder<'a> {
 
     fn emitter(&mut self, element: &'a Element) -> Result<(), SceneError> {
         let props = Props::read(element, self.files)?;
+        self.ignore_emitter_media(&props)?;
         let plugin = props.plugin.clone();
         let to_world = props.transform(self.files, "to_world")?;
         let rigid = |builder: &Self, m: Matrix4| -> Result<Transform, SceneError> {
@@ -2245,7 +2294,6 @@ impl<'a> Builder<'a> {
     }
 }
 
-/// Mitsuba's `max_depth` (−1 unbounded) in Glint's count of scattering events.
 /// The determinant of `m`'s linear part (negative for a mirror).
 fn determinant3(m: &Matrix4) -> f64 {
     let a = &m.m;
@@ -2254,6 +2302,7 @@ fn determinant3(m: &Matrix4) -> f64 {
         + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
 }
 
+/// Mitsuba's `max_depth` (−1 unbounded) in Glint's count of scattering events.
 fn glint_depth(
     max_depth: i64,
     props: &Props,

@@ -1,7 +1,8 @@
 //! Mitsuba 3 scenes (`<scene version="...">`): the XML with its includes, defaults and
 //! references (`parse.rs`), each object's typed properties (`props.rs`), spectra as Mitsuba's
 //! RGB variants convert them (`spectrum.rs`, `tables.rs`), meshes with their attributes
-//! (`meshes.rs`), and the assembly into `SceneParts` (`build.rs`).
+//! (`meshes.rs`), and the assembly into `SceneParts` (`build.rs`, participating media in
+//! `build/media.rs`).
 
 mod build;
 mod meshes;

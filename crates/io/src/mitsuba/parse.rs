@@ -240,8 +240,21 @@ impl Parser<'_> {
                 format!("includes nested more than {MAX_INCLUDE_DEPTH} deep"),
             ));
         }
+        // Mitsuba's resolver, as its parser builds it for an include: the including file's
+        // folder, the folders of the files that include that one (innermost first), the
+        // `<path>` folders (newest first), then the scene's own folder.
         let mut candidates = vec![self.files.folder(element.file).join(name)];
+        // `stack` runs from the scene file to the including one, both named elsewhere.
+        let between = self.stack.get(1..self.stack.len().saturating_sub(1));
+        candidates.extend(
+            between
+                .unwrap_or_default()
+                .iter()
+                .rev()
+                .map(|file| file.parent().unwrap_or(Path::new("")).join(name)),
+        );
         candidates.extend(self.search_paths.iter().map(|folder| folder.join(name)));
+        candidates.push(self.files.folder(0).join(name));
         let Some(path) = candidates
             .iter()
             .find(|path| self.assets.exists(path))
