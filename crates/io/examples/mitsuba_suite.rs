@@ -20,8 +20,6 @@ use std::time::Instant;
 use glint_render::testing::mitsuba_rule::{judge, Verdict};
 use glint_render::{render, Film, IntegratorKind, RenderSettings, Scene, SceneIntegrator};
 
-/// Folders of the suite that another part of the renderer (media) has to bring.
-const EXCLUDED_FOLDERS: &[&str] = &["participating_media"];
 const SAMPLE_BUDGET: u64 = 2_000_000;
 const SEED: u64 = 0;
 
@@ -55,8 +53,7 @@ fn scenes(root: &Path, filter: Option<&str>) -> Vec<PathBuf> {
     let mut folders: Vec<_> = folders.filter_map(|e| e.ok().map(|e| e.path())).collect();
     folders.sort();
     for folder in folders {
-        let name = folder.file_name().and_then(|n| n.to_str()).unwrap_or("");
-        if !folder.is_dir() || EXCLUDED_FOLDERS.contains(&name) {
+        if !folder.is_dir() {
             continue;
         }
         let Ok(entries) = std::fs::read_dir(&folder) else {
@@ -93,6 +90,11 @@ fn run(scene_path: &Path) -> Result<Outcome, String> {
         Some(SceneIntegrator::Direct) => Some(1),
         _ => defaults.max_depth,
     };
+    // The media scenes name volpath or volpathmis; the others are surfaces only.
+    let integrator = match defaults.integrator {
+        Some(SceneIntegrator::VolPath) => IntegratorKind::VolPath,
+        _ => IntegratorKind::Path,
+    };
     let spp = (SAMPLE_BUDGET / (width as u64 * height as u64)).max(1) as u32;
     let settings = RenderSettings {
         width,
@@ -100,7 +102,7 @@ fn run(scene_path: &Path) -> Result<Outcome, String> {
         samples_per_pixel: spp,
         max_depth,
         seed: SEED,
-        integrator: IntegratorKind::Path,
+        integrator,
         ..RenderSettings::default()
     };
     let start = Instant::now();
