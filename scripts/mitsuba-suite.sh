@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Mitsuba 3's own render tests (../shared/mitsuba/tests/scenes, every folder),
+# Mitsuba 3's own render tests (../shared/mitsuba/tests/scenes, every folder, media included),
 # each scene judged by Mitsuba's rule (crates/render/src/testing/mitsuba_rule.rs): a line per
 # scene, a summary line, exit 1 when a scene fails. A failing scene leaves its render, the
 # reference and the map of rejected pixels in target/mitsuba-suite/.
