@@ -193,7 +193,9 @@ impl Leaf {
     fn is_null(&self, wo: Vec3, sample: &BsdfSample) -> bool {
         match &self.family {
             Family::Null => true,
-            Family::ThinDielectric(_) => sample.wi.dot(wo) < 0.0,
+            // Its transmission leaves on the other side; its reflection, even at grazing
+            // angles where ωi and ωo point apart, on the same one.
+            Family::ThinDielectric(_) => self.frame.w.dot(sample.wi) * self.frame.w.dot(wo) < 0.0,
             _ => false,
         }
     }

@@ -333,3 +333,45 @@ fn broken_composites_are_rejected() {
     };
     assert!(rejected("blend, value × 1.1", &bright, wo, 0.0));
 }
+
+/// `sample_event` calls a thin dielectric's transmission a null event (light passing straight
+/// on, which the volumetric path tracer does not count as a bounce) and its reflection not
+/// one, from either side and at every angle: at grazing angles the reflected ωi points away
+/// from ωo, as the transmitted one does, and only the side tells them apart. A null leaf's
+/// sample is null; a diffuse one's never.
+#[test]
+fn null_events_are_told_by_side_not_by_angle() {
+    let thin = [BsdfNode::ThinDielectric {
+        eta: 1.5,
+        specular_reflectance: Param::Constant(Color::ONE),
+        specular_transmittance: Param::Constant(Color::ONE),
+    }];
+    for theta in [10.0f32, 44.0, 46.0, 70.0, 89.0, 100.0, 150.0] {
+        let wo = direction_at(theta, 30.0);
+        let tree = Tree::new(&thin, &[], &[], wo);
+        // Mitsuba picks the reflection for u ≤ R′, which is at most 1 here, and at least 4 %.
+        let (reflected, null) = tree.bsdf.sample_event(wo, 0.0, (0.5, 0.5)).unwrap();
+        assert!(!null, "θo {theta}: a reflection was called null");
+        assert!(reflected.wi.z * wo.z > 0.0, "θo {theta}: not a reflection");
+        let (passed, null) = tree
+            .bsdf
+            .sample_event(wo, 1.0 - f32::EPSILON, (0.5, 0.5))
+            .unwrap();
+        assert!(null, "θo {theta}: the transmission was not called null");
+        assert!(
+            (passed.wi + wo).length() < 1e-6,
+            "θo {theta}: not straight on"
+        );
+    }
+    let wo = direction_at(60.0, 10.0);
+    let (_, null) = Tree::new(&[BsdfNode::Null], &[], &[], wo)
+        .bsdf
+        .sample_event(wo, 0.3, (0.2, 0.7))
+        .unwrap();
+    assert!(null, "a null leaf's sample is null");
+    let (_, null) = Tree::new(&[diffuse(Color::splat(0.5))], &[], &[], wo)
+        .bsdf
+        .sample_event(wo, 0.3, (0.2, 0.7))
+        .unwrap();
+    assert!(!null, "a diffuse sample is not null");
+}
