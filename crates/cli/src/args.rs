@@ -280,9 +280,10 @@ pub struct Options {
     pub seed: u64,
 
     /// `course`: the course's ray tracer. `path`: the physically based path tracer (exactly
-    /// RPP samples per pixel). Debug views of the first hit: `normals` ((n + 1) / 2),
-    /// `albedo`, `depth`. An .exr output also gets `albedo`, `normal` and `depth` layers.
-    /// [default: `path` for a scene that names an integrator (Mitsuba's), else `course`]
+    /// RPP samples per pixel). `volpath`: the path tracer with participating media. Debug
+    /// views of the first hit: `normals` ((n + 1) / 2), `albedo`, `depth`. An .exr output also
+    /// gets `albedo`, `normal` and `depth` layers. [default: the integrator a scene names
+    /// (Mitsuba's `path`, `volpath`, ...), else `course`]
     #[arg(long, visible_alias = "shader", value_name = "NAME", value_enum)]
     pub integrator: Option<IntegratorArg>,
 
@@ -446,6 +447,8 @@ pub enum IntegratorArg {
     // No doc comments on the variants: clap would then list them one per line.
     Course,
     Path,
+    #[value(name = "volpath")]
+    VolPath,
     Normals,
     Albedo,
     Depth,
@@ -457,6 +460,7 @@ impl From<IntegratorArg> for IntegratorKind {
             IntegratorArg::Course => IntegratorKind::Course,
             IntegratorArg::Normals => IntegratorKind::Normals,
             IntegratorArg::Path => IntegratorKind::Path,
+            IntegratorArg::VolPath => IntegratorKind::VolPath,
             IntegratorArg::Albedo => IntegratorKind::Albedo,
             IntegratorArg::Depth => IntegratorKind::Depth,
         }

@@ -598,6 +598,7 @@ mod tests {
         assert_eq!(png(&["--integrator", "depth"]), PngEncoding::Course);
         let display = PngEncoding::Display(DisplayTransform::default());
         assert_eq!(png(&["--integrator", "path"]), display);
+        assert_eq!(png(&["--integrator", "volpath"]), display);
         assert_eq!(png(&["--integrator", "albedo"]), display);
         // Any display option turns it on, for the course integrator too.
         assert_eq!(png(&["--tonemap", "none"]), display);
