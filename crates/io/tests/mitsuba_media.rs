@@ -3,6 +3,8 @@
 //! media, volumes and phase functions written inline take Mitsuba's defaults and meanings; a
 //! shape's interior and exterior are on the sides Mitsuba puts them; mistakes are located.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use glint_io::{load_scene_with_defines, Limits, MemoryAssets, SceneError};
@@ -12,18 +14,7 @@ use glint_render::{
 };
 
 fn suite() -> Option<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/mitsuba/tests/scenes/participating_media");
-    if root.is_dir() {
-        Some(root)
-    } else {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "../shared/mitsuba is missing"
-        );
-        println!("SKIPPED: ../shared/mitsuba is missing");
-        None
-    }
+    common::mitsuba_suite().map(|root| root.join("participating_media"))
 }
 
 fn load_suite(root: &Path, name: &str) -> SceneParts {

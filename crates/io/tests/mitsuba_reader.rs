@@ -3,23 +3,15 @@
 //! mistaken files get located errors. Participating media have their own file,
 //! `mitsuba_media.rs`.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 
 use glint_io::{load_scene_with_defines, Limits, MemoryAssets, SceneError};
 use glint_render::{Background, BsdfNode, Light, Material, Param, PixelFilter, SceneIntegrator};
 
 fn suite() -> Option<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/mitsuba/tests/scenes");
-    if root.is_dir() {
-        Some(root)
-    } else {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "../shared/mitsuba is missing"
-        );
-        println!("SKIPPED: ../shared/mitsuba is missing");
-        None
-    }
+    common::mitsuba_suite()
 }
 
 fn suite_scenes(root: &Path) -> Vec<PathBuf> {
@@ -298,29 +290,27 @@ fn includes_are_found_as_mitsuba_finds_them() {
         b"<scene version=\"3.0.0\"><default name=\"depth\" value=\"4\"/></scene>".to_vec(),
     );
     let text = "<scene version=\"3.0.0\"><include filename=\"include/base.xml\"/></scene>";
-    let loaded = load_scene_with_defines(
-        text,
-        Path::new("mem/scene.xml"),
-        &assets,
-        &Limits::default(),
-        &[],
-    )
-    .unwrap();
-    assert_eq!(loaded.parts.physical.defaults.max_depth, Some(3));
+    let max_depth = |assets: &MemoryAssets| {
+        load_scene_with_defines(
+            text,
+            Path::new("mem/scene.xml"),
+            assets,
+            &Limits::default(),
+            &[],
+        )
+        .unwrap()
+        .parts
+        .physical
+        .defaults
+        .max_depth
+    };
+    assert_eq!(max_depth(&assets), Some(3));
     // The including file's folder comes first: a pre.xml beside base.xml wins.
     assets.insert(
         "mem/include/include/pre.xml",
         b"<scene version=\"3.0.0\"><default name=\"depth\" value=\"9\"/></scene>".to_vec(),
     );
-    let loaded = load_scene_with_defines(
-        text,
-        Path::new("mem/scene.xml"),
-        &assets,
-        &Limits::default(),
-        &[],
-    )
-    .unwrap();
-    assert_eq!(loaded.parts.physical.defaults.max_depth, Some(8));
+    assert_eq!(max_depth(&assets), Some(8));
 }
 
 #[test]

@@ -1,4 +1,5 @@
-//! What the tests (and `examples/image_digest.rs`) that read the course corpus share.
+//! What the tests (and `examples/image_digest.rs`) that read the course corpus or Mitsuba's
+//! suite share.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
@@ -18,6 +19,21 @@ pub fn corpus() -> Option<PathBuf> {
         panic!("{message} (CI is set, so this is a failure)");
     }
     eprintln!("SKIPPED: {message}");
+    None
+}
+
+/// Mitsuba's test suite, `../shared/mitsuba/tests/scenes` beside the repository, or `None`
+/// (with a message) when it is not there; under CI its absence is a failure.
+pub fn mitsuba_suite() -> Option<PathBuf> {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/mitsuba/tests/scenes");
+    if root.is_dir() {
+        return Some(root);
+    }
+    assert!(
+        std::env::var_os("CI").is_none(),
+        "../shared/mitsuba is missing (CI is set, so this is a failure)"
+    );
+    println!("SKIPPED: ../shared/mitsuba is missing");
     None
 }
 

@@ -987,6 +987,30 @@ fn floor_expected(
         * (FLOOR_ALBEDO / std::f32::consts::PI * cos_theta / to_light.length_squared())
 }
 
+/// Floor point `p`'s samples against the slanted path to the light at `light` through the
+/// slab of `optical_depth`, and (away from the point under the light, where the two agree)
+/// rejected against the vertical path: the shadow ray must cross the slab along itself.
+fn check_floor_point(
+    label: &str,
+    samples: &[Color],
+    p: Vec3,
+    light: Vec3,
+    optical_depth: &dyn Fn(f32) -> Color,
+) {
+    pass(judge_samples(
+        label,
+        samples,
+        floor_expected(p, light, optical_depth, true),
+    ));
+    if p != Vec3::ZERO {
+        reject(judge_samples(
+            &format!("{label}, vertical path"),
+            samples,
+            floor_expected(p, light, optical_depth, false),
+        ));
+    }
+}
+
 const FLOOR_POINTS: [Vec3; 3] = [
     Vec3::new(0.0, 0.0, 0.0),
     Vec3::new(0.8, -0.5, 0.0),
@@ -1020,18 +1044,7 @@ fn shadow_rays_carry_beer_lambert_transmittance() {
         for p in FLOOR_POINTS {
             let samples = floor_samples(&scene, p, 64);
             let label = format!("{name} light through a homogeneous slab at {p:?}");
-            pass(judge_samples(
-                &label,
-                &samples,
-                floor_expected(p, light_position, &sigma, true),
-            ));
-            if p != Vec3::ZERO {
-                reject(judge_samples(
-                    &format!("{label}, vertical path"),
-                    &samples,
-                    floor_expected(p, light_position, &sigma, false),
-                ));
-            }
+            check_floor_point(&label, &samples, p, light_position, &sigma);
         }
     }
 }
@@ -1059,18 +1072,7 @@ fn shadow_rays_ratio_track_a_ramp_grid() {
     for p in FLOOR_POINTS {
         let samples = floor_samples(&scene, p, 20_000);
         let label = format!("point light through a ramp grid at {p:?}");
-        pass(judge_samples(
-            &label,
-            &samples,
-            floor_expected(p, light_position, &depth, true),
-        ));
-        if p != Vec3::ZERO {
-            reject(judge_samples(
-                &format!("{label}, vertical path"),
-                &samples,
-                floor_expected(p, light_position, &depth, false),
-            ));
-        }
+        check_floor_point(&label, &samples, p, light_position, &depth);
     }
 }
 
