@@ -155,6 +155,7 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
             BsdfNode::Mask { .. } => "mask",
             BsdfNode::Blend { .. } => "blendbsdf",
             BsdfNode::Null => "null",
+            BsdfNode::Gltf(_) => "glTF metallic-roughness",
         }
     }
     None

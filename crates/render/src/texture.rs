@@ -356,6 +356,9 @@ pub struct TextureNode {
     /// The 2 x 3 affine map applied to the surface's uv first (Mitsuba's `to_uv`), rows
     /// (a, b, c) and (d, e, f): u' = a u + b v + c, v' = d u + e v + f.
     pub to_uv: [[f32; 3]; 2],
+    /// Which texture coordinates it reads: 0 the mesh's first set (`TexturePoint::uv`), 1
+    /// its second (glTF's `TEXCOORD_1`, `TexturePoint::uv1`).
+    pub uv_set: u8,
 }
 
 /// What a `TextureNode` reads.
@@ -367,7 +370,8 @@ pub enum TextureKind {
     Bitmap {
         image: TextureId,
         filter: TexelFilter,
-        wrap: Wrap,
+        /// Along u and along v (glTF's samplers set them apart; Mitsuba's `wrap_mode` both).
+        wrap: [Wrap; 2],
     },
     /// Alternating squares of `color0` and `color1`, each 1/2 on a side in uv.
     Checkerboard { color0: Color, color1: Color },
@@ -383,16 +387,29 @@ pub const IDENTITY_UV: [[f32; 3]; 2] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0]];
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TexturePoint {
     pub uv: (f32, f32),
+    /// The second set of texture coordinates (glTF's `TEXCOORD_1`); (0, 0) where the mesh
+    /// has none.
+    pub uv1: (f32, f32),
     pub vertex_color: Color,
     pub face_color: Color,
 }
 
 impl TextureNode {
+    /// The surface's texture coordinates this node reads, before `to_uv`.
+    #[inline]
+    fn uv(&self, at: &TexturePoint) -> (f32, f32) {
+        if self.uv_set == 1 {
+            at.uv1
+        } else {
+            at.uv
+        }
+    }
+
     /// The texture's colour at `at`, reading its image from `images`; black for an image
     /// index out of range or an empty image (the loader never makes either).
     pub fn eval(&self, images: &[Image], at: &TexturePoint) -> Color {
         let [[a, b, c], [d, e, f]] = self.to_uv;
-        let (u0, v0) = at.uv;
+        let (u0, v0) = self.uv(at);
         let (u, v) = (a * u0 + b * v0 + c, d * u0 + e * v0 + f);
         match &self.kind {
             TextureKind::Bitmap {
@@ -437,7 +454,7 @@ impl TextureNode {
             return (0.0, 0.0);
         };
         let [[a, b, c], [d, e, f]] = self.to_uv;
-        let (u0, v0) = at.uv;
+        let (u0, v0) = self.uv(at);
         let (u, v) = (a * u0 + b * v0 + c, d * u0 + e * v0 + f);
         let (w, h) = (image.width, image.height);
         let limit = 1.0e9;
@@ -450,7 +467,7 @@ impl TextureNode {
         let (fx, fy) = (x - x0, y - y0);
         let (x0, y0) = (x0 as i64, y0 as i64);
         let lum = |x: i64, y: i64| {
-            let (x, y) = (wrap_texel(x, w, *wrap), wrap_texel(y, h, *wrap));
+            let (x, y) = (wrap_texel(x, w, wrap[0]), wrap_texel(y, h, wrap[1]));
             image.texels[(y as usize) * (w as usize) + x as usize].luminance()
         };
         let (f00, f10, f01, f11) = (
@@ -519,7 +536,7 @@ fn wrap_texel(x: i64, size: u32, wrap: Wrap) -> u32 {
 
 /// A bitmap at (u, v): texel (floor(u·w), floor(v·h)) for `Nearest`; for `Bilinear` the
 /// four texels around (u·w − 1/2, v·h − 1/2), whose centres sit at half-integers.
-fn bitmap_lookup(image: &Image, filter: TexelFilter, wrap: Wrap, u: f32, v: f32) -> Color {
+fn bitmap_lookup(image: &Image, filter: TexelFilter, wrap: [Wrap; 2], u: f32, v: f32) -> Color {
     let (w, h) = (image.width, image.height);
     // Far outside [0, 1] only the wrap matters; the clamp keeps the casts defined.
     let limit = 1.0e9;
@@ -531,7 +548,7 @@ fn bitmap_lookup(image: &Image, filter: TexelFilter, wrap: Wrap, u: f32, v: f32)
         return Color::ZERO;
     }
     let texel = |x: i64, y: i64| {
-        let (x, y) = (wrap_texel(x, w, wrap), wrap_texel(y, h, wrap));
+        let (x, y) = (wrap_texel(x, w, wrap[0]), wrap_texel(y, h, wrap[1]));
         image.texels[(y as usize) * (w as usize) + x as usize]
     };
     match filter {
@@ -569,9 +586,10 @@ mod mitsuba_texture_tests {
             kind: TextureKind::Bitmap {
                 image: 0,
                 filter,
-                wrap,
+                wrap: [wrap; 2],
             },
             to_uv: IDENTITY_UV,
+            uv_set: 0,
         }
     }
 
@@ -639,6 +657,7 @@ mod mitsuba_texture_tests {
                 color1: Color::splat(0.2),
             },
             to_uv: [[2.0, 0.0, 0.0], [0.0, 2.0, 0.0]],
+            uv_set: 0,
         };
         // uv (0.1, 0.1) → (0.2, 0.2): both halves lower → colour 0.
         assert_eq!(node.eval(&[], &at(0.1, 0.1)).x, 0.4);
@@ -656,13 +675,16 @@ mod mitsuba_texture_tests {
         let vertex = TextureNode {
             kind: TextureKind::MeshAttribute(MeshAttribute::VertexColor),
             to_uv: IDENTITY_UV,
+            uv_set: 0,
         };
         let face = TextureNode {
             kind: TextureKind::MeshAttribute(MeshAttribute::FaceColor),
             to_uv: IDENTITY_UV,
+            uv_set: 0,
         };
         let point = TexturePoint {
             uv: (0.0, 0.0),
+            uv1: (0.0, 0.0),
             vertex_color: Color::new(0.1, 0.2, 0.3),
             face_color: Color::new(0.4, 0.5, 0.6),
         };

@@ -1010,7 +1010,7 @@ impl<'a> Builder<'a> {
                 TextureKind::Bitmap {
                     image,
                     filter,
-                    wrap,
+                    wrap: [wrap; 2],
                 }
             }
             "checkerboard" => {
@@ -1094,10 +1094,11 @@ impl<'a> Builder<'a> {
             }
         };
         props.check_all_used(self.files)?;
-        self.parts
-            .physical
-            .textures
-            .push(TextureNode { kind, to_uv });
+        self.parts.physical.textures.push(TextureNode {
+            kind,
+            to_uv,
+            uv_set: 0,
+        });
         let index = (self.parts.physical.textures.len() - 1) as u32;
         self.textures.insert(element.index, index);
         if let Some(name) = pending_attribute {
@@ -2225,6 +2226,7 @@ impl<'a> Builder<'a> {
                                 color1: c,
                             },
                             to_uv: IDENTITY_UV,
+                            uv_set: 0,
                         });
                         (self.parts.physical.textures.len() - 1) as u32
                     }

@@ -5,6 +5,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+pub mod gltf;
 pub mod microfacet;
 pub mod physical;
 pub mod plastic;

@@ -131,6 +131,109 @@ pub enum BsdfNode {
     },
     /// `null`: the surface does not scatter; light passes straight on.
     Null,
+    /// glTF 2.0's metallic-roughness material with the KHR extensions Glint reads
+    /// (`material::gltf`).
+    Gltf(Box<GltfParams>),
+}
+
+/// How a glTF material's alpha is used (`alphaMode`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum GltfAlphaMode {
+    /// Alpha is ignored.
+    Opaque,
+    /// A cutout: opaque where alpha ≥ `cutoff`, absent elsewhere.
+    Mask { cutoff: f32 },
+    /// Alpha is the probability that a ray meets the surface (stochastic transparency).
+    Blend,
+}
+
+/// A glTF material as the file gives it. Each `*_texture` is a `TextureNode` index
+/// (`PhysicalParts::textures`) whose node already carries the texture's uv set, sampler and
+/// `KHR_texture_transform`; colour textures hold linear values (decoded from sRGB), data
+/// textures raw ones. The value at a point is the factor times the texture's channel named
+/// beside it.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GltfParams {
+    /// `baseColorFactor` (RGB), times `baseColorTexture`'s RGB, times `COLOR_0` when
+    /// `vertex_color`.
+    pub base_color: Color,
+    pub base_color_texture: Option<u32>,
+    pub vertex_color: bool,
+    /// `baseColorFactor`'s alpha, times `alpha_texture` (a grey image of the base colour
+    /// texture's alpha channel, made by the loader where the alpha mode reads it).
+    pub alpha: f32,
+    pub alpha_texture: Option<u32>,
+    pub alpha_mode: GltfAlphaMode,
+    /// `metallicFactor` times the texture's blue channel; `roughnessFactor` times its green.
+    pub metallic: f32,
+    pub roughness: f32,
+    pub metallic_roughness_texture: Option<u32>,
+    /// A tangent-space normal map (raw), its x and y scaled by `normal_scale`.
+    pub normal_texture: Option<u32>,
+    pub normal_scale: f32,
+    /// `KHR_materials_ior` (1.5 without it).
+    pub ior: f32,
+    /// `KHR_materials_specular`: `specularFactor` times `specular_texture`'s alpha (a grey
+    /// image made by the loader), `specularColorFactor` times `specular_color_texture`'s RGB.
+    pub specular: f32,
+    pub specular_texture: Option<u32>,
+    pub specular_color: Color,
+    pub specular_color_texture: Option<u32>,
+    /// `KHR_materials_transmission`: factor times the texture's red channel.
+    pub transmission: f32,
+    pub transmission_texture: Option<u32>,
+    /// No `KHR_materials_volume` (or a zero thickness): the surface is an infinitely thin
+    /// wall, and transmitted light leaves it unrefracted. Otherwise the mesh bounds a
+    /// volume (its attenuation is a medium of `PhysicalParts::media`).
+    pub thin_walled: bool,
+    /// `KHR_materials_clearcoat`: factor times the texture's red channel; roughness factor
+    /// times its texture's green channel.
+    pub clearcoat: f32,
+    pub clearcoat_texture: Option<u32>,
+    pub clearcoat_roughness: f32,
+    pub clearcoat_roughness_texture: Option<u32>,
+    /// `doubleSided`: the back face is shaded as the front with its normal reversed;
+    /// otherwise it is culled (rays pass through it), but where the mesh bounds a volume.
+    pub double_sided: bool,
+}
+
+impl GltfParams {
+    /// Whether some light may pass through the surface by transmission.
+    pub fn has_transmission(&self) -> bool {
+        self.transmission > 0.0
+    }
+}
+
+impl Default for GltfParams {
+    /// The specification's default material.
+    fn default() -> Self {
+        GltfParams {
+            base_color: Color::ONE,
+            base_color_texture: None,
+            vertex_color: false,
+            alpha: 1.0,
+            alpha_texture: None,
+            alpha_mode: GltfAlphaMode::Opaque,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            ior: 1.5,
+            specular: 1.0,
+            specular_texture: None,
+            specular_color: Color::ONE,
+            specular_color_texture: None,
+            transmission: 0.0,
+            transmission_texture: None,
+            thin_walled: true,
+            clearcoat: 0.0,
+            clearcoat_texture: None,
+            clearcoat_roughness: 0.0,
+            clearcoat_roughness_texture: None,
+            double_sided: false,
+        }
+    }
 }
 
 /// Parameters of `principled` and `principledthin` as the scene gives them (Mitsuba's

@@ -20,8 +20,11 @@ use crate::material::bsdf::BsdfSample;
 use crate::material::conductor::{Conductor, RoughConductor};
 use crate::material::dielectric::{Dielectric, RoughDielectric, ThinDielectric};
 use crate::material::diffuse::Diffuse;
+use crate::material::gltf::GltfPbr;
 use crate::material::microfacet::{Distribution, Microfacet};
-use crate::material::physical::{BsdfId, BsdfNode, DistributionKind, Param, Roughness};
+use crate::material::physical::{
+    BsdfId, BsdfNode, DistributionKind, GltfAlphaMode, GltfParams, Param, Roughness,
+};
 use crate::material::plastic::{specular_sampling_weight, Plastic, RoughPlastic};
 use crate::material::principled::{Principled, PrincipledThin};
 use crate::material::scatter::Scatter;
@@ -43,6 +46,9 @@ pub struct PhysicalSurface {
     pub dp_dv: Vec3,
     /// What textures read here.
     pub texture: TexturePoint,
+    /// The sign of the bitangent relative to `frame.v` (glTF's tangent `w`): a tangent-space
+    /// normal map's y is read along `bitangent_sign · frame.v`. 1 without tangents.
+    pub bitangent_sign: f32,
 }
 
 impl PhysicalSurface {
@@ -86,6 +92,7 @@ pub enum Family {
     RoughPlastic(RoughPlastic),
     Principled(Principled),
     PrincipledThin(PrincipledThin),
+    Gltf(GltfPbr),
     /// Light passes straight on (a mask's transparent part, `null`).
     Null,
 }
@@ -103,6 +110,7 @@ macro_rules! each_family {
             Family::RoughPlastic($f) => $body,
             Family::Principled($f) => $body,
             Family::PrincipledThin($f) => $body,
+            Family::Gltf($f) => $body,
             Family::Null => $null,
         }
     };
@@ -433,6 +441,129 @@ impl Resolver<'_> {
         p.eval(self.textures, self.images, &self.surface.texture)
     }
 
+    /// A texture's value at the hit; `None` reads as white.
+    fn texel(&self, texture: Option<u32>) -> Color {
+        texture.map_or(Color::ONE, |i| {
+            self.textures.get(i as usize).map_or(Color::ZERO, |node| {
+                node.eval(self.images, &self.surface.texture)
+            })
+        })
+    }
+
+    /// A glTF material: its alpha (a null leaf for the part light passes), its sides, its
+    /// normal map, then the family with every factor times its texture.
+    fn add_gltf(
+        &self,
+        bsdf: &mut SurfaceBsdf,
+        p: &GltfParams,
+        weight: f32,
+        mut frame: Frame,
+        tilt: Option<Tilt>,
+    ) {
+        let opacity = match p.alpha_mode {
+            GltfAlphaMode::Opaque => 1.0,
+            mode => {
+                let alpha = (p.alpha * self.texel(p.alpha_texture).x).clamp(0.0, 1.0);
+                match mode {
+                    GltfAlphaMode::Mask { cutoff } => f32::from(alpha >= cutoff),
+                    _ => alpha,
+                }
+            }
+        };
+        let pass = |bsdf: &mut SurfaceBsdf, share: f32| {
+            self.push(
+                bsdf,
+                Leaf {
+                    family: Family::Null,
+                    weight: weight * share,
+                    frame,
+                    tilt,
+                },
+            )
+        };
+        pass(bsdf, 1.0 - opacity);
+        let weight = weight * opacity;
+        if weight <= 0.0 {
+            return;
+        }
+        let mut sign = self.surface.bitangent_sign;
+        if frame.to_local(self.wo).z < 0.0 {
+            if p.double_sided || (p.thin_walled && p.has_transmission()) {
+                // The back face is the front with its normal reversed.
+                frame.w = -frame.w;
+                sign = -sign;
+            } else if p.thin_walled {
+                // Culled: light passes the back face as if it were not there.
+                pass(bsdf, opacity);
+                return;
+            }
+            // A volume's boundary seen from inside: the family refracts out.
+        }
+        let mut tilt = tilt;
+        if let Some(texture) = p.normal_texture {
+            let t = self.texel(Some(texture)) * 2.0 - Color::ONE;
+            let mut n = Vec3::new(t.x * p.normal_scale, t.y * p.normal_scale * sign, t.z);
+            if frame.w.dot(self.surface.frame.w) < 0.0 {
+                // The reversed back face: reversing the perturbed normal negates its
+                // tangential part in the flipped frame.
+                n = Vec3::new(-n.x, -n.y, n.z);
+            }
+            let wo_local = frame.to_local(self.wo);
+            if wo_local.z * wo_local.dot(n) <= 0.0 {
+                n = Vec3::new(-n.x, -n.y, n.z);
+            }
+            let n = n.normalized();
+            if n.is_finite() && n.z > 0.0 {
+                let s = (Vec3::X - n * n.x).normalized();
+                let local = Frame {
+                    u: s,
+                    v: n.cross(s),
+                    w: n,
+                };
+                tilt = Some(Tilt {
+                    parent: frame,
+                    normal: n,
+                });
+                frame = Frame {
+                    u: frame.to_world(local.u),
+                    v: frame.to_world(local.v),
+                    w: frame.to_world(local.w),
+                };
+            }
+        }
+        let mut base_color = p.base_color.mul_elem(self.texel(p.base_color_texture));
+        if p.vertex_color {
+            base_color = base_color.mul_elem(self.surface.texture.vertex_color);
+        }
+        let mr = self.texel(p.metallic_roughness_texture);
+        let family = Family::Gltf(GltfPbr {
+            base_color: base_color.clamp01(),
+            metallic: (p.metallic * mr.z).clamp(0.0, 1.0),
+            roughness: (p.roughness * mr.y).clamp(0.0, 1.0),
+            ior: p.ior,
+            specular: (p.specular * self.texel(p.specular_texture).x).clamp(0.0, 1.0),
+            specular_color: (p
+                .specular_color
+                .mul_elem(self.texel(p.specular_color_texture)))
+            .max(Color::ZERO),
+            transmission: (p.transmission * self.texel(p.transmission_texture).x).clamp(0.0, 1.0),
+            thin_walled: p.thin_walled,
+            clearcoat: (p.clearcoat * self.texel(p.clearcoat_texture).x).clamp(0.0, 1.0),
+            clearcoat_roughness: (p.clearcoat_roughness
+                * self.texel(p.clearcoat_roughness_texture).y)
+                .clamp(0.0, 1.0),
+        });
+        self.push(
+            bsdf,
+            Leaf {
+                family,
+                weight,
+                frame,
+                tilt,
+            },
+        );
+    }
+
     fn microfacet(&self, r: &Roughness) -> Microfacet {
         let distribution = match r.distribution {
             DistributionKind::Beckmann => Distribution::Beckmann,
@@ -624,6 +755,7 @@ impl Resolver<'_> {
                 self.push(bsdf, leaf(family));
             }
             BsdfNode::Null => self.push(bsdf, leaf(Family::Null)),
+            BsdfNode::Gltf(p) => self.add_gltf(bsdf, p, weight, frame, tilt),
             BsdfNode::TwoSided { front, back } => {
                 if frame.to_local(self.wo).z >= 0.0 {
                     self.add(bsdf, *front, weight, frame, tilt, depth + 1);

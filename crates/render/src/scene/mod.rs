@@ -363,6 +363,7 @@ impl Scene {
             .and_then(Option::as_ref);
         let shape = geom.shape(prelim.primitive);
         let mut texture = TexturePoint::default();
+        let mut bitangent_sign = 1.0;
         // Object-space derivatives and shading normal; None: the geometric normal.
         let (dp_du, dp_dv, shading) = match shape {
             Shape::Triangle {
@@ -411,6 +412,26 @@ impl Scene {
                         .and_then(|c| c.get(source))
                         .copied()
                         .unwrap_or(Color::ZERO);
+                }
+                if let Some([t0, t1, t2]) = attributes
+                    .and_then(|a| a.uvs1.as_ref())
+                    .and_then(|uvs| uvs.get(source))
+                {
+                    texture.uv1 = (
+                        t0.0 * b0 + t1.0 * b1 + t2.0 * b2,
+                        t0.1 * b0 + t1.1 * b1 + t2.1 * b2,
+                    );
+                }
+                if let Some(t) = attributes
+                    .and_then(|a| a.tangents.as_ref())
+                    .and_then(|t| t.get(source))
+                {
+                    let at = |i: usize| Vec3::new(t[i][0], t[i][1], t[i][2]);
+                    let tangent = at(0) * b0 + at(1) * b1 + at(2) * b2;
+                    if tangent.is_finite() && tangent != Vec3::ZERO {
+                        derivatives.0 = tangent;
+                        bitangent_sign = if t[0][3] < 0.0 { -1.0 } else { 1.0 };
+                    }
                 }
                 let shading = corner(attributes.and_then(|a| a.normals.as_ref()));
                 (derivatives.0, derivatives.1, shading)
@@ -464,6 +485,7 @@ impl Scene {
             dp_du,
             dp_dv,
             texture,
+            bitangent_sign,
         }
     }
 

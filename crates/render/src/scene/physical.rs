@@ -38,6 +38,12 @@ pub struct MeshAttributes {
     pub normals: Option<Vec<[Vec3; 3]>>,
     /// Texture coordinates at the corners; without them uv are the barycentrics.
     pub uvs: Option<Vec<[(f32, f32); 3]>>,
+    /// A second set of texture coordinates (glTF's `TEXCOORD_1`).
+    pub uvs1: Option<Vec<[(f32, f32); 3]>>,
+    /// Tangents at the corners (object space) with the bitangent's sign in the fourth
+    /// component, as glTF's `TANGENT` (or MikkTSpace's) gives them: the shading frame's `u`
+    /// follows the interpolated tangent instead of ∂p/∂u.
+    pub tangents: Option<Vec<[[f32; 4]; 3]>>,
     /// `vertex_color` at the corners.
     pub vertex_colors: Option<Vec<[Color; 3]>>,
     /// `face_color` per triangle.

@@ -44,6 +44,7 @@ impl Tree {
                 uv: (0.3, 0.4),
                 ..TexturePoint::default()
             },
+            bitangent_sign: 1.0,
         };
         let prepared = prepare_rough_plastics(bsdfs, textures, images);
         // The root is the last node, its children before it.
@@ -117,6 +118,7 @@ fn constant_texture(c: Color) -> TextureNode {
             color1: c,
         },
         to_uv: IDENTITY_UV,
+        uv_set: 0,
     }
 }
 
@@ -134,9 +136,10 @@ fn ramp() -> (TextureNode, Image) {
             kind: TextureKind::Bitmap {
                 image: 0,
                 filter: TexelFilter::Bilinear,
-                wrap: Wrap::Clamp,
+                wrap: [Wrap::Clamp; 2],
             },
             to_uv: IDENTITY_UV,
+            uv_set: 0,
         },
         Image {
             width: w,

@@ -551,9 +551,10 @@ fn quadrant_texture() -> (PhysicalParts, Vec<Image>) {
             kind: TextureKind::Bitmap {
                 image: 0,
                 filter: TexelFilter::Nearest,
-                wrap: Wrap::Repeat,
+                wrap: [Wrap::Repeat; 2],
             },
             to_uv: IDENTITY_UV,
+            uv_set: 0,
         }],
         ..PhysicalParts::default()
     };
@@ -631,6 +632,7 @@ fn projector_irradiance_and_frustum() {
             color1: Color::new(0.5, 1.0, 2.0),
         },
         to_uv: IDENTITY_UV,
+        uv_set: 0,
     });
     let scale = 3.0;
     let fov = 60.0f32;
@@ -701,9 +703,10 @@ fn projector_frustum_follows_the_texture_aspect() {
             kind: TextureKind::Bitmap {
                 image: 0,
                 filter: TexelFilter::Bilinear,
-                wrap: Wrap::Clamp,
+                wrap: [Wrap::Clamp; 2],
             },
             to_uv: IDENTITY_UV,
+            uv_set: 0,
         }],
         ..PhysicalParts::default()
     };
