@@ -207,9 +207,16 @@ impl<'a, 't> Builder<'a, 't> {
             );
         }
         if self.document.skins().len() > 0 {
-            self.warn("skins", "skins are ignored: skinned meshes render in their bind pose");
+            self.warn(
+                "skins",
+                "skins are ignored: skinned meshes render in their bind pose",
+            );
         }
-        if self.document.meshes().any(|m| m.primitives().any(|p| p.morph_targets().len() > 0)) {
+        if self
+            .document
+            .meshes()
+            .any(|m| m.primitives().any(|p| p.morph_targets().len() > 0))
+        {
             self.warn(
                 "meshes",
                 "morph targets are ignored: meshes render with their base shape",
