@@ -628,7 +628,8 @@ impl Scatter for GltfPbr {
         diffuse || specular || coat
     }
 
+    /// The base colour in [0, 1] (a NaN channel reads 0).
     fn albedo(&self) -> Color {
-        self.base_color.clamp01()
+        self.base_color.map(unit)
     }
 }
