@@ -1,34 +1,30 @@
 //! glTF 2.0's metallic-roughness material (the specification's Appendix B) with
 //! `KHR_materials_ior`, `_specular`, `_transmission`, `_volume` and `_clearcoat`.
 //!
-//! material = mix(dielectric, metal, metallic), coated by the clearcoat:
-//! - metal: Schlick's Fresnel (f0 = base colour, f90 = 1, on |ωo·h|) times the specular BRDF
-//!   D · V, GGX's D with α = roughness² and the height-correlated Smith visibility V;
-//! - dielectric: the same BRDF weighted by Schlick's Fresnel with f0 = min(((ior − 1)/(ior + 1))²
-//!   · specular_color, 1) · specular and f90 = specular, over a base that is a Lambertian
-//!   (share 1 − transmission) and a GGX transmission tinted by the base colour (share
-//!   transmission): mirrored through the surface for a thin wall, refracted by `ior` (Walter
-//!   et al.'s BTDF, separable Smith G as the extension writes it) for a volume's boundary;
-//! - clearcoat: a GGX layer (α = clearcoat_roughness², f0 0.04) weighted by clearcoat ·
-//!   F_c(cos θo) over the rest, weighted by 1 − clearcoat · F_c(cos θo) (the extension's
-//!   `fresnel_coat` on the shading normal).
+//! material = mix(dielectric, metal, metallic) under the clearcoat:
+//! - metal: Schlick's F (f0 = base colour, f90 = 1, on |ωo·h|) times GGX's D (α = roughness²)
+//!   times the height-correlated Smith visibility V;
+//! - dielectric: the same D · V weighted by Schlick's F with f0 = min(((ior − 1)/(ior + 1))²
+//!   · specular_color, 1) · specular and f90 = specular, over a base weighted by 1 − max F:
+//!   a Lambertian (share 1 − transmission) and GGX transmission tinted by the base colour,
+//!   with F at the transmission's own micro-normal: mirrored through the surface for a thin
+//!   wall, refracted by `ior` (Walter et al.'s BTDF for radiance, `_volume`'s Schlick cases
+//!   and total internal reflection) for a volume; transmission uses the extension's
+//!   separable Smith G;
+//! - clearcoat: D · V with α = clearcoat_roughness², weighted by clearcoat · F_c(cos θo)
+//!   (f0 0.04), the rest by 1 − clearcoat · F_c(cos θo) (`fresnel_coat` on the normal).
 //!
-//! Two choices differ from Appendix B's informative formulas, for energy conservation, which
-//! the specification requires of a physically accurate simulation:
-//! - the Lambertian is weighted by (1 − max F(cos θo)) (1 − max F(cos θi)), not by
-//!   1 − max F(|ωo·h|): with the half vector of the pair, a white dielectric reflects up to
-//!   1.8 at grazing angles (the specification's discussion says the coupling is not energy
-//!   conserving and names this product as the conserving alternative); the product is
-//!   reciprocal too;
-//! - the transmission is weighted by 1 − max F(|ωo·m|) of its own micro-normal m, so that
-//!   reflection and transmission split each facet's light as an interface does.
+//! One deliberate departure, for energy conservation (which the specification asks of a
+//! physically accurate simulation): the Lambertian is weighted by (1 − max F(cos θo))
+//! (1 − max F(cos θi)), not by 1 − max F(|ωo·h|) of the pair's half vector, with which a
+//! white smooth dielectric reflects 1.2 at 75° and 1.85 at 89°. Appendix B's discussion
+//! names this product as the conserving coupling; it is reciprocal too.
 //!
-//! Conventions are `Scatter`'s. An opaque configuration is one-sided; thin-walled
-//! transmission needs ωo above (the resolver turns the frame); a volume's boundary scatters
-//! from both sides, the interior (index `ior`) below: from inside only its transmissive part
-//! (weight (1 − metallic) · transmission) is seen, reflecting F and refracting out, and the
-//! clearcoat, which lies outside, dims light that leaves. A volume of `ior` 1 transmits
-//! like a thin wall (nothing bends light). Lobes with α under `DELTA_ALPHA` are Dirac deltas.
+//! Conventions are `Scatter`'s. Opaque configurations are one-sided; thin-walled transmission
+//! needs ωo above (the resolver turns the frame); a volume's boundary (interior below) is
+//! seen from both sides, from inside only its transmissive share (1 − metallic) ·
+//! transmission, reflecting F and refracting out through the clearcoat. A volume of `ior` 1
+//! transmits like a thin wall. Lobes with α under `DELTA_ALPHA` are Dirac deltas.
 
 use crate::material::bsdf::BsdfSample;
 use crate::material::fresnel::{fresnel, reflect_about, refract, refract_about};
