@@ -10,9 +10,11 @@
 //!    random configurations, reciprocity of reflection, sidedness, which configurations have
 //!    a continuous part, and no NaN for any input.
 //! 3. Furnaces: white configurations keep at most the energy they receive, by sampling and
-//!    by quadrature alike; a smooth white metal reflects exactly 1, a black dielectric without
-//!    specular 0, smooth white thin and volume glass R + T = 1; the single-scattering GGX
-//!    loss at roughness 1 gives 1 − ln 2 at normal incidence.
+//!    by quadrature alike, but where a Lambertian base sits under Appendix B's half-vector
+//!    coupling, which gains energy obliquely (its figures are pinned down by a test of their
+//!    own); a smooth white metal reflects exactly 1, a black dielectric without specular 0,
+//!    smooth white thin and volume glass R + T = 1; the single-scattering GGX loss at
+//!    roughness 1 gives 1 − ln 2 at normal incidence.
 //! 4. Known answers: the BSDF's value at chosen directions computed in f64 from the
 //!    specification's formulas, written here again (Schlick, GGX's D, the height-correlated
 //!    visibility, Walter's BTDF), not by calling the code under test.
@@ -21,9 +23,9 @@
 //!    separable masking fail the known answers; the clearcoat (the extension weighs it by
 //!    the view alone) fails the reciprocity check, which shows the check can fail.
 //!
-//! The white dielectric reflects less than 1 even when smooth: its Lambertian is weighted by
-//! (1 − F(cos θo)) (1 − F(cos θi)) (see `material::gltf`), and its GGX layers lose the light
-//! that single scattering does not follow, as Appendix B's model does.
+//! The white dielectric's Lambertian is weighted by 1 − F at the half vector of ωo and ωi,
+//! as Appendix B's `fresnel_mix` weighs it (see `material::gltf`), and its GGX layers lose
+//! the light that single scattering does not follow, as Appendix B's model does.
 
 use super::chi2_sampling::{direction_at, sidak_level, FAMILY_SIGNIFICANCE};
 use super::scatter_harness::{
@@ -573,8 +575,12 @@ fn furnace(bsdf: &(dyn Scatter + Sync), wo: Vec3, samples: usize, quadrature: bo
 }
 
 /// The furnace's own checks: sampling and quadrature agree on the continuous part, and no
-/// more energy leaves than arrives.
+/// more energy leaves than arrives, except where a Lambertian base sits under Appendix B's
+/// half-vector coupling, which by its definition gains energy away from normal incidence
+/// (`gltf_appendix_b_coupling_gains_energy_obliquely` states how much).
 fn check_furnace(name: &str, bsdf: &GltfPbr, wo: Vec3) -> Furnace {
+    let coupled =
+        bsdf.metallic < 1.0 && bsdf.transmission < 1.0 && bsdf.base_color.max_component() > 0.0;
     // With refraction ∫ eval bounds nothing (radiance is scaled by 1/η²), and the harness
     // compares it with sampling already (`gltf_sampling_volume_*`): no quadrature here.
     let refracts = !bsdf.thin_walled && bsdf.transmission > 0.0;
@@ -585,7 +591,7 @@ fn check_furnace(name: &str, bsdf: &GltfPbr, wo: Vec3) -> Furnace {
         f.albedo, f.standard_error, f.energy, f.continuous, f.quadrature
     );
     assert!(
-        f.energy <= 1.0 + 5.0 * f.standard_error,
+        coupled || f.energy <= 1.0 + 5.0 * f.standard_error,
         "{name}: energy {} ± {}",
         f.energy,
         f.standard_error
@@ -598,7 +604,7 @@ fn check_furnace(name: &str, bsdf: &GltfPbr, wo: Vec3) -> Furnace {
             f.quadrature
         );
         assert!(
-            f.quadrature <= 1.0 + 2e-3,
+            coupled || f.quadrature <= 1.0 + 2e-3,
             "{name}: quadrature {}",
             f.quadrature
         );
@@ -631,6 +637,27 @@ fn gltf_furnace_white_dielectric() {
             check_furnace(&name, &gltf(WHITE, 0.0, roughness), wo_at(theta));
         }
     }
+}
+
+/// Appendix B weighs the Lambertian base by 1 − F at the half vector of ωo and ωi, which is
+/// not energy conserving: a white smooth dielectric returns all it receives head-on, more
+/// obliquely. The figures pin the coupling down; the product (1 − F(θo))(1 − F(θi)) some
+/// renderers use instead would give 0.92 and 0.94 here, and fails.
+#[test]
+fn gltf_appendix_b_coupling_gains_energy_obliquely() {
+    let smooth = gltf(WHITE, 0.0, 0.0);
+    let head_on = furnace(&smooth, wo_at(0.0), 50_000, true);
+    let oblique = furnace(&smooth, wo_at(75.0), 50_000, true);
+    eprintln!(
+        "FIGURE Appendix B white smooth dielectric: energy {:.4} at 0°, {:.4} at 75°",
+        head_on.energy, oblique.energy
+    );
+    assert!((head_on.energy - 1.0).abs() < 0.01, "{}", head_on.energy);
+    assert!(
+        oblique.energy > 1.15 && oblique.energy < 1.25,
+        "{}",
+        oblique.energy
+    );
 }
 
 #[test]
@@ -804,13 +831,11 @@ impl Reference {
         let coat = self.coat_fresnel(no);
         let coat_layer =
             coat * Self::d(self.coat_alpha, h[2]) * self.visibility(self.coat_alpha, no, ni) * ni;
-        let f_o = self.max_dielectric(no, 1.0, self.ior.max(1.0));
-        let f_i = self.max_dielectric(ni, 1.0, self.ior.max(1.0));
+        let f_h = self.max_dielectric(c, 1.0, self.ior.max(1.0));
         std::array::from_fn(|k| {
             let metal = self.schlick(self.base[k], 1.0, c) * spec;
             let layer = self.dielectric(k, c, 1.0, self.ior) * spec;
-            let diffuse =
-                (1.0 - self.transmission) * (1.0 - f_o) * (1.0 - f_i) * self.base[k] / PI * ni;
+            let diffuse = (1.0 - self.transmission) * (1.0 - f_h) * self.base[k] / PI * ni;
             (1.0 - coat) * (self.metallic * metal + (1.0 - self.metallic) * (layer + diffuse))
                 + coat_layer
         })
