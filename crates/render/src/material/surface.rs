@@ -487,18 +487,19 @@ impl Resolver<'_> {
             return;
         }
         let mut sign = self.surface.bitangent_sign;
-        if frame.to_local(self.wo).z < 0.0 {
-            if p.double_sided || (p.thin_walled && p.has_transmission()) {
+        let volume = !p.thin_walled && p.has_transmission();
+        if frame.to_local(self.wo).z < 0.0 && !volume {
+            if p.double_sided || p.has_transmission() {
                 // The back face is the front with its normal reversed.
                 frame.w = -frame.w;
                 sign = -sign;
-            } else if p.thin_walled {
+            } else {
                 // Culled: light passes the back face as if it were not there.
                 pass(bsdf, opacity);
                 return;
             }
-            // A volume's boundary seen from inside: the family refracts out.
         }
+        // A volume's boundary seen from inside keeps its frame: the family refracts out.
         let mut tilt = tilt;
         if let Some(texture) = p.normal_texture {
             let t = self.texel(Some(texture)) * 2.0 - Color::ONE;
