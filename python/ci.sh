@@ -49,7 +49,8 @@ test_suite() {
     pip install -q --no-build-isolation "$HERE"
     # The CLI the equality tests compare with (cached when `cargo test` built it already).
     (cd "$REPO" && cargo build -q -p glint)
-    export GLINT_CLI="$REPO/target/debug/glint"
+    # Where cargo put it: CARGO_TARGET_DIR when set, as cargo itself reads it.
+    export GLINT_CLI="${CARGO_TARGET_DIR:-$REPO/target}/debug/glint"
 
     local report="$HERE/target/pytest-report.txt"
     mkdir -p "$HERE/target"

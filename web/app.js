@@ -1,7 +1,7 @@
-// The page: choose or drop a scene, check it with the renderer (diagnostics as the CLI prints
-// them), render it in tiles on a pool of Web Workers, and download the image encoded by the
-// same Rust code as the CLI's.
-import init, { Files, encode, load } from './pkg/glint_wasm.js';
+// The page: choose or drop a scene or a glTF model, check it with the renderer (diagnostics as
+// the CLI prints them), render it in tiles on a pool of Web Workers, and download the image
+// encoded by the same Rust code as the CLI's.
+import init, { Files, encode, load_bytes as loadBytes } from './pkg/glint_wasm.js';
 
 const EXAMPLES = [
   { name: 'Three spheres', root: 'scenes/', scene: 'three_spheres.xml', assets: [] },
@@ -13,7 +13,9 @@ const EXAMPLES = [
   },
 ];
 const TILE = 32;
-const SCENE_FILE = /\.(xml|json)$/i;
+const SCENE_FILE = /\.(xml|json|gltf|glb)$/i;
+// A GLB is binary: it is loaded from the dropped bytes and its text is not shown or edited.
+const BINARY_SCENE = /\.glb$/i;
 
 const $ = (id) => document.getElementById(id);
 const ui = {
@@ -73,15 +75,28 @@ function setFiles(newFiles) {
   if (scenes.length) {
     showScene(scenes[0]);
   } else {
-    ui.diagnostics.textContent = 'error: no scene file (.xml or .json) among the files given';
+    ui.diagnostics.textContent =
+      'error: no scene file (.xml, .json, .gltf or .glb) among the files given';
   }
 }
 
 function showScene(path) {
   scenePath = path;
   ui.sceneFile.value = path;
-  ui.sceneText.value = new TextDecoder().decode(files.get(path));
+  const binary = BINARY_SCENE.test(path);
+  ui.sceneText.readOnly = binary;
+  ui.sceneText.value = binary
+    ? `(binary glTF, ${files.get(path).length} bytes: rendered as dropped, not editable here)`
+    : new TextDecoder().decode(files.get(path));
   checkScene();
+}
+
+// What the workers load: the dropped bytes of a GLB, else the (possibly edited) text. Both go
+// through bytes, so one loader reads every format.
+function sceneBytes() {
+  return BINARY_SCENE.test(scenePath)
+    ? files.get(scenePath)
+    : new TextEncoder().encode(ui.sceneText.value);
 }
 
 async function chooseExample(index) {
@@ -137,7 +152,7 @@ async function inputFiles(input) {
 function checkScene() {
   const assets = new Files();
   for (const [path, bytes] of files) assets.add(path, bytes);
-  const loaded = load(ui.sceneText.value, scenePath, assets);
+  const loaded = loadBytes(sceneBytes(), scenePath, assets);
   assets.free();
   ui.diagnostics.textContent = loaded.messages.map((message) => message.text).join('\n');
   ui.diagnostics.dataset.state = loaded.ok ? 'ok' : 'error';
@@ -236,7 +251,7 @@ function startRender() {
   const message = {
     type: 'job',
     job: render.job,
-    text: ui.sceneText.value,
+    bytes: sceneBytes(),
     path: scenePath,
     files: [...files],
     settings,

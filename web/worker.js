@@ -1,6 +1,6 @@
 // One render worker: loads the scene into its own copy of the renderer, then renders the tiles
 // the page hands it, one at a time, until the page terminates it.
-import init, { Files, Settings, load } from './pkg/glint_wasm.js';
+import init, { Files, Settings, load_bytes as loadBytes } from './pkg/glint_wasm.js';
 
 const ready = init();
 let current = null; // { job, loaded, settings }
@@ -13,11 +13,11 @@ function release() {
   }
 }
 
-function startJob({ job, text, path, files, settings }) {
+function startJob({ job, bytes, path, files, settings }) {
   release();
   const assets = new Files();
   for (const [name, bytes] of files) assets.add(name, bytes);
-  const loaded = load(text, path, assets);
+  const loaded = loadBytes(bytes, path, assets);
   assets.free();
   if (!loaded.ok) {
     const error = loaded.messages[0]?.text ?? 'the scene did not load';

@@ -1,5 +1,5 @@
-"""Glint from Python: load the course's ray-tracing scenes, or Mitsuba 3's, and render them into
-numpy arrays.
+"""Glint from Python: load the course's ray-tracing scenes, Mitsuba 3's, or glTF 2.0 models,
+and render them into numpy arrays.
 
 The same renderer as the ``glint`` command: for the same scene, settings and seed,
 :func:`render` returns exactly the pixels the CLI writes to an EXR file.
@@ -99,30 +99,70 @@ def _issue_warnings(scene: Scene) -> None:
 
 
 def load_scene(
-    path: PathLike, background: RGB | None = None, defines: Mapping[str, str] | None = None
+    path: PathLike,
+    background: RGB | None = None,
+    defines: Mapping[str, str] | None = None,
+    scene: int | None = None,
+    camera: str | int | None = None,
+    env: PathLike | None = None,
+    env_strength: float = 1.0,
 ) -> Scene:
-    """Loads a scene file, the course's XML or JSON or a Mitsuba 3 scene, and builds it for
-    rendering.
+    """Loads a scene file, the course's XML or JSON, a Mitsuba 3 scene or a glTF 2.0 model
+    (``.gltf`` or ``.glb``), and builds it for rendering.
 
-    Meshes, textures and environment maps are found relative to the file's directory.
+    Meshes, textures, environment maps and a ``.gltf``'s buffers and images are found relative
+    to the file's directory (Glint reads none from above it).
     ``background=(r, g, b)`` replaces the scene's background, as the CLI's ``--background``
     does (the course's reference renders used ``(0.2, 0.2, 0.2)``). ``defines`` gives a
     Mitsuba scene's parameters, ``{"name": "value"}``, as the CLI's ``-D name=value``: they win
     over the scene's ``<default>`` s (course scenes have none and ignore them). A Mitsuba scene
     brings its own film size, sample count and integrator, which :func:`render` uses wherever
-    it is not given them. What the
-    loader works around (unknown keys, missing textures...) is issued as a :class:`SceneWarning`
-    naming ``file:line:col``; a scene that cannot be loaded raises :class:`SceneError` (with
-    ``file``, ``line``, ``column`` and ``message``), a file that cannot be read ``OSError``
-    (``FileNotFoundError``...).
+    it is not given them.
+
+    For a glTF model, as the CLI's ``--scene N`` and ``--camera NAME|INDEX``: ``scene`` picks
+    one of the file's scenes by index (default: the file's default scene) and ``camera`` a
+    camera by its or its node's name, or by index (default: the first camera in the scene; with
+    none, one that frames the model). A model brings the path tracer and its camera's image
+    size for :func:`render`. Other formats ignore both.
+
+    ``env`` lights the scene with an equirectangular environment map (OpenEXR, Radiance
+    ``.hdr`` or an 8-bit image), its radiance times ``env_strength``, as the CLI's ``--env`` and
+    ``--env-strength``: it replaces the background, and a glTF model then gets no default sky.
+    ``background`` wins over it when both are given, as in the CLI.
+
+    What the loader works around (unknown keys, missing textures...) is issued as a
+    :class:`SceneWarning` naming ``file:line:col``; a scene that cannot be loaded raises
+    :class:`SceneError` (with ``file``, ``line``, ``column`` and ``message``), a file that
+    cannot be read ``OSError`` (``FileNotFoundError``...).
 
     >>> glint.load_scene("no/such/scene.xml")
     Traceback (most recent call last):
     FileNotFoundError: [Errno 2] No such file or directory: 'no/such/scene.xml'
     """
-    scene = _glint.load_scene(os.fspath(path), _rgb(background), _defines(defines))
-    _issue_warnings(scene)
-    return scene
+    loaded = _glint.load_scene(
+        os.fspath(path),
+        _rgb(background),
+        _defines(defines),
+        *_model(scene, camera, env),
+        env_strength,
+    )
+    _issue_warnings(loaded)
+    return loaded
+
+
+def _model(
+    scene: int | None, camera: str | int | None, env: PathLike | None
+) -> tuple[int | None, str | None, str | None]:
+    """``scene``, ``camera`` and ``env`` as the native module takes them."""
+    if scene is not None and (isinstance(scene, bool) or not isinstance(scene, int)):
+        raise TypeError(f"scene must be an index (int), not {type(scene).__name__}")
+    if camera is not None and (isinstance(camera, bool) or not isinstance(camera, (str, int))):
+        raise TypeError(f"camera must be a name (str) or an index (int), not {camera!r}")
+    return (
+        scene,
+        None if camera is None else str(camera),
+        None if env is None else os.fspath(env),
+    )
 
 
 def _defines(defines: Mapping[str, str] | None) -> list[tuple[str, str]] | None:
@@ -144,8 +184,8 @@ def _rgb(background: RGB | None) -> RGB | None:
 
 
 def _text_path(format: str, base_dir: PathLike | None, name: str | None) -> str:
-    if format not in ("json", "xml"):
-        raise ValueError(f"format must be 'json' or 'xml', not {format!r}")
+    if format not in ("json", "xml", "gltf"):
+        raise ValueError(f"format must be 'json', 'xml' or 'gltf', not {format!r}")
     name = name if name is not None else f"<text>.{format}"
     return name if base_dir is None else os.path.join(os.fspath(base_dir), name)
 
@@ -157,13 +197,20 @@ def load_scene_text(
     name: str | None = None,
     background: RGB | None = None,
     defines: Mapping[str, str] | None = None,
+    scene: int | None = None,
+    camera: str | int | None = None,
+    env: PathLike | None = None,
+    env_strength: float = 1.0,
 ) -> Scene:
-    """Loads a scene from its text, in the course's JSON (``format="json"``) or XML (the
-    course's or Mitsuba 3's).
+    """Loads a scene from its text, in the course's JSON (``format="json"``), XML (the
+    course's or Mitsuba 3's) or a glTF 2.0 model's JSON (``format="gltf"``, or a ``name``
+    ending in ``.gltf``).
 
-    Diagnostics name the text ``name`` (default ``<text>.json`` or ``<text>.xml``) inside
-    ``base_dir``, and assets are found relative to ``base_dir`` (default: the current
-    directory). ``background``, ``defines``, warnings and errors as for :func:`load_scene`.
+    Diagnostics name the text ``name`` (default ``<text>.json``, ``<text>.xml`` or
+    ``<text>.gltf``) inside ``base_dir``, and assets (a model's ``.bin`` buffers and images
+    too) are found relative to ``base_dir`` (default: the current directory). ``background``,
+    ``defines``, ``scene``, ``camera``, ``env``, ``env_strength``, warnings and errors as for
+    :func:`load_scene`.
 
     >>> import warnings
     >>> with warnings.catch_warnings(record=True) as caught:
@@ -182,14 +229,24 @@ def load_scene_text(
     >>> glint.load_scene_text('{"scene": {"camera": 7}}')
     Traceback (most recent call last):
     glint.SceneError: <text>.json:1:22: ...
+    >>> glint.load_scene_text('{"asset": {"version": "2.0"}}', format="gltf", camera="top")
+    Traceback (most recent call last):
+    glint.SceneError: <text>.gltf:...: ...top...
     """
     first = text.lstrip("\ufeff \t\r\n")[:1]
-    if (format == "xml" and first in ("{", "[")) or (format == "json" and first == "<"):
+    if (format == "xml" and first in ("{", "[")) or (format in ("json", "gltf") and first == "<"):
         raise ValueError(f"format={format!r}, but the text starts with {first!r}")
     path = _text_path(format, base_dir, name)
-    scene = _glint.load_scene_text(text, path, _rgb(background), _defines(defines))
-    _issue_warnings(scene)
-    return scene
+    loaded = _glint.load_scene_text(
+        text,
+        path,
+        _rgb(background),
+        _defines(defines),
+        *_model(scene, camera, env),
+        env_strength,
+    )
+    _issue_warnings(loaded)
+    return loaded
 
 
 def scene_from_dict(

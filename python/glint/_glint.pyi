@@ -50,23 +50,49 @@ class Scene:
         self,
     ) -> tuple[
         Any,
-        tuple[str, str | None, tuple[float, float, float] | None, list[tuple[str, str]]],
+        tuple[
+            str,
+            str | None,
+            tuple[float, float, float] | None,
+            list[tuple[str, str]],
+            int | None,
+            str | None,
+            str | None,
+            float,
+        ],
     ]: ...
 
 _RGB = tuple[float, float, float]
 _Defines = list[tuple[str, str]]
 
 def load_scene(
-    path: str, background: _RGB | None = None, defines: _Defines | None = None
+    path: str,
+    background: _RGB | None = None,
+    defines: _Defines | None = None,
+    scene: int | None = None,
+    camera: str | None = None,
+    env: str | None = None,
+    env_strength: float = 1.0,
 ) -> Scene: ...
 def load_scene_text(
-    text: str, path: str, background: _RGB | None = None, defines: _Defines | None = None
+    text: str,
+    path: str,
+    background: _RGB | None = None,
+    defines: _Defines | None = None,
+    scene: int | None = None,
+    camera: str | None = None,
+    env: str | None = None,
+    env_strength: float = 1.0,
 ) -> Scene: ...
 def _restore(
     path: str,
     text: str | None = None,
     background: _RGB | None = None,
     defines: _Defines | None = None,
+    scene: int | None = None,
+    camera: str | None = None,
+    env: str | None = None,
+    env_strength: float = 1.0,
 ) -> Scene: ...
 def render(
     scene: Scene,

@@ -1,6 +1,6 @@
 //! `glint._glint`: the native half of Glint's Python module. It wraps the renderer's public API
-//! and nothing else (`glint_io::load_scene_limited_with_defines` / `load_scene_with_defines`,
-//! `glint_render::Scene`, `RequestedSettings`, `RenderSettings`, `render`,
+//! and nothing else (`glint_io::load_scene_with_options` / `load_scene_bytes`,
+//! `load_environment`, `glint_render::Scene`, `RequestedSettings`, `RenderSettings`, `render`,
 //! `glint_io::write_image`); `glint/__init__.py` puts the
 //! documented, keyword-friendly functions in front of it (crop slices, feature dicts, sRGB).
 //!
@@ -15,7 +15,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
-use glint_io::{Diagnostic, FileSystem, ImageWriteError, Limits, LoadedScene};
+use glint_io::{Diagnostic, FileSystem, ImageWriteError, Limits, LoadedScene, ModelOptions};
 use glint_render::{
     Background, Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderDefaults,
     RenderError, RenderSettings, RenderStats, RequestedSettings, Vec3,
@@ -66,14 +66,47 @@ enum Source {
 /// A Mitsuba scene's `-D name=value` defines, in the order given.
 type Defines = Vec<(String, String)>;
 
+/// How a scene is loaded besides its source: the keyword arguments of `load_scene` and
+/// `load_scene_text`, kept so that an unpickled scene is loaded the same way.
+#[derive(Clone, Debug, Default)]
+struct LoadOptions {
+    /// Replaces the scene's background (the CLI's `--background`).
+    background: Option<[f32; 3]>,
+    /// A Mitsuba scene's `-D name=value` defines.
+    defines: Defines,
+    /// A glTF model's `--scene N` and `--camera NAME|INDEX`.
+    scene: Option<usize>,
+    camera: Option<String>,
+    /// An environment map and its strength (`--env FILE --env-strength S`), the path absolute
+    /// once loaded.
+    environment: Option<(PathBuf, f32)>,
+}
+
+impl LoadOptions {
+    fn model(&self) -> ModelOptions {
+        ModelOptions {
+            scene: self.scene,
+            camera: self.camera.clone(),
+            has_environment: self.environment.is_some(),
+        }
+    }
+}
+
 impl Source {
-    fn load(&self, defines: &[(String, String)]) -> Result<LoadedScene, glint_io::SceneError> {
+    fn load(&self, options: &LoadOptions) -> Result<LoadedScene, glint_io::SceneError> {
         let limits = Limits::default();
+        let (defines, model) = (&options.defines, &options.model());
         match self {
-            Source::File(path) => glint_io::load_scene_limited_with_defines(path, &limits, defines),
-            Source::Text { text, path } => {
-                glint_io::load_scene_with_defines(text, path, &FileSystem, &limits, defines)
-            }
+            Source::File(path) => glint_io::load_scene_with_options(path, &limits, defines, model),
+            // Through bytes, so that a `.gltf` text takes the model options too.
+            Source::Text { text, path } => glint_io::load_scene_bytes(
+                text.as_bytes(),
+                path,
+                &FileSystem,
+                &limits,
+                defines,
+                model,
+            ),
         }
     }
 
@@ -104,10 +137,8 @@ struct PyScene {
     source: Source,
     /// The source's path made absolute at load time, for loading again in another process.
     absolute_path: PathBuf,
-    /// The background that replaced the scene's, if one did.
-    background: Option<[f32; 3]>,
-    /// The defines it was loaded with, to load it again with them.
-    defines: Defines,
+    /// What it was loaded with, to load it again the same way.
+    options: LoadOptions,
     /// What the scene file asks of its render (a Mitsuba scene's film, sampler, integrator).
     defaults: RenderDefaults,
     warnings: Vec<Diagnostic>,
@@ -174,15 +205,41 @@ impl PyScene {
         let restore = py.import("glint._glint")?.getattr("_restore")?;
         let path = path_string(&self.absolute_path)?;
         let text = self.source.text().map(str::to_owned);
-        Ok((restore, (path, text, self.background, self.defines.clone())))
+        let options = &self.options;
+        let (env, env_strength) = match &options.environment {
+            Some((env, strength)) => (Some(path_string(env)?), *strength),
+            None => (None, 1.0),
+        };
+        Ok((
+            restore,
+            (
+                path,
+                text,
+                options.background,
+                options.defines.clone(),
+                options.scene,
+                options.camera.clone(),
+                env,
+                env_strength,
+            ),
+        ))
     }
 }
 
 /// What `Scene.__reduce__` returns: `_restore` and its arguments (path, text, background,
-/// defines).
+/// defines, scene, camera, env, env_strength).
 type Reduced<'py> = (
     Bound<'py, PyAny>,
-    (String, Option<String>, Option<[f32; 3]>, Defines),
+    (
+        String,
+        Option<String>,
+        Option<[f32; 3]>,
+        Defines,
+        Option<usize>,
+        Option<String>,
+        Option<String>,
+        f32,
+    ),
 );
 
 fn path_string(path: &Path) -> PyResult<String> {
@@ -191,29 +248,52 @@ fn path_string(path: &Path) -> PyResult<String> {
     })
 }
 
-/// Loads and builds a scene with the GIL released; `background` replaces the scene's (the
-/// CLI's `--background`), `defines` are a Mitsuba scene's `-D name=value`.
-fn load(
-    py: Python<'_>,
-    source: Source,
-    background: Option<[f32; 3]>,
-    defines: Defines,
-) -> PyResult<PyScene> {
-    if let Some(rgb) = background {
+/// Loads and builds a scene with the GIL released, with `options`: `background` replaces the
+/// scene's (the CLI's `--background`), after an environment map (`--env`) when both are given,
+/// as in the CLI.
+fn load(py: Python<'_>, source: Source, mut options: LoadOptions) -> PyResult<PyScene> {
+    if let Some(rgb) = options.background {
         if rgb.iter().any(|c| !c.is_finite() || *c < 0.0) {
             return Err(PyValueError::new_err(format!(
                 "background components must be finite and >= 0, not {rgb:?}"
             )));
         }
     }
+    if let Some((env, strength)) = &mut options.environment {
+        // The CLI's `--env-strength` rule.
+        if !(strength.is_finite() && *strength >= 0.0) {
+            return Err(PyValueError::new_err(format!(
+                "env_strength must be finite and >= 0, not {strength}"
+            )));
+        }
+        // Absolute, so that an unpickled scene finds it from another working directory.
+        *env = std::path::absolute(&*env)?;
+    }
     let loaded = py
-        .detach(|| source.load(&defines))
+        .detach(|| {
+            let loaded = source.load(&options)?;
+            let environment = match &options.environment {
+                Some((env, strength)) => Some(glint_io::load_environment(
+                    env,
+                    *strength,
+                    &Limits::default(),
+                )?),
+                None => None,
+            };
+            Ok::<_, glint_io::SceneError>((loaded, environment))
+        })
         .map_err(|error| scene_error(py, error))?;
-    let LoadedScene {
-        mut parts,
-        warnings,
-    } = loaded;
-    if let Some([r, g, b]) = background {
+    let (
+        LoadedScene {
+            mut parts,
+            warnings,
+        },
+        environment,
+    ) = loaded;
+    if let Some(environment) = environment {
+        parts.background = environment;
+    }
+    if let Some([r, g, b]) = options.background {
         parts.background = Background::Color(Color::new(r, g, b));
     }
     let defaults = parts.physical.defaults;
@@ -223,60 +303,99 @@ fn load(
         scene,
         source,
         absolute_path,
-        background,
-        defines,
+        options,
         defaults,
         warnings,
     })
 }
 
-/// Loads the scene file at `path` (the course's XML or JSON, or Mitsuba 3's XML with
-/// `defines`). Warnings are returned in `Scene.warnings` for the caller to issue.
+/// The keyword arguments `load_scene`, `load_scene_text` and `_restore` share.
+#[allow(clippy::too_many_arguments)]
+fn load_options(
+    background: Option<[f32; 3]>,
+    defines: Option<Defines>,
+    scene: Option<usize>,
+    camera: Option<String>,
+    env: Option<PathBuf>,
+    env_strength: f32,
+) -> PyResult<LoadOptions> {
+    if env.is_none() && env_strength != 1.0 {
+        return Err(PyValueError::new_err(
+            "env_strength scales env: give an environment map with env=",
+        ));
+    }
+    Ok(LoadOptions {
+        background,
+        defines: defines.unwrap_or_default(),
+        scene,
+        camera,
+        environment: env.map(|env| (env, env_strength)),
+    })
+}
+
+/// Loads the scene file at `path` (the course's XML or JSON, Mitsuba 3's XML with `defines`,
+/// or a glTF 2.0 model, `.gltf` or `.glb`, with `scene` and `camera`), lit by the environment
+/// map `env` times `env_strength` when given. Warnings are returned in `Scene.warnings` for
+/// the caller to issue.
 #[pyfunction]
-#[pyo3(signature = (path, background=None, defines=None))]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (path, background=None, defines=None, scene=None, camera=None, env=None, env_strength=1.0))]
 fn load_scene(
     py: Python<'_>,
     path: PathBuf,
     background: Option<[f32; 3]>,
     defines: Option<Defines>,
+    scene: Option<usize>,
+    camera: Option<String>,
+    env: Option<PathBuf>,
+    env_strength: f32,
 ) -> PyResult<PyScene> {
-    load(
-        py,
-        Source::File(path),
-        background,
-        defines.unwrap_or_default(),
-    )
+    let options = load_options(background, defines, scene, camera, env, env_strength)?;
+    load(py, Source::File(path), options)
 }
 
-/// Loads a scene from its text; `path` names it in diagnostics and locates its assets.
+/// Loads a scene from its text; `path` names it in diagnostics, locates its assets and, by
+/// its extension, tells a `.gltf` model's JSON from a course scene's. The other arguments as
+/// for `load_scene`.
 #[pyfunction]
-#[pyo3(signature = (text, path, background=None, defines=None))]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (text, path, background=None, defines=None, scene=None, camera=None, env=None, env_strength=1.0))]
 fn load_scene_text(
     py: Python<'_>,
     text: String,
     path: PathBuf,
     background: Option<[f32; 3]>,
     defines: Option<Defines>,
+    scene: Option<usize>,
+    camera: Option<String>,
+    env: Option<PathBuf>,
+    env_strength: f32,
 ) -> PyResult<PyScene> {
-    let source = Source::Text { text, path };
-    load(py, source, background, defines.unwrap_or_default())
+    let options = load_options(background, defines, scene, camera, env, env_strength)?;
+    load(py, Source::Text { text, path }, options)
 }
 
-/// Unpickles a `Scene`: loads it again from where it came from, with the same defines.
+/// Unpickles a `Scene`: loads it again from where it came from, with the same options.
 #[pyfunction]
-#[pyo3(signature = (path, text=None, background=None, defines=None))]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (path, text=None, background=None, defines=None, scene=None, camera=None, env=None, env_strength=1.0))]
 fn _restore(
     py: Python<'_>,
     path: PathBuf,
     text: Option<String>,
     background: Option<[f32; 3]>,
     defines: Option<Defines>,
+    scene: Option<usize>,
+    camera: Option<String>,
+    env: Option<PathBuf>,
+    env_strength: f32,
 ) -> PyResult<PyScene> {
     let source = match text {
         None => Source::File(path),
         Some(text) => Source::Text { text, path },
     };
-    load(py, source, background, defines.unwrap_or_default())
+    let options = load_options(background, defines, scene, camera, env, env_strength)?;
+    load(py, source, options)
 }
 
 /// What the CLI prints after `error: ` or `warning: ` (glint-io's `Diagnostic::located`).

@@ -5,6 +5,7 @@
 //! - [`load`] reads a scene from its text (the course's XML or JSON, or Mitsuba 3's XML) with
 //!   those files and returns a [`Loaded`]: the scene, or the located diagnostics exactly as the
 //!   `glint` CLI prints them, and [`Loaded::scene_settings`], what the scene asks of its render;
+//!   [`load_bytes`] does the same from a file's bytes, for glTF models (`.glb` is binary);
 //! - [`Loaded::render_tile`] renders one rectangle of the image with `RenderSettings::pixel_bounds`,
 //!   so tiles rendered by separate Web Workers are the pixels of the whole render;
 //! - [`encode`] turns the assembled film into PNG or EXR bytes with glint-io's own encoder, so the
@@ -20,7 +21,8 @@
 use std::path::Path;
 
 use glint_io::{
-    Diagnostic, MemoryAssets, OutputFormat, PngEncoding, SceneError, Severity, WriteOptions,
+    Diagnostic, Limits, LoadedScene, MemoryAssets, ModelOptions, OutputFormat, PngEncoding,
+    SceneError, Severity, WriteOptions,
 };
 use glint_render::{
     Color, Features, Film, IntegratorKind, PixelBounds, RenderDefaults, RenderSettings,
@@ -118,40 +120,80 @@ pub struct SceneSettings {
 /// `messages`.
 #[wasm_bindgen]
 pub fn load(text: &str, path: &str, files: &Files) -> Loaded {
-    match glint_io::load_scene_with_assets(text, Path::new(path), &files.0) {
-        Ok(loaded) => {
-            let mut messages: Vec<Message> = Vec::new();
-            for warning in &loaded.warnings {
-                let message = Message::from_diagnostic(warning);
-                // The CLI shows each distinct warning once.
-                if !messages.iter().any(|shown| shown.text == message.text) {
-                    messages.push(message);
+    Loaded::from_result(
+        glint_io::load_scene_with_assets(text, Path::new(path), &files.0),
+        path,
+    )
+}
+
+/// Loads the scene file `bytes` named `path`, any format: a glTF model (`.glb`, or `.gltf`
+/// with its buffers and images among `files`) as well as the text scenes [`load`] reads.
+/// A binary file cannot go through `load`'s text, hence bytes. `scene` and `camera` are the
+/// CLI's `--scene N` and `--camera NAME|INDEX` (undefined: the model's own choice); other
+/// formats ignore them. Never throws, as `load`.
+#[wasm_bindgen]
+pub fn load_bytes(
+    bytes: &[u8],
+    path: &str,
+    files: &Files,
+    scene: Option<u32>,
+    camera: Option<String>,
+) -> Loaded {
+    let model = ModelOptions {
+        scene: scene.map(|index| index as usize),
+        camera,
+        has_environment: false,
+    };
+    Loaded::from_result(
+        glint_io::load_scene_bytes(
+            bytes,
+            Path::new(path),
+            &files.0,
+            &Limits::default(),
+            &[],
+            &model,
+        ),
+        path,
+    )
+}
+
+impl Loaded {
+    fn from_result(result: Result<LoadedScene, SceneError>, path: &str) -> Loaded {
+        match result {
+            Ok(loaded) => {
+                let mut messages: Vec<Message> = Vec::new();
+                for warning in &loaded.warnings {
+                    let message = Message::from_diagnostic(warning);
+                    // The CLI shows each distinct warning once.
+                    if !messages.iter().any(|shown| shown.text == message.text) {
+                        messages.push(message);
+                    }
+                }
+                Loaded {
+                    defaults: loaded.parts.physical.defaults,
+                    scene: Some(Scene::new(loaded.parts)),
+                    messages,
                 }
             }
-            Loaded {
-                defaults: loaded.parts.physical.defaults,
-                scene: Some(Scene::new(loaded.parts)),
-                messages,
-            }
+            Err(SceneError::Invalid(diagnostic)) => Loaded {
+                scene: None,
+                messages: vec![Message::from_diagnostic(&diagnostic)],
+                defaults: RenderDefaults::default(),
+            },
+            Err(error) => Loaded {
+                scene: None,
+                messages: vec![Message {
+                    severity: "error".to_owned(),
+                    file: path.to_owned(),
+                    line: 0,
+                    column: 0,
+                    message: error.to_string(),
+                    excerpt: String::new(),
+                    text: format!("error: {error}"),
+                }],
+                defaults: RenderDefaults::default(),
+            },
         }
-        Err(SceneError::Invalid(diagnostic)) => Loaded {
-            scene: None,
-            messages: vec![Message::from_diagnostic(&diagnostic)],
-            defaults: RenderDefaults::default(),
-        },
-        Err(error) => Loaded {
-            scene: None,
-            messages: vec![Message {
-                severity: "error".to_owned(),
-                file: path.to_owned(),
-                line: 0,
-                column: 0,
-                message: error.to_string(),
-                excerpt: String::new(),
-                text: format!("error: {error}"),
-            }],
-            defaults: RenderDefaults::default(),
-        },
     }
 }
 

@@ -1,11 +1,11 @@
 //! The page's API, natively: tiles rendered one by one and encoded here give the CLI's PNG and
 //! EXR byte for byte, a broken scene gives the CLI's located error text, and a Mitsuba scene
-//! loads from memory with the settings it asks for.
+//! loads from memory with the settings it asks for; glTF models load from their bytes.
 
 use std::path::Path;
 
 use glint_render::RenderSettings;
-use glint_wasm::{encode, load, Files, SceneSettings, Settings};
+use glint_wasm::{encode, load, load_bytes, Files, SceneSettings, Settings};
 
 const WEB: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
 
@@ -244,4 +244,63 @@ fn a_mitsuba_scene_loads_from_memory_and_asks_for_its_settings() {
     let (text, files) = example_files();
     let course = load(&text, "textured/textured.xml", &files);
     assert_eq!(course.scene_settings(), SceneSettings::default());
+}
+
+/// The project's shared glTF test files (`../shared/gltf`, beside the repository).
+fn shared_gltf() -> Option<std::path::PathBuf> {
+    let folder = Path::new(WEB).join("../../shared/gltf");
+    if folder.is_dir() {
+        return Some(folder);
+    }
+    assert!(
+        std::env::var_os("CI").is_none(),
+        "{} is missing",
+        folder.display()
+    );
+    eprintln!("SKIPPED: {} is missing", folder.display());
+    None
+}
+
+#[test]
+fn glb_and_gltf_bytes_load_with_the_dropped_files() {
+    let Some(models) = shared_gltf() else {
+        return;
+    };
+    // A GLB: binary, whole in its bytes. No camera or light: the loader says how it frames
+    // and lights it, and asks for the path tracer.
+    let glb = std::fs::read(models.join("BoxTextured-GLB/BoxTextured.glb")).unwrap();
+    let loaded = load_bytes(&glb, "BoxTextured.glb", &Files::new(), None, None);
+    assert!(loaded.ok(), "{:?}", loaded.messages());
+    assert!(!loaded.messages().is_empty());
+    assert!(loaded
+        .messages()
+        .iter()
+        .all(|m| m.severity == "warning" && m.file == "BoxTextured.glb"));
+    assert_eq!(loaded.scene_settings().integrator.as_deref(), Some("path"));
+    let settings = Settings::new(16, 12, 1, "path", 0, None, false).unwrap();
+    let tile = loaded.render_tile(&settings, 0, 0, 16, 12).unwrap();
+    assert!(tile.pixels.iter().any(|&v| v > 0.0));
+
+    // A .gltf finds its buffer among the files, beside it.
+    let gltf = std::fs::read(models.join("gltf-rs/Box.gltf")).unwrap();
+    let mut files = Files::new();
+    files.add(
+        "models/Box0.bin",
+        std::fs::read(models.join("gltf-rs/Box0.bin")).unwrap(),
+    );
+    let loaded = load_bytes(&gltf, "models/Box.gltf", &files, None, None);
+    assert!(loaded.ok(), "{:?}", loaded.messages());
+    // Without it, a located error naming it; a camera it lacks, another.
+    let missing = load_bytes(&gltf, "Box.gltf", &files, None, None);
+    assert!(!missing.ok());
+    let error = &missing.messages()[0];
+    assert!(error.text.starts_with("error: Box.gltf:"), "{error:?}");
+    assert!(error.text.contains("Box0.bin"), "{error:?}");
+    let camera = load_bytes(&gltf, "models/Box.gltf", &files, None, Some("top".into()));
+    assert!(
+        camera.messages()[0].text.contains("top"),
+        "{:?}",
+        camera.messages()
+    );
+    assert!(!load_bytes(&gltf, "models/Box.gltf", &files, Some(1), None).ok());
 }
