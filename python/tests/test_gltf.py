@@ -84,7 +84,7 @@ def test_scene_chooses_one_of_the_files_scenes(models):
     triangle = coverage(quiet_load(path, scene=0))
     assert square == chosen
     assert 0.35 < triangle / square < 0.65, (triangle, square)
-    with pytest.raises(glint.SceneError, match="names no scene"):
+    with pytest.raises(glint.SceneError, match="there is no scene 2"):
         glint.load_scene(path, scene=2)
     with pytest.raises(TypeError, match="index"):
         glint.load_scene(path, scene="0")

@@ -233,7 +233,7 @@ impl<'a, 't> Builder<'a, 't> {
             self.parts.background = Background::Color(Color::ONE);
             self.warn(
                 "",
-                "the model brings no light: a uniform white sky (radiance 1) lights it (--env FILE gives an environment map instead)",
+                "the model brings no light: a uniform white sky (radiance 1) lights it (an environment map lights it instead: --env, or env= in Python)",
             );
         }
         if !self.parts.physical.media.is_empty() {
@@ -251,7 +251,7 @@ impl<'a, 't> Builder<'a, 't> {
                 return Err(self.error(
                     "scenes",
                     format!(
-                        "--scene {n} names no scene: the model has {scenes} scene{}{}",
+                        "there is no scene {n}: the model has {scenes} scene{}{}",
                         if scenes == 1 { "" } else { "s" },
                         if scenes > 0 {
                             format!(" (0 to {})", scenes - 1)
@@ -1108,7 +1108,7 @@ impl<'a, 't> Builder<'a, 't> {
                         return Err(self.error(
                             "cameras",
                             format!(
-                                "--camera {wanted} names no camera of the scene{}",
+                                "the camera `{wanted}` names no camera of the scene{}",
                                 if names.is_empty() {
                                     " (it has none)".to_string()
                                 } else {
@@ -1253,7 +1253,7 @@ impl<'a, 't> Builder<'a, 't> {
             "",
             format!(
                 "the model has no camera: one frames it from direction (1, 1, 2), at {} from \
-                 the centre ({}, {}, {}) of its box (--camera names one of the file's)",
+                 the centre ({}, {}, {}) of its box",
                 distance, center.x, center.y, center.z
             ),
         );
