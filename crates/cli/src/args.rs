@@ -90,7 +90,7 @@ pub enum Command {
     /// all load (with --strict: without warnings), 2 otherwise.
     #[command(disable_help_flag = true)]
     Check {
-        /// Scene files, XML or JSON.
+        /// Scene files: course XML or JSON, Mitsuba 3 XML, glTF (.gltf, .glb).
         #[arg(value_name = "SCENE", required = true)]
         scenes: Vec<PathBuf>,
 
@@ -163,6 +163,35 @@ pub struct LimitOptions {
     #[arg(short = 'D', long = "define", value_name = "NAME=VALUE", value_parser = parse_define,
           action = ArgAction::Append)]
     pub defines: Vec<(String, String)>,
+
+    /// Which scene of a glTF model to render [default: the file's default scene].
+    #[arg(long = "scene", value_name = "N")]
+    pub gltf_scene: Option<usize>,
+
+    /// Which camera of a glTF model to look through: a camera's (or its node's) name or the
+    /// camera's index [default: the first camera in the scene; without one, a camera framing
+    /// the model].
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub camera: Option<String>,
+
+    /// Light the scene with this equirectangular environment map (.exr or .hdr; 8-bit images
+    /// are decoded from sRGB), replacing its background. Without it, a glTF model that brings
+    /// no light of its own is lit by a uniform white sky.
+    #[arg(long, value_name = "FILE")]
+    pub env: Option<PathBuf>,
+
+    /// Scale of --env's radiance.
+    #[arg(long, value_name = "SCALE", default_value_t = 1.0, requires = "env",
+          value_parser = parse_strength)]
+    pub env_strength: f32,
+}
+
+/// A finite, non-negative `--env-strength`.
+fn parse_strength(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!("`{text}` is not a finite, non-negative number")),
+    }
 }
 
 /// `NAME=VALUE` of `-D`.
@@ -179,6 +208,15 @@ fn parse_define(text: &str) -> Result<(String, String), String> {
 }
 
 impl LimitOptions {
+    /// What a glTF model's load is told.
+    pub fn model_options(&self) -> glint_io::ModelOptions {
+        glint_io::ModelOptions {
+            scene: self.gltf_scene,
+            camera: self.camera.clone(),
+            has_environment: self.env.is_some(),
+        }
+    }
+
     /// The loader's limits and the memory budget (the textures get no more than it).
     pub fn resolve(&self) -> (glint_io::Limits, u64) {
         let max_memory = self.max_memory.unwrap_or_else(default_max_memory);

@@ -15,12 +15,13 @@ pub fn run(
     scenes: &[PathBuf],
     limits: &glint_io::Limits,
     defines: &[(String, String)],
+    model: &glint_io::ModelOptions,
     strict: bool,
     err: &mut dyn Write,
 ) -> u8 {
     let mut failed = 0usize;
     for scene in scenes {
-        match glint_io::load_scene_limited_with_defines(scene, limits, defines) {
+        match glint_io::load_scene_with_options(scene, limits, defines, model) {
             Ok(loaded) => {
                 let label = if strict { "error" } else { "warning" };
                 for warning in &loaded.warnings {

@@ -62,6 +62,10 @@ pub struct Job {
     pub limits: glint_io::Limits,
     /// `-D NAME=VALUE` for Mitsuba scenes.
     pub defines: Vec<(String, String)>,
+    /// `--scene`, `--camera` for glTF models.
+    pub model: glint_io::ModelOptions,
+    /// `--env FILE` and `--env-strength`.
+    pub environment: Option<(PathBuf, f32)>,
     /// The memory estimate's budget, in bytes.
     pub max_memory: u64,
     /// `--checkpoint` / `--resume`.
@@ -198,6 +202,12 @@ impl Options {
         Ok(Job {
             strict: self.limits.strict,
             defines: self.limits.defines.clone(),
+            model: self.limits.model_options(),
+            environment: self
+                .limits
+                .env
+                .clone()
+                .map(|file| (file, self.limits.env_strength)),
             limits,
             max_memory,
             scene,

@@ -60,6 +60,7 @@ fn main() -> ExitCode {
             scenes,
             &resolved,
             &limits.defines,
+            &limits.model_options(),
             limits.strict,
             &mut std::io::stderr(),
         );

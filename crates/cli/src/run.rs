@@ -169,7 +169,9 @@ fn load(
         .min(job.max_memory.saturating_sub(film_bytes));
     // In the pool, so that `-n` also bounds the threads that read meshes.
     let loaded = pool
-        .install(|| glint_io::load_scene_limited_with_defines(&job.scene, &limits, &job.defines))
+        .install(|| {
+            glint_io::load_scene_with_options(&job.scene, &limits, &job.defines, &job.model)
+        })
         .map_err(Failure::Scene)?;
     if job.strict && !loaded.warnings.is_empty() {
         for warning in &loaded.warnings {
@@ -182,6 +184,10 @@ fn load(
     }
     print_warnings(&loaded.warnings, MAX_SHOWN_WARNINGS, err);
     let mut parts = loaded.parts;
+    if let Some((file, strength)) = &job.environment {
+        parts.background =
+            glint_io::load_environment(file, *strength, &limits).map_err(Failure::Scene)?;
+    }
     if let Some(color) = job.background {
         parts.background = Background::Color(color);
     }

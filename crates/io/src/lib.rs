@@ -47,6 +47,7 @@ mod build;
 mod desc;
 mod diagnostic;
 mod display;
+mod gltf;
 mod image_io;
 mod json;
 mod limits;
@@ -73,6 +74,7 @@ pub use diagnostic::{Diagnostic, SceneError, Severity, SourceLine};
 pub use display::{
     DisplayTransform, PngEncoding, ToneMap, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD,
 };
+pub use gltf::ModelOptions;
 pub use image_io::{
     encode_image, output_format, read_exr, remove_stale_partials, write_image, write_image_with,
     write_image_with_metadata, EncodeError, ExrFile, ImageReadError, ImageWriteError, OutputFormat,
@@ -123,11 +125,25 @@ pub fn load_scene_limited_with_defines(
     limits: &Limits,
     defines: &[(String, String)],
 ) -> Result<LoadedScene, SceneError> {
+    load_scene_with_options(path, limits, defines, &ModelOptions::default())
+}
+
+/// [`load_scene_limited_with_defines`] with the choices a glTF model leaves to its user
+/// (`--scene`, `--camera`, whether `--env` lights it); other formats ignore them.
+pub fn load_scene_with_options(
+    path: &Path,
+    limits: &Limits,
+    defines: &[(String, String)],
+    model: &ModelOptions,
+) -> Result<LoadedScene, SceneError> {
     let bytes =
         read_file_at_most(path, limits.max_file_bytes).map_err(|source| SceneError::Io {
             path: path.to_path_buf(),
             source,
         })?;
+    if gltf::is_gltf(path, &bytes) {
+        return gltf::load(&bytes, path, &FileSystem, limits, model);
+    }
     match String::from_utf8(bytes) {
         Ok(text) => load_scene_with_defines(&text, path, &FileSystem, limits, defines),
         Err(error) => {
@@ -188,6 +204,88 @@ pub fn load_scene_with_assets_limited(
     load_scene_with_defines(text, path, assets, limits, &[])
 }
 
+/// The background `--env FILE` gives: an equirectangular environment map (OpenEXR or Radiance
+/// `.hdr` kept as they are; 8-bit images decoded from sRGB) times `strength`, in Mitsuba's
+/// `envmap` mapping with +y up (glTF's up): u = 1/2 looks along +z, a glTF model's front.
+/// The path tracer samples it by luminance.
+pub fn load_environment(
+    path: &Path,
+    strength: f32,
+    limits: &Limits,
+) -> Result<glint_render::Background, SceneError> {
+    let mut budget = texture_io::TextureBudget::new(*limits);
+    let image = texture_io::read_image(path, &FileSystem, &mut budget)
+        .and_then(|checked| checked.decode_srgb(false))
+        .map_err(|error| {
+            let empty = Diagnostics::new(path, "");
+            let message = match error {
+                assets::AssetError::Refused(m) | assets::AssetError::Failed(m) => m,
+            };
+            empty.error(
+                empty.span_at(0),
+                format!("cannot use it as an environment map: {message}"),
+            )
+        })?;
+    Ok(glint_render::Background::Environment {
+        image: Box::new(image),
+        scale: strength,
+        to_world: glint_render::Transform::from_matrix(&glint_render::Matrix4::IDENTITY)
+            .expect("the identity inverts"),
+    })
+}
+
+/// Loads a scene (any format, a GLB included) from its bytes, reading the files it names
+/// from `assets` relative to `path`'s folder: how the browser and Python load what they were
+/// handed.
+///
+/// ```
+/// use std::path::Path;
+/// use glint_io::{load_scene_bytes, Limits, MemoryAssets, ModelOptions};
+///
+/// // One triangle in a base64 buffer: three positions (36 bytes of f32).
+/// let gltf = r#"{"asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+///   "nodes": [{"mesh": 0}], "meshes": [{"primitives": [{"attributes": {"POSITION": 0}}]}],
+///   "accessors": [{"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+///                  "min": [0, 0, 0], "max": [1, 1, 0]}],
+///   "bufferViews": [{"buffer": 0, "byteLength": 36}],
+///   "buffers": [{"byteLength": 36, "uri": "data:application/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAA"}]}"#;
+/// let loaded = load_scene_bytes(
+///     gltf.as_bytes(),
+///     Path::new("dropped/triangle.gltf"),
+///     &MemoryAssets::new(),
+///     &Limits::default(),
+///     &[],
+///     &ModelOptions::default(),
+/// )?;
+/// assert_eq!(loaded.parts.geometries[0].shapes.len(), 1);
+/// // No camera and no light: the loader says how it frames and lights the model.
+/// assert_eq!(loaded.warnings.len(), 2);
+/// # Ok::<(), glint_io::SceneError>(())
+/// ```
+pub fn load_scene_bytes(
+    bytes: &[u8],
+    path: &Path,
+    assets: &dyn Assets,
+    limits: &Limits,
+    defines: &[(String, String)],
+    model: &ModelOptions,
+) -> Result<LoadedScene, SceneError> {
+    if gltf::is_gltf(path, bytes) {
+        return gltf::load(bytes, path, assets, limits, model);
+    }
+    match std::str::from_utf8(bytes) {
+        Ok(text) => load_scene_with_defines(text, path, assets, limits, defines),
+        Err(error) => {
+            let valid = std::str::from_utf8(&bytes[..error.valid_up_to()]).unwrap_or("");
+            let diagnostics = Diagnostics::new(path, valid);
+            Err(diagnostics.error(
+                diagnostics.span_at(valid.len()),
+                "the file is not UTF-8 text",
+            ))
+        }
+    }
+}
+
 /// Loads a scene from its text as [`load_scene_with_assets_limited`] does, with `defines`:
 /// `name=value` pairs that a Mitsuba scene's `$name` references read, winning over its
 /// `<default>`s (Mitsuba's `-D`). Course scenes have no parameters and ignore them.
@@ -198,6 +296,15 @@ pub fn load_scene_with_defines(
     limits: &Limits,
     defines: &[(String, String)],
 ) -> Result<LoadedScene, SceneError> {
+    if gltf::is_gltf(path, text.as_bytes()) {
+        return gltf::load(
+            text.as_bytes(),
+            path,
+            assets,
+            limits,
+            &ModelOptions::default(),
+        );
+    }
     // A byte-order mark is not part of line 1's columns.
     let text = text.strip_prefix('\u{feff}').unwrap_or(text);
     // A Mitsuba 3 scene's root is `<scene version="...">`; the course's has no version.

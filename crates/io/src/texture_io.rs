@@ -77,7 +77,12 @@ fn reader(bytes: &[u8]) -> Result<image::ImageReader<std::io::Cursor<&[u8]>>, As
         .map_err(|error| AssetError::Failed(error.to_string()))
 }
 
-fn check_image(bytes: Vec<u8>, budget: &mut TextureBudget) -> Result<Checked, AssetError> {
+/// An image file held in memory (a glTF model's embedded image), its header checked against
+/// the limits and its memory charged to `budget`.
+pub(crate) fn check_image(
+    bytes: Vec<u8>,
+    budget: &mut TextureBudget,
+) -> Result<Checked, AssetError> {
     let (width, height) = reader(&bytes)?
         .into_dimensions()
         .map_err(|error| AssetError::Failed(error.to_string()))?;
@@ -180,6 +185,67 @@ impl Checked {
                 })
             }
         })
+    }
+
+    /// The image as a glTF material reads it: RGB decoded from sRGB unless `raw` (data
+    /// textures), and, when `alpha` asks, the alpha channel (linear in every format) as a
+    /// grey image of its own; an image without alpha is opaque.
+    pub(crate) fn decode_with_alpha(
+        self,
+        raw: bool,
+        alpha: bool,
+    ) -> Result<(Image, Option<Image>), AssetError> {
+        let mut reader = reader(&self.bytes)?;
+        reader.limits(self.limits);
+        let decoded = reader
+            .decode()
+            .map_err(|error| AssetError::Failed(error.to_string()))?;
+        let (width, height) = (decoded.width(), decoded.height());
+        let grey = |values: Vec<f32>| Image {
+            width,
+            height,
+            texels: values.into_iter().map(Color::splat).collect(),
+        };
+        if matches!(
+            decoded,
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+        ) {
+            let rgba = decoded.into_rgba32f();
+            let alpha = alpha.then(|| grey(rgba.pixels().map(|p| p.0[3]).collect()));
+            let rgb = image::DynamicImage::ImageRgba32F(rgba).into_rgb32f();
+            return Ok((float_image(rgb).map_err(AssetError::Failed)?, alpha));
+        }
+        let rgba = decoded.into_rgba8();
+        let table: Vec<f32> = (0..=255u8)
+            .map(|level| {
+                let v = f32::from(level) / 255.0;
+                if raw || v <= 0.04045 {
+                    if raw {
+                        v
+                    } else {
+                        v / 12.92
+                    }
+                } else {
+                    ((v + 0.055) / 1.055).powf(2.4)
+                }
+            })
+            .collect();
+        let texels = rgba
+            .pixels()
+            .map(|p| {
+                let [r, g, b, _] = p.0.map(|level| table[usize::from(level)]);
+                Color::new(r, g, b)
+            })
+            .collect();
+        let alpha = alpha.then(|| grey(rgba.pixels().map(|p| f32::from(p.0[3]) / 255.0).collect()));
+        Ok((
+            Image {
+                width,
+                height,
+                texels,
+            },
+            alpha,
+        ))
     }
 
     fn decode_levels(self) -> Result<Decoded, AssetError> {

@@ -86,7 +86,8 @@ pub use light::sampler::CubeDistribution;
 pub use light::sampler::LightSelection;
 pub use light::Light;
 pub use material::physical::{
-    BsdfId, BsdfNode, DistributionKind, Param, PrincipledParams, Roughness,
+    BsdfId, BsdfNode, DistributionKind, GltfAlphaMode, GltfParams, Param, PrincipledParams,
+    Roughness,
 };
 pub use material::principled::eta_from_specular;
 pub use material::{Material, MaterialId};
