@@ -18,4 +18,8 @@ find "$course" -name '*.png' -size -64k -exec cp {} "$here/corpus/texture/" \;
 # PLY: the shared models when present, and two small hand-written ones.
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' > "$here/corpus/ply/ascii.ply"
 printf 'ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n' > "$here/corpus/ply/empty.ply"
+# glTF: the shared models (../shared/gltf), GLB and JSON.
+mkdir -p "$here/corpus/gltf"
+gltf="$here/../../shared/gltf"
+[ -d "$gltf" ] && find "$gltf" \( -name '*.gltf' -o -name '*.glb' \) -exec cp {} "$here/corpus/gltf/" \;
 echo "seeded: $(for t in xml json obj ply texture scene; do printf '%s=%s ' $t "$(ls "$here/corpus/$t" | wc -l)"; done)"

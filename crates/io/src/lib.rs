@@ -270,6 +270,15 @@ pub fn load_scene_bytes(
     defines: &[(String, String)],
     model: &ModelOptions,
 ) -> Result<LoadedScene, SceneError> {
+    if bytes.len() as u64 > limits.max_file_bytes {
+        return Err(SceneError::Io {
+            path: path.to_path_buf(),
+            source: TooLarge {
+                limit: limits.max_file_bytes,
+            }
+            .into(),
+        });
+    }
     if gltf::is_gltf(path, bytes) {
         return gltf::load(bytes, path, assets, limits, model);
     }

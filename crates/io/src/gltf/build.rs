@@ -200,6 +200,28 @@ impl<'a, 't> Builder<'a, 't> {
                 stack.push((child.index(), world));
             }
         }
+        if self.document.animations().len() > 0 {
+            self.warn(
+                "animations",
+                "animations are ignored: the model renders in its rest pose",
+            );
+        }
+        if self.document.skins().len() > 0 {
+            self.warn(
+                "skins",
+                "skins are ignored: skinned meshes render in their bind pose",
+            );
+        }
+        if self
+            .document
+            .meshes()
+            .any(|m| m.primitives().any(|p| p.morph_targets().len() > 0))
+        {
+            self.warn(
+                "meshes",
+                "morph targets are ignored: meshes render with their base shape",
+            );
+        }
         if self.parts.instances.is_empty() {
             self.warn(
                 "",

@@ -133,7 +133,7 @@ mod tests {
             "meshes[0].primitives[0].attributes[\"POSITION\"]",
             &diagnostics,
         );
-        assert_eq!((span.line, span.column), (3, 52));
+        assert_eq!((span.line, span.column), (3, 49));
         // A missing member is reported at the deepest value that exists.
         let span = locator.span("meshes[0].primitives[3]", &diagnostics);
         assert_eq!((span.line, span.column), (3, 20));

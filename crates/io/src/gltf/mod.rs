@@ -121,6 +121,7 @@ pub(crate) fn load(
     })?;
     let locator = locate::Locator::new(text);
     check_extensions(&root, &locator, &mut diagnostics)?;
+    check_required_members(&root, &locator, &diagnostics)?;
     let document = match gltf::Document::from_json(root) {
         Ok(document) => document,
         Err(gltf::Error::Validation(errors)) => {
@@ -229,6 +230,67 @@ fn check_extensions(
                 span,
                 format!("the extension {name} is ignored (Glint does not read it)"),
             );
+        }
+    }
+    Ok(())
+}
+
+/// Members the specification requires together that the `gltf` crate's validation lets
+/// through (and its accessors would then unwrap): an image in a buffer view needs its
+/// `mimeType`, otherwise a `uri`; a camera needs the member its `type` names; so does a spot
+/// light.
+fn check_required_members(
+    root: &gltf::json::Root,
+    locator: &locate::Locator,
+    diagnostics: &Diagnostics,
+) -> Result<(), SceneError> {
+    use gltf::json::validation::Checked;
+    let missing = |at: String, message: &str| {
+        Err(diagnostics.error(locator.span(&at, diagnostics), message.to_string()))
+    };
+    for (i, image) in root.images.iter().enumerate() {
+        if image.buffer_view.is_some() && image.mime_type.is_none() {
+            return missing(
+                format!("images[{i}]"),
+                "an image in a buffer view needs a `mimeType`",
+            );
+        }
+        if image.buffer_view.is_none() && image.uri.is_none() {
+            return missing(
+                format!("images[{i}]"),
+                "an image needs a `uri` or a `bufferView`",
+            );
+        }
+    }
+    for (i, camera) in root.cameras.iter().enumerate() {
+        let ok = match camera.type_ {
+            Checked::Valid(gltf::json::camera::Type::Perspective) => camera.perspective.is_some(),
+            Checked::Valid(gltf::json::camera::Type::Orthographic) => camera.orthographic.is_some(),
+            Checked::Invalid => true,
+        };
+        if !ok {
+            return missing(
+                format!("cameras[{i}]"),
+                "the camera lacks the `perspective` or `orthographic` member its `type` names",
+            );
+        }
+    }
+    if let Some(lights) = root
+        .extensions
+        .as_ref()
+        .and_then(|e| e.khr_lights_punctual.as_ref())
+    {
+        for (i, light) in lights.lights.iter().enumerate() {
+            let spot = matches!(
+                light.type_,
+                Checked::Valid(gltf::json::extensions::scene::khr_lights_punctual::Type::Spot)
+            );
+            if spot && light.spot.is_none() {
+                return missing(
+                    format!("extensions.KHR_lights_punctual.lights[{i}]"),
+                    "a spot light needs its `spot` member",
+                );
+            }
         }
     }
     Ok(())

@@ -99,6 +99,22 @@ impl FirstHit {
         let bsdf = Bsdf::from_material(&scene.materials, &scene.textures, si.material, si.uv);
         let albedo = match Material::get(&scene.materials, si.material) {
             Material::Emissive { radiance, .. } if bsdf.is_black() => radiance.clamp01(),
+            // A physically based material's albedo is its resolved tree's, as the path
+            // tracer records it (rough plastics, whose tables are prepared per render, show
+            // none here).
+            Material::Physical(id) => {
+                let surface = scene.physical_surface(&ray, &hit);
+                crate::material::surface::SurfaceBsdf::new(
+                    &scene.physical.bsdfs,
+                    &scene.physical.textures,
+                    &[],
+                    &scene.textures,
+                    *id,
+                    &surface,
+                    -ray.direction,
+                )
+                .albedo()
+            }
             _ => bsdf.albedo(),
         };
         FirstHit {

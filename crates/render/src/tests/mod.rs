@@ -7,6 +7,7 @@ mod accel_watertight;
 mod chi2_sampling;
 mod composite_bsdfs;
 mod depth_of_field;
+mod gltf_bsdf;
 mod lecture_math;
 mod media_known_answers;
 mod mitsuba_emitters;
