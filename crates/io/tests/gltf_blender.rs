@@ -4,23 +4,20 @@
 //! For every model of `tests/gltf_refs/manifest.json` (the shared models in `../shared/gltf`
 //! and Glint's material test models in `scenes/gltf`):
 //!
-//! - Layers, pixel for pixel. Depth and normal: Glint renders them at the reference's size
+//! - Layers, pixel for pixel: Glint renders depth, normal and albedo at the reference's size
 //!   with one camera ray through each pixel's centre (the depth debug view's one-sample
-//!   grid), as Cycles did (one sample, a 0.01-pixel box filter). A pixel disagrees when its
-//!   depth differs by more than `DEPTH_TOLERANCE` times max(1, depth) or a normal component
-//!   by more than `NORMAL_TOLERANCE` (the reference stores normals as half floats: 2⁻¹¹
-//!   relative). The model passes when at most `EDGE_SHARE` of its pixels disagree and every
-//!   one of them is an edge pixel (a silhouette or crease: the reference's escape, depth or
-//!   normal changes across its 8-neighbourhood), where a ray a rounding error away meets
-//!   another surface. Albedo: the debug views give 0 on glTF materials (see
-//!   `render_albedo`), so the path tracer's albedo layer is used, averaged over
-//!   `ALBEDO_SPP` samples spread over the pixel; it is compared off edges where the
-//!   reference's albedo is linear across the pixel's neighbourhood (so that the pixel's
-//!   average is the centre's value), within `ALBEDO_TOLERANCE`, and at most `ALBEDO_SHARE`
-//!   of those pixels may disagree (texel edges of NEAREST textures). Pixels the reference
-//!   masks out (first hit on a BLEND material: stochastic in both renderers) are not
-//!   compared. `KNOWN_LAYER_DISAGREEMENTS` lists the models Glint gets wrong today; they must
-//!   keep failing until fixed, and then leave the list.
+//!   grid with features on), as Cycles did (one sample, a 0.01-pixel box filter). A pixel
+//!   disagrees when its depth differs by more than `DEPTH_TOLERANCE` times max(1, depth) or
+//!   a normal component by more than `NORMAL_TOLERANCE` (the reference stores normals as
+//!   half floats: 2⁻¹¹ relative); the model passes when at most `EDGE_SHARE` of its pixels
+//!   disagree and every one of them is an edge pixel (a silhouette or crease: the
+//!   reference's escape, depth or normal changes across its 8-neighbourhood), where a ray a
+//!   rounding error away meets another surface. Albedo is compared off edges where the
+//!   reference's albedo is linear over the 3x3 neighbourhood (`albedo_is_linear`: elsewhere
+//!   the renderers' texture filtering differs), within `ALBEDO_TOLERANCE` per channel, and at
+//!   most `ALBEDO_SHARE` of those pixels may disagree. Pixels the reference masks out (first hit on a BLEND material: stochastic in
+//!   both renderers) are not compared. `KNOWN_LAYER_DISAGREEMENTS` lists the models Glint
+//!   gets wrong today; they must keep failing until fixed, and then leave the list.
 //! - Beauty, for the models the manifest marks `tested` (metal-only or diffuse-only
 //!   materials under the white sky): Glint's path tracer renders two halves of
 //!   `BEAUTY_SPP` / 2 samples and `glint_render::testing::compare::judge` holds their mean to
@@ -29,8 +26,10 @@
 //!   1.15 times the noise's, every 40x40 block mean within 2% or five standard errors).
 //!   Metal-only models get the block rule alone, at `METAL_BLOCK_TOLERANCE`: Cycles' metal
 //!   differs from Appendix B by up to 3.1% on average (the README's furnace measurement), a
-//!   bias no relMSE allowance of noise may absorb. While `GLTF_PBR_IS_PLACEHOLDER` (Glint's
-//!   glTF material is the Lambertian placeholder) the metal models are reported, not judged.
+//!   bias no relMSE allowance of noise may absorb; block channels darker than
+//!   `METAL_DARK_BLOCK` are not judged. `KNOWN_BEAUTY_DISAGREEMENTS` lists the rough metals
+//!   the reference itself cannot hold that closely. (`GLTF_PBR_IS_PLACEHOLDER` turns the
+//!   metal judgement off while Glint's glTF material is a Lambertian placeholder.)
 //! - Negative controls: a camera moved sideways by 2% of its distance must fail the layers,
 //!   and Glint's beauty made 3% darker (diffuse) or `METAL_NEGATIVE` darker (metal) must
 //!   fail the beauty rule.
@@ -44,21 +43,24 @@ use glint_render::{Features, IntegratorKind, RenderSettings, Scene};
 
 const DEPTH_TOLERANCE: f32 = 1e-3;
 const NORMAL_TOLERANCE: f32 = 2e-3;
-const ALBEDO_TOLERANCE: f32 = 4e-3;
-/// Largest share of the albedo-compared pixels that may disagree: a pixel crossed by a
-/// texel edge of a NEAREST texture, which Glint averages over the pixel and Cycles samples
-/// at its centre, can look linear to `albedo_is_linear`.
-const ALBEDO_SHARE: f64 = 0.005;
-/// Samples of the path tracer's albedo layer per pixel.
-const ALBEDO_SPP: u32 = 8;
+const ALBEDO_TOLERANCE: f32 = 2e-3;
+/// Largest share of a model's pixels that may disagree in depth or normal (all of them
+/// edge pixels).
+const EDGE_SHARE: f64 = 0.01;
 /// Largest second difference of the reference's albedo where it counts as linear.
 const LINEAR_ALBEDO: f32 = 1e-3;
-/// Largest share of a model's pixels that may disagree (all of them edge pixels).
-const EDGE_SHARE: f64 = 0.01;
+/// Largest share of the albedo-compared pixels that may disagree (a texel edge of a NEAREST
+/// texture a rounding error from a pixel centre).
+const ALBEDO_SHARE: f64 = 0.005;
 const BEAUTY_SPP: u32 = 128;
 const BLOCK: u32 = 40;
 /// Block-mean tolerance for metal-only models (README: Cycles' metal against Appendix B).
 const METAL_BLOCK_TOLERANCE: f64 = 0.05;
+/// Metal block channels whose reference mean is at or below this are not judged: there the
+/// metal's reflectance is mostly Schlick's (1 − cos)⁵ tail (F0 near 0, as the red Box's
+/// green and blue), which the reference takes at N·V and Appendix B at V·H, tens of percent
+/// apart on a rough metal.
+const METAL_DARK_BLOCK: f64 = 0.1;
 /// How much darker the metal negative control is: more than `METAL_BLOCK_TOLERANCE`.
 const METAL_NEGATIVE: f64 = 0.90;
 
@@ -202,25 +204,10 @@ fn render_layers(scene: &Scene, entry: &Entry) -> Features {
     film.features.expect("features were asked for")
 }
 
-/// Glint's albedo layer as the path tracer records it, averaged over `ALBEDO_SPP` samples
-/// spread over each pixel. (The debug integrators' `FirstHit::trace` gives 0 on glTF
-/// materials: `Bsdf::from_material` does not resolve `BsdfNode::Gltf`; reported to the lead.)
-fn render_albedo(scene: &Scene, entry: &Entry) -> Vec<glint_render::Color> {
-    let settings = RenderSettings {
-        width: entry.width,
-        height: entry.height,
-        samples_per_pixel: ALBEDO_SPP,
-        integrator: IntegratorKind::Path,
-        features: true,
-        ..RenderSettings::default()
-    };
-    let (film, _) = glint_render::render(scene, &settings, &|_| true).unwrap();
-    film.features.expect("features were asked for").albedo
-}
-
 /// Whether the reference's albedo is linear across pixel (x, y)'s neighbourhood (every
-/// second difference below `LINEAR_ALBEDO`), so that Glint's pixel average equals the
-/// value at the centre.
+/// second difference at most `LINEAR_ALBEDO`). Elsewhere a texture varies within a pixel's
+/// footprint, and the renderers filter it differently: Cycles reads the full-resolution
+/// texture at the point, Glint honours the sampler's mipmapped minification.
 fn albedo_is_linear(reference: &BlenderReference, width: u32, height: u32, x: u32, y: u32) -> bool {
     if x == 0 || y == 0 || x + 1 >= width || y + 1 >= height {
         return false;
@@ -243,7 +230,7 @@ fn albedo_is_linear(reference: &BlenderReference, width: u32, height: u32, x: u3
 #[derive(Debug, Default)]
 struct LayerFigures {
     compared: usize,
-    /// Pixels whose albedo is compared (linear there, off edges), and those that disagree.
+    /// Pixels whose albedo is compared (off edges), and those that disagree.
     albedo_compared: usize,
     albedo_disagreeing: usize,
     disagreeing: usize,
@@ -307,12 +294,7 @@ fn is_edge(reference: &BlenderReference, width: u32, height: u32, x: u32, y: u32
     false
 }
 
-fn compare_layers(
-    reference: &BlenderReference,
-    glint: &Features,
-    albedo: &[glint_render::Color],
-    entry: &Entry,
-) -> LayerFigures {
+fn compare_layers(reference: &BlenderReference, glint: &Features, entry: &Entry) -> LayerFigures {
     let mut figures = LayerFigures::default();
     let (mut depth_sum, mut normal_sum, mut albedo_sum) = (0.0, 0.0, 0.0);
     for y in 0..entry.height {
@@ -330,7 +312,7 @@ fn compare_layers(
                 .map(|(g, r)| (g - r).abs())
                 .fold(0.0f32, f32::max);
             let edge = is_edge(reference, entry.width, entry.height, x, y);
-            let a = albedo[i];
+            let a = glint.albedo[i];
             let albedo = if !edge && albedo_is_linear(reference, entry.width, entry.height, x, y) {
                 figures.albedo_compared += 1;
                 [a.x, a.y, a.z]
@@ -369,7 +351,12 @@ fn compare_layers(
 
 /// Models whose layers Glint gets wrong today, with why (reported to the importer's
 /// author): they must keep disagreeing, so that the list is emptied once they are fixed.
-const KNOWN_LAYER_DISAGREEMENTS: [(&str, &str); 3] = [
+const KNOWN_LAYER_DISAGREEMENTS: [(&str, &str); 4] = [
+    (
+        "emissive",
+        "Glint's debug views give the emissive panel its clamped radiance as albedo (1) where \
+         the rule (and Glint's path tracer) gives its base colour (0)",
+    ),
     (
         "alpha_modes",
         "Glint's first hit is the MASK quad where its alpha is below the cutoff (depth of \
@@ -390,8 +377,7 @@ fn layers_match_blender() {
         let Some(scene) = load(&entry) else { continue };
         let reference = read_reference(&entry);
         let glint = render_layers(&scene, &entry);
-        let albedo = render_albedo(&scene, &entry);
-        let figures = compare_layers(&reference, &glint, &albedo, &entry);
+        let figures = compare_layers(&reference, &glint, &entry);
         let known = KNOWN_LAYER_DISAGREEMENTS
             .iter()
             .find(|(model, _)| *model == entry.model);
@@ -431,8 +417,7 @@ fn a_moved_camera_fails_the_layers() {
         .fold(f32::INFINITY, f32::min);
     scene.camera.position += scene.camera.basis.u * (0.02 * distance);
     let glint = render_layers(&scene, entry);
-    let albedo = render_albedo(&scene, entry);
-    let figures = compare_layers(&reference, &glint, &albedo, entry);
+    let figures = compare_layers(&reference, &glint, entry);
     println!(
         "diffuse_only, camera moved (must fail): {}",
         figures.summary()
@@ -459,7 +444,13 @@ fn render_beauty(scene: &Scene, entry: &Entry, samples: u32, seed: u64) -> Vec<P
 /// reported but not judged until the full Appendix B model lands; then set this to false.
 /// (`gltf-rs-box_sparse` agrees even now: its faces are wound inwards, so the camera sees
 /// the inside of a closed box, which no light reaches.)
-const GLTF_PBR_IS_PLACEHOLDER: bool = true;
+const GLTF_PBR_IS_PLACEHOLDER: bool = false;
+
+/// Metal models whose beauty the reference cannot hold to `METAL_BLOCK_TOLERANCE`: rough
+/// (roughness 1) metal seen at grazing angles, where the reference's Fresnel at N·V and
+/// separable Smith term depart from Appendix B by up to 13% (the README's furnace
+/// measurement). They must keep failing; a better reference graph empties the list.
+const KNOWN_BEAUTY_DISAGREEMENTS: [&str; 2] = ["Box", "BoxVertexColors"];
 
 #[test]
 fn beauty_matches_blender() {
@@ -478,6 +469,7 @@ fn beauty_matches_blender() {
             Criterion {
                 tolerance: f64::INFINITY,
                 block_tolerance: METAL_BLOCK_TOLERANCE,
+                dark_block: Some(METAL_DARK_BLOCK),
                 ..Criterion::new(entry.width, entry.height, BLOCK)
             }
         };
@@ -502,7 +494,11 @@ fn beauty_matches_blender() {
         if pending {
             println!("  (metal: reported, not judged, until the full glTF material lands)");
         }
-        if (verdict.is_err() && !pending) || control.is_ok() {
+        let known = KNOWN_BEAUTY_DISAGREEMENTS.contains(&entry.model.as_str());
+        if known {
+            println!("  (known: the reference's rough metal at grazing angles; must fail)");
+        }
+        if (verdict.is_err() != known && !pending) || control.is_ok() {
             failures.push(entry.model.clone());
         }
     }
