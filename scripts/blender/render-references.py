@@ -2,8 +2,8 @@
 
 For every shared model (../shared/gltf) and every model in scenes/gltf/, import it with
 Blender's glTF importer, set the camera (the file's first in depth-first node order, or
-Glint's framing camera), the world (a white sky of radiance 1 when the file has no
-punctual light) and render with Cycles:
+Glint's framing camera), the world (a white sky of radiance 1 when the file brings no
+light: no punctual light and no emissive material) and render with Cycles:
 
 - layers (1 sample at the pixel centre: box filter 0.01 px wide): depth (distance along
   the ray, Camera Data 'View Distance'), normal (Geometry 'True Normal': the geometric
