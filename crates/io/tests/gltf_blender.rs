@@ -351,24 +351,7 @@ fn compare_layers(reference: &BlenderReference, glint: &Features, entry: &Entry)
 
 /// Models whose layers Glint gets wrong today, with why (reported to the importer's
 /// author): they must keep disagreeing, so that the list is emptied once they are fixed.
-const KNOWN_LAYER_DISAGREEMENTS: [(&str, &str); 4] = [
-    (
-        "emissive",
-        "Glint's debug views give the emissive panel its clamped radiance as albedo (1) where \
-         the rule (and Glint's path tracer) gives its base colour (0)",
-    ),
-    (
-        "alpha_modes",
-        "Glint's first hit is the MASK quad where its alpha is below the cutoff (depth of \
-         the quad, albedo 0) instead of what lies behind the cut-out",
-    ),
-    (
-        "gltf-rs-box_sparse",
-        "the faces are wound inwards and single-sided: Glint culls them when shading but its \
-         layers record the culled face (its depth, albedo 0) instead of the face behind",
-    ),
-    ("gltf-rs-box_sparse-GLB", "as gltf-rs-box_sparse"),
-];
+const KNOWN_LAYER_DISAGREEMENTS: &[(&str, &str)] = &[];
 
 #[test]
 fn layers_match_blender() {

@@ -84,50 +84,85 @@ impl FirstHit {
     /// family and the debug views get them (the path tracer records them as it goes, by the
     /// same definition). Adds the ray it traces to `rays`.
     pub fn trace(scene: &Scene, camera_ray: &Ray, rays: &mut u64) -> FirstHit {
-        let ray = Ray {
+        let mut ray = Ray {
             direction: camera_ray.direction.normalized(),
             ..*camera_ray
         };
-        *rays += 1;
-        let Some(hit) = scene.intersect(&ray) else {
-            return FirstHit {
-                albedo: scene.background_radiance(ray.direction).clamp01(),
-                ..FirstHit::default()
+        // A surface that lets this ray pass whole (a cut-out, a culled back face) is not its
+        // first hit; a bounded number of them are stepped through.
+        let mut travelled = 0.0;
+        for _ in 0..MAX_PASSED_SURFACES {
+            *rays += 1;
+            let Some(hit) = scene.intersect(&ray) else {
+                return FirstHit {
+                    albedo: scene.background_radiance(ray.direction).clamp01(),
+                    ..FirstHit::default()
+                };
             };
-        };
-        let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
-        let bsdf = Bsdf::from_material(&scene.materials, &scene.textures, si.material, si.uv);
-        let albedo = match Material::get(&scene.materials, si.material) {
-            Material::Emissive { radiance, .. } if bsdf.is_black() => radiance.clamp01(),
-            // A physically based material's albedo is its resolved tree's, as the path
-            // tracer records it (rough plastics, whose tables are prepared per render, show
-            // none here).
-            Material::Physical(id) => {
+            let si = scene.surface(&ray, &hit, SurfaceNeeds::Uv);
+            let physical = |id: u32| {
                 let surface = scene.physical_surface(&ray, &hit);
                 crate::material::surface::SurfaceBsdf::new(
                     &scene.physical.bsdfs,
                     &scene.physical.textures,
                     &[],
                     &scene.textures,
-                    *id,
+                    id,
                     &surface,
                     -ray.direction,
                 )
-                .albedo()
-            }
-            _ => bsdf.albedo(),
-        };
-        FirstHit {
-            albedo,
-            normal: if ray.direction.dot(si.normal) > 0.0 {
-                -si.normal
-            } else {
-                si.normal
-            },
-            depth: hit.t,
+            };
+            // A physically based material's albedo is its resolved tree's, as the path
+            // tracer records it (rough plastics, whose tables are prepared per render, show
+            // none here); an emitter's is its surface's, or its radiance where it has none.
+            let surface_of = |material: &Material| match material {
+                Material::Physical(id) => Some(*id),
+                Material::Emissive {
+                    surface: Some(s), ..
+                } => match Material::get(&scene.materials, *s) {
+                    Material::Physical(id) => Some(*id),
+                    _ => None,
+                },
+                _ => None,
+            };
+            let material = Material::get(&scene.materials, si.material);
+            let albedo = match surface_of(material) {
+                Some(id) => {
+                    let bsdf = physical(id);
+                    if bsdf.passes_all() {
+                        travelled += hit.t;
+                        ray = Ray::spawn(si.point, ray.direction);
+                        continue;
+                    }
+                    bsdf.albedo()
+                }
+                None => {
+                    let bsdf =
+                        Bsdf::from_material(&scene.materials, &scene.textures, si.material, si.uv);
+                    match material {
+                        Material::Emissive { radiance, .. } if bsdf.is_black() => {
+                            radiance.clamp01()
+                        }
+                        _ => bsdf.albedo(),
+                    }
+                }
+            };
+            return FirstHit {
+                albedo,
+                normal: if ray.direction.dot(si.normal) > 0.0 {
+                    -si.normal
+                } else {
+                    si.normal
+                },
+                depth: travelled + hit.t,
+            };
         }
+        FirstHit::default()
     }
 }
+
+/// How many surfaces that let a ray pass whole `FirstHit::trace` steps through.
+const MAX_PASSED_SURFACES: usize = 16;
 
 /// One sample of a pixel.
 #[derive(Clone, Copy, Debug)]

@@ -327,6 +327,15 @@ impl SurfaceBsdf {
         self.count == 0
     }
 
+    /// True when every leaf lets light pass straight on (a mask's cut-out, a culled back
+    /// face): the surface is not there for this ray.
+    pub fn passes_all(&self) -> bool {
+        self.count > 0
+            && self.leaves[..self.count]
+                .iter()
+                .all(|leaf| matches!(leaf.family, Family::Null))
+    }
+
     /// Whether light sampling can find some leaf (Mitsuba's `Smooth` flag).
     pub fn has_non_delta(&self) -> bool {
         self.leaves[..self.count].iter().any(Leaf::has_non_delta)
