@@ -529,6 +529,19 @@ fn required_extensions_glint_lacks_are_refused_by_name() {
     .is_ok());
 }
 
+/// Found by the fuzzer: gltf-json's validation indexed the accessors with POSITION's value
+/// before checking it.
+#[test]
+fn an_attribute_naming_no_accessor_is_refused() {
+    let text = model(&TRIANGLE, &[0, 1, 2], "").replace(r#""POSITION": 0"#, r#""POSITION": 9"#);
+    let (line, column, message) = refused(&text);
+    assert_eq!((line, column), position_of(&text, "9}"), "{message}");
+    assert!(
+        message.contains("names accessor 9, but the model has 2"),
+        "{message}"
+    );
+}
+
 #[test]
 fn points_and_lines_are_refused_by_name() {
     for (mode, what) in [(0, "points"), (1, "lines"), (3, "lines")] {

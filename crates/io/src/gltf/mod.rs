@@ -248,6 +248,29 @@ fn check_required_members(
     let missing = |at: String, message: &str| {
         Err(diagnostics.error(locator.span(&at, diagnostics), message.to_string()))
     };
+    // gltf-json's own validation indexes `accessors` with a primitive's POSITION before it
+    // checks that index (a panic on a bad one): every attribute's accessor is checked here.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, primitive) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &primitive.attributes {
+                if index.value() >= root.accessors.len() {
+                    let name = match semantic {
+                        Checked::Valid(s) => s.to_string(),
+                        Checked::Invalid => "?".to_string(),
+                    };
+                    let at = format!("meshes[{m}].primitives[{p}].attributes[\"{name}\"]");
+                    return Err(diagnostics.error(
+                        locator.span(&at, diagnostics),
+                        format!(
+                            "the attribute {name} names accessor {}, but the model has {}",
+                            index.value(),
+                            root.accessors.len()
+                        ),
+                    ));
+                }
+            }
+        }
+    }
     for (i, image) in root.images.iter().enumerate() {
         if image.buffer_view.is_some() && image.mime_type.is_none() {
             return missing(
