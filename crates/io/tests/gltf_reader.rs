@@ -482,6 +482,16 @@ fn a_glb_whose_chunk_lengths_lie_is_refused() {
     assert!(load(&lying).is_err());
     // Cut inside the BIN chunk.
     assert!(load(&glb[..glb.len() - 10]).is_err());
+    // Found by the fuzzer: a declared length under the header's own 12 bytes, and a file
+    // that ends inside its header.
+    let mut lying = glb.clone();
+    lying[8..12].copy_from_slice(&3u32.to_le_bytes());
+    let error = match load(&lying) {
+        Err(error) => error.to_string(),
+        Ok(_) => panic!("a 3-byte GLB loaded"),
+    };
+    assert!(error.contains("fewer than the 12 of the header"), "{error}");
+    assert!(load(&glb[..10]).is_err());
 }
 
 #[test]

@@ -72,6 +72,26 @@ pub(crate) fn load(
 ) -> Result<LoadedScene, SceneError> {
     let glb;
     let (json, blob): (&[u8], Option<&[u8]>) = if bytes.starts_with(b"glTF") {
+        // The gltf crate subtracts the header's size from the length the header declares
+        // before comparing them (an overflow on a declared length under 12).
+        let declared = bytes
+            .get(8..12)
+            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+        if declared.is_none_or(|length| length < 12) {
+            let empty = Diagnostics::new(path, "");
+            return Err(empty.error(
+                Span { line: 1, column: 1 },
+                format!(
+                    "malformed GLB container: {}",
+                    match declared {
+                        None => format!("the file ({} bytes) ends inside its header", bytes.len()),
+                        Some(length) => format!(
+                            "the header declares {length} bytes, fewer than the 12 of the header"
+                        ),
+                    }
+                ),
+            ));
+        }
         glb = gltf::binary::Glb::from_slice(bytes).map_err(|error| {
             let empty = Diagnostics::new(path, "");
             empty.error(
