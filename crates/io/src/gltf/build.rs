@@ -671,12 +671,8 @@ impl<'a, 't> Builder<'a, 't> {
                     Some(self.texture_node(&texture, coord, transform, Decode::Alpha, &at)?);
             }
         }
-        if let Some(info) = pbr.metallic_roughness_texture() {
-            let coord = self.tex_coord(&info, &at)?;
-            let transform = transform_of(info.texture_transform());
-            p.metallic_roughness_texture =
-                Some(self.texture_node(&info.texture(), coord, transform, Decode::Raw, &at)?);
-        }
+        p.metallic_roughness_texture =
+            self.info_node(pbr.metallic_roughness_texture(), Decode::Raw, &at)?;
         let mut normal_set = None;
         if let Some(normal) = material.normal_texture() {
             let (coord, transform) = self.raw_info(
@@ -702,37 +698,14 @@ impl<'a, 't> Builder<'a, 't> {
             p.specular = specular.specular_factor();
             let [r, g, b] = specular.specular_color_factor();
             p.specular_color = Color::new(r, g, b);
-            if let Some(info) = specular.specular_texture() {
-                let coord = self.tex_coord(&info, &at)?;
-                let transform = transform_of(info.texture_transform());
-                p.specular_texture = Some(self.texture_node(
-                    &info.texture(),
-                    coord,
-                    transform,
-                    Decode::Alpha,
-                    &at,
-                )?);
-            }
-            if let Some(info) = specular.specular_color_texture() {
-                let coord = self.tex_coord(&info, &at)?;
-                let transform = transform_of(info.texture_transform());
-                p.specular_color_texture = Some(self.texture_node(
-                    &info.texture(),
-                    coord,
-                    transform,
-                    Decode::Srgb,
-                    &at,
-                )?);
-            }
+            p.specular_texture = self.info_node(specular.specular_texture(), Decode::Alpha, &at)?;
+            p.specular_color_texture =
+                self.info_node(specular.specular_color_texture(), Decode::Srgb, &at)?;
         }
         if let Some(transmission) = material.transmission() {
             p.transmission = transmission.transmission_factor();
-            if let Some(info) = transmission.transmission_texture() {
-                let coord = self.tex_coord(&info, &at)?;
-                let transform = transform_of(info.texture_transform());
-                p.transmission_texture =
-                    Some(self.texture_node(&info.texture(), coord, transform, Decode::Raw, &at)?);
-            }
+            p.transmission_texture =
+                self.info_node(transmission.transmission_texture(), Decode::Raw, &at)?;
         }
         let mut medium = None;
         if let Some(volume) = material.volume() {
@@ -802,14 +775,7 @@ impl<'a, 't> Builder<'a, 't> {
         let strength = material.emissive_strength().unwrap_or(1.0);
         let [er, eg, eb] = material.emissive_factor();
         let radiance = Color::new(er, eg, eb) * strength;
-        let emissive_texture = match material.emissive_texture() {
-            Some(info) => {
-                let coord = self.tex_coord(&info, &at)?;
-                let transform = transform_of(info.texture_transform());
-                Some(self.texture_node(&info.texture(), coord, transform, Decode::Srgb, &at)?)
-            }
-            None => None,
-        };
+        let emissive_texture = self.info_node(material.emissive_texture(), Decode::Srgb, &at)?;
         let emissive = (radiance.max_component() > 0.0 && radiance.is_finite())
             .then_some((radiance, emissive_texture));
         self.parts.physical.bsdfs.push(BsdfNode::Gltf(Box::new(p)));
@@ -820,6 +786,22 @@ impl<'a, 't> Builder<'a, 't> {
         let built = (id, emissive, medium, normal_set);
         self.materials.insert((index, has_color), built);
         Ok(built)
+    }
+
+    /// The `TextureNode` a texture info names (with its uv set and transform), if any.
+    fn info_node(
+        &mut self,
+        info: Option<gltf::texture::Info>,
+        decode: Decode,
+        at: &str,
+    ) -> Result<Option<u32>, SceneError> {
+        let Some(info) = info else {
+            return Ok(None);
+        };
+        let coord = self.tex_coord(&info, at)?;
+        let transform = transform_of(info.texture_transform());
+        self.texture_node(&info.texture(), coord, transform, decode, at)
+            .map(Some)
     }
 
     /// A texture info's uv set, warned down to 0 or 1 (KHR_texture_transform may override
