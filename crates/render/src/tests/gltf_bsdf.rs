@@ -29,7 +29,7 @@
 
 use super::chi2_sampling::{direction_at, sidak_level, FAMILY_SIGNIFICANCE};
 use super::scatter_harness::{
-    albedo_by_quadrature, bsdf_config, chi2_directions, draw_all, examine, mean, rejected,
+    albedo_by_quadrature, bsdf_config, check_at_level, chi2_directions, draw_all, mean, rejected,
     uniforms, Distorted, Distortion, Figures,
 };
 use crate::material::bsdf::BsdfSample;
@@ -100,26 +100,7 @@ const GOLD: Color = Color::new(1.0, 0.78, 0.34);
 
 /// Runs the harness, prints its figures and checks the p-value when continuous samples came.
 fn check(name: &str, bsdf: &GltfPbr, wo: Vec3) -> Figures {
-    let figures = examine(name, bsdf, wo, 0.0).unwrap_or_else(|e| panic!("{e}"));
-    eprintln!(
-        "FIGURE {name}: p = {:.4}, albedo {:.4} ± {:.4} (sampled), {:.4} continuous \
-         (quadrature), energy {:.4}, {:.3} continuous draws",
-        figures.p_value,
-        figures.albedo_sampled,
-        figures.standard_error,
-        figures.albedo_quadrature,
-        figures.energy,
-        figures.continuous
-    );
-    if figures.continuous > 0.0 {
-        let alpha = significance();
-        assert!(
-            figures.p_value > alpha,
-            "{name}: chi-square rejects the sampler (p = {:.2e}, α = {alpha:.2e})",
-            figures.p_value
-        );
-    }
-    figures
+    check_at_level(name, bsdf, wo, 0.0, significance)
 }
 
 // ---- 1. sampling against pdf ----------------------------------------------------------------

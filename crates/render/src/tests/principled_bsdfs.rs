@@ -19,7 +19,7 @@
 //! sheen at roughness 0. Every configuration prints its albedo.
 
 use super::chi2_sampling::{sidak_level, FAMILY_SIGNIFICANCE};
-use super::scatter_harness::{albedo_by_quadrature, examine, Figures};
+use super::scatter_harness::{albedo_by_quadrature, check_at_level, examine, Figures};
 use crate::material::bsdf::BsdfSample;
 use crate::material::fresnel::fresnel;
 use crate::material::principled::{
@@ -59,25 +59,7 @@ fn wo_at(theta_degrees: f32) -> Vec3 {
 /// Runs the harness, prints the figure line, checks the p-value against the family's level
 /// when any continuous sample came back, and returns the figures.
 fn check(name: &str, bsdf: &(dyn Scatter + Sync), wo: Vec3) -> Figures {
-    let figures = examine(name, bsdf, wo, 0.0).unwrap_or_else(|e| panic!("{e}"));
-    eprintln!(
-        "FIGURE {name}: p = {:.4}, furnace albedo {:.4} ± {:.4} (sampled), {:.4} \
-         (quadrature), {:.3} of draws returned",
-        figures.p_value,
-        figures.albedo_sampled,
-        figures.standard_error,
-        figures.albedo_quadrature,
-        figures.continuous
-    );
-    if figures.continuous > 0.0 {
-        let alpha = significance();
-        assert!(
-            figures.p_value > alpha,
-            "{name}: chi-square rejects the sampler (p = {:.2e}, α = {alpha:.2e})",
-            figures.p_value
-        );
-    }
-    figures
+    check_at_level(name, bsdf, wo, 0.0, significance)
 }
 
 /// Asserts the furnace bound with five standard errors of slack.
