@@ -293,6 +293,27 @@ pub struct Options {
           value_parser = clap::value_parser!(u32).range(1..))]
     pub rpp: Option<u32>,
 
+    /// Adaptive sampling (path tracers): stop sampling a pixel once the estimated relative
+    /// standard error of its mean is below T (0.01 is 1%; see docs/sampling.md), taking at
+    /// least --min-spp and at most -r samples; an .exr output gets a `samples` layer.
+    #[arg(long, value_name = "T", value_parser = parse_noise_threshold,
+          help_heading = SAMPLING_HEADING)]
+    pub noise_threshold: Option<f32>,
+
+    /// Samples every pixel takes before adaptive sampling first checks it.
+    #[arg(long, value_name = "N", requires = "noise_threshold",
+          value_parser = clap::value_parser!(u32).range(2..),
+          help_heading = SAMPLING_HEADING)]
+    pub min_spp: Option<u32>,
+
+    /// Time budget (path tracers): render in passes for about SECONDS, writing the image
+    /// after each pass, until the budget is spent or every pixel has -r samples (without -r:
+    /// until the budget is spent).
+    #[arg(long = "time", value_name = "SECONDS", value_parser = parse_time_budget,
+          conflicts_with_all = ["checkpoint", "resume", "sample_range"],
+          help_heading = SAMPLING_HEADING)]
+    pub time_budget: Option<f64>,
+
     /// Maximum recursion depth: reflection/refraction for the course integrator, scattering
     /// events for the path tracer [default: 4 for the course; for path the scene's max_depth
     /// (1 for its `direct` integrator), else unbounded (1024)].
@@ -435,6 +456,7 @@ pub struct Options {
     pub preview_close: bool,
 }
 
+const SAMPLING_HEADING: &str = "Adaptive sampling and time budgets";
 const PNG_HEADING: &str = "PNG output transform (EXR is always linear and untouched)";
 
 /// `--tonemap` values.
@@ -452,6 +474,29 @@ pub enum ToneMapArg {
 pub enum TransferArg {
     Srgb,
     Linear,
+}
+
+/// Parses `--noise-threshold`: a relative error above 0 and below 1.
+pub fn parse_noise_threshold(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(value) if value > 0.0 && value < 1.0 => Ok(value),
+        _ => Err(format!(
+            "expected a relative error between 0 and 1 (0.01 is 1%), got '{text}'"
+        )),
+    }
+}
+
+/// The longest `--time` budget: a year.
+pub const MAX_TIME_BUDGET: f64 = 365.0 * 24.0 * 3600.0;
+
+/// Parses `--time`: seconds above 0, at most `MAX_TIME_BUDGET`.
+pub fn parse_time_budget(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(value) if value > 0.0 && value <= MAX_TIME_BUDGET => Ok(value),
+        _ => Err(format!(
+            "expected a number of seconds above 0 and at most {MAX_TIME_BUDGET}, got '{text}'"
+        )),
+    }
 }
 
 /// Parses `--exposure`: a finite number of stops, within ±64 (2^64 overflows nothing in f32,

@@ -95,9 +95,10 @@ pub fn load(
     }
     if film.features.is_some() != settings.features
         || film.sums.is_some() != settings.sample_range.is_some()
+        || film.samples.is_some() != settings.adaptive.is_some()
     {
         return Err(UsageError(format!(
-            "cannot resume {name}: its layers (features, sample sums) differ from this run's \
+            "cannot resume {name}: its layers (features, sample sums, samples) differ from this run's \
              (the output format decides them)"
         )));
     }
@@ -121,6 +122,9 @@ pub fn append(film: &mut Film, band: Film) {
     if let (Some(ours), Some(theirs)) = (&mut film.sums, band.sums) {
         ours.radiance.extend(theirs.radiance);
         ours.counts.extend(theirs.counts);
+    }
+    if let (Some(ours), Some(theirs)) = (&mut film.samples, band.samples) {
+        ours.extend(theirs);
     }
 }
 
@@ -170,6 +174,7 @@ pub fn render(
                         radiance: Vec::new(),
                         counts: Vec::new(),
                     }),
+                samples: settings.adaptive.is_some().then(Vec::new),
                 ..Film::new(bounds.width(), 0)
             },
             0,

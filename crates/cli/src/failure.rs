@@ -36,6 +36,9 @@ pub enum Failure {
     Memory(String),
     /// Ctrl-C or SIGTERM with `--checkpoint` (exit 130): the finished rows are in the file.
     InterruptedWithCheckpoint(std::path::PathBuf),
+    /// Ctrl-C or SIGTERM during a `--time` render (exit 130): the image of the last finished
+    /// pass, `samples` per pixel, is in `output`.
+    InterruptedAfterPass { output: PathBuf, samples: u32 },
 }
 
 impl Failure {
@@ -47,7 +50,9 @@ impl Failure {
             | Failure::Memory(_)
             | Failure::GpuUnsupported(_) => 2,
             Failure::Write(_) | Failure::ThreadPool(_) | Failure::Gpu(_) => 1,
-            Failure::Interrupted | Failure::InterruptedWithCheckpoint(_) => EXIT_INTERRUPTED,
+            Failure::Interrupted
+            | Failure::InterruptedWithCheckpoint(_)
+            | Failure::InterruptedAfterPass { .. } => EXIT_INTERRUPTED,
         }
     }
 }
@@ -76,6 +81,12 @@ impl fmt::Display for Failure {
                 plural(*warnings as u64)
             ),
             Failure::Memory(why) => f.write_str(why),
+            Failure::InterruptedAfterPass { output, samples } => write!(
+                f,
+                "interrupted: {} holds the image of the last finished pass ({samples} samples \
+                 per pixel)",
+                output.display()
+            ),
             Failure::InterruptedWithCheckpoint(file) => write!(
                 f,
                 "interrupted: the finished rows are in {0}; continue with --resume {0}",

@@ -27,6 +27,8 @@ pub mod key {
     pub const VERSION: &str = "glint.version";
     /// `A..B`: the samples of each pixel this image holds.
     pub const SAMPLE_RANGE: &str = "glint.sample_range";
+    /// `T/N`: adaptive sampling's threshold and minimum samples (`none` without it).
+    pub const ADAPTIVE: &str = "glint.adaptive";
     /// Seconds spent rendering (summed over the parts of a merged image).
     pub const RENDER_TIME: &str = "glint.render_time";
     /// Rays traced (summed over the parts of a merged image).
@@ -34,7 +36,7 @@ pub mod key {
 }
 
 /// The keys whose values must agree for parts to be merged: everything that changes a pixel.
-pub const IDENTITY_KEYS: [&str; 8] = [
+pub const IDENTITY_KEYS: [&str; 9] = [
     key::VERSION,
     key::SCENE_HASH,
     key::IMAGE_SIZE,
@@ -43,6 +45,7 @@ pub const IDENTITY_KEYS: [&str; 8] = [
     key::SAMPLES_PER_PIXEL,
     key::MAX_DEPTH,
     key::ASPECT,
+    key::ADAPTIVE,
 ];
 
 /// Glint's version, as the metadata names it.
@@ -76,6 +79,13 @@ pub fn metadata(
                 .map_or_else(|| "auto".to_string(), |a| a.to_string()),
         ),
         (key::VERSION, VERSION.to_string()),
+        (
+            key::ADAPTIVE,
+            settings.adaptive.map_or_else(
+                || "none".to_string(),
+                |a| format!("{}/{}", a.threshold, a.min_samples),
+            ),
+        ),
         (
             key::SAMPLE_RANGE,
             format!("{}..{}", samples.start, samples.end),

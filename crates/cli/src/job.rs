@@ -8,7 +8,8 @@ use std::time::Duration;
 
 use glint_io::{DisplayTransform, PngEncoding, ToneMap, Transfer};
 use glint_render::{
-    Color, IntegratorKind, RenderDefaults, RenderSettings, RequestedSettings, SplitMethod,
+    AdaptiveSampling, Color, IntegratorKind, RenderDefaults, RenderSettings, RequestedSettings,
+    SplitMethod,
 };
 
 use crate::args::{Cli, Command, DeviceArg, Options, Rgb, ToneMapArg, TransferArg, MAX_SIDE};
@@ -72,6 +73,8 @@ pub struct Job {
     pub checkpoint: Option<Checkpointing>,
     /// Between progress lines when stderr is not a terminal.
     pub progress_every: Duration,
+    /// `--time`: render in passes for this long, writing the image after each.
+    pub time_budget: Option<Duration>,
     /// The options as given, to settle again with the scene's render defaults once it is
     /// loaded (`Job::with_scene_defaults`).
     options: Box<Options>,
@@ -100,6 +103,16 @@ impl Job {
             notes: settled.notes,
             ..self.clone()
         })
+    }
+}
+
+impl Job {
+    /// The job as a `--time` render that took `samples` per pixel ended: what its image
+    /// holds, for its metadata and the closing line.
+    pub fn with_samples_taken(&self, samples: u32) -> Job {
+        let mut job = self.clone();
+        job.settings.samples_per_pixel = samples;
+        job
     }
 }
 
@@ -231,6 +244,7 @@ impl Options {
             notes,
             checkpoint,
             progress_every: Duration::from_secs_f64(self.progress_every),
+            time_budget: self.time_budget.map(Duration::from_secs_f64),
             options,
         })
     }
@@ -242,7 +256,8 @@ impl Options {
         let scene_settled = RequestedSettings {
             width: self.width,
             height: self.height,
-            samples_per_pixel: self.rpp,
+            // A time budget without -r samples until the budget is spent.
+            samples_per_pixel: self.rpp.or(self.time_budget.map(|_| UNBOUNDED_SAMPLES)),
             integrator: self.integrator.map(IntegratorKind::from),
             max_depth: self.recursion_depth,
         }
@@ -286,9 +301,30 @@ impl Options {
             features: output_is_exr(output) && sample_range.is_none(),
             pixel_bounds,
             sample_range,
+            adaptive: self.noise_threshold.map(|threshold| AdaptiveSampling {
+                threshold,
+                min_samples: self.min_spp.unwrap_or(DEFAULT_MIN_SAMPLES),
+            }),
             ..scene_settled
         };
-        settings.validate().map_err(UsageError)?;
+        settings.validate().map_err(|why| {
+            UsageError(match settings.adaptive {
+                Some(_) => why.replace("adaptive sampling", "--noise-threshold"),
+                None => why,
+            })
+        })?;
+        if self.time_budget.is_some() {
+            settings.check_progressive("--time").map_err(UsageError)?;
+        }
+        if self.device == DeviceArg::Gpu
+            && (self.time_budget.is_some() || settings.adaptive.is_some())
+        {
+            return Err(UsageError(
+                "--time and --noise-threshold run on the CPU only (the GPU takes every sample in \
+                 every pixel); drop them or render with --device cpu"
+                    .to_string(),
+            ));
+        }
         // The path tracer takes exactly RPP samples; the course's grid takes N².
         let taken = settings.samples_per_pixel();
         if taken != rpp {
@@ -305,6 +341,14 @@ impl Options {
         })
     }
 }
+
+/// Samples per pixel of a time budget without `-r`: more than any budget takes.
+pub const UNBOUNDED_SAMPLES: u32 = 1 << 24;
+
+/// `--min-spp` when not given: enough samples that a pixel whose light arrives along rare
+/// paths (a caustic, a small light seen through glass) has likely met some before its error
+/// is first estimated.
+pub const DEFAULT_MIN_SAMPLES: u32 = 32;
 
 /// The PNG conversion: the display transform when any of its options is given, else the
 /// integrator's own. The course integrator keeps the course's conversion (its reference images

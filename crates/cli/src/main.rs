@@ -18,6 +18,7 @@ mod interrupt;
 mod job;
 mod memory;
 mod merge;
+mod passes;
 mod preview;
 mod progress;
 mod report;

@@ -6,9 +6,17 @@ use glint_render::{Background, SceneParts};
 use crate::failure::Failure;
 
 /// Bytes per pixel of a render: the pipeline's per-pixel values (40), the film (12), the
-/// 8-bit copy and its encoding (6), and with feature layers their film copies (28).
-pub fn film_bytes(settings: &glint_render::RenderSettings) -> u64 {
-    let per_pixel = if settings.features { 86 } else { 58 };
+/// 8-bit copy and its encoding (6), and with feature layers their film copies (28); adaptive
+/// sampling's counts (8); and for a render in passes (`progressive`, `--time`) the running
+/// sums each pixel keeps between passes, twice during a pass (256).
+pub fn film_bytes(settings: &glint_render::RenderSettings, progressive: bool) -> u64 {
+    let mut per_pixel = if settings.features { 86 } else { 58 };
+    if settings.adaptive.is_some() {
+        per_pixel += 8;
+    }
+    if progressive {
+        per_pixel += 256;
+    }
     u64::from(settings.width) * u64::from(settings.height) * per_pixel
 }
 
@@ -83,7 +91,7 @@ mod tests {
             height: 65_535,
             ..glint_render::RenderSettings::default()
         };
-        let film = film_bytes(&huge);
+        let film = film_bytes(&huge, false);
         assert!(film > 200 << 30, "{film}");
         let refused = check(film, 0, 0, 8 << 30).unwrap_err();
         assert_eq!(refused.exit_code(), 2);

@@ -262,6 +262,24 @@ fn merge(parts: &[Part]) -> Result<(Film, Vec<(String, String)>), Failure> {
             features
         });
 
+    // So does adaptive sampling's count of samples.
+    let samples = parts
+        .iter()
+        .all(|part| part.samples == full && part.film.samples.is_some())
+        .then(|| {
+            let mut samples = vec![0; pixel_count];
+            for part in parts {
+                let (film, taken) = (&part.film, part.film.samples.as_ref().expect("checked"));
+                for row in 0..film.height {
+                    let start = ((film.origin.1 + row) * width + film.origin.0) as usize;
+                    let local = (row * film.width) as usize;
+                    samples[start..start + film.width as usize]
+                        .copy_from_slice(&taken[local..local + film.width as usize]);
+                }
+            }
+            samples
+        });
+
     let mut metadata: Vec<(String, String)> = farm::IDENTITY_KEYS
         .iter()
         .map(|key| {
@@ -290,6 +308,7 @@ fn merge(parts: &[Part]) -> Result<(Film, Vec<(String, String)>), Failure> {
     let film = Film {
         pixels,
         features,
+        samples,
         ..Film::new(width, height)
     };
     Ok((film, metadata))

@@ -45,7 +45,7 @@ pub fn run(
     // be written, and the film fits in the memory budget.
     check_output(&job.output)?;
     remove_stale_partials(&job.output, err);
-    let film_bytes = memory::film_bytes(&job.settings);
+    let film_bytes = memory::film_bytes(&job.settings, job.time_budget.is_some());
     memory::check(film_bytes, 0, 0, job.max_memory)?;
     let loaded = load(job, &pool, film_bytes, err)?;
     // A scene may set its film, samples, integrator and depth (Mitsuba's do); flags win.
@@ -60,7 +60,7 @@ pub fn run(
         let _ = writeln!(err, "note: {note}");
     }
     let job = &settled;
-    let film_bytes = memory::film_bytes(&job.settings);
+    let film_bytes = memory::film_bytes(&job.settings, job.time_budget.is_some());
     check_memory(job, film_bytes, &loaded.parts)?;
     if job.device == DeviceArg::Gpu {
         return crate::gpu::run(job, &loaded.parts, interrupt, err, progress_bar);
@@ -70,6 +70,18 @@ pub fn run(
         print_settings(job, &built, err);
     }
     let rendered = render(job, &pool, &built, interrupt, err, progress_bar, preview)?;
+    // A time budget's image holds the samples it took, not the cap.
+    let taken_job;
+    let job = match rendered.samples_taken {
+        Some(samples) => {
+            taken_job = job.with_samples_taken(samples);
+            &taken_job
+        }
+        None => job,
+    };
+    if let Some(samples) = &rendered.film.samples {
+        print_adaptive(samples, err);
+    }
     warn_nonfinite(Device::Cpu, &rendered.stats, err);
     let write_time = write(job, &pool, &built, &rendered, err)?;
     let (rays, stats) = (rendered.stats.rays, rendered.stats);
@@ -123,6 +135,8 @@ struct Rendered {
     render_seconds: f64,
     /// This run's render, checkpoint writes included.
     time: Duration,
+    /// Samples per pixel a `--time` render took: what its image holds.
+    samples_taken: Option<u32>,
 }
 
 /// Notes about accepted options that have no effect.
@@ -232,6 +246,18 @@ fn build(job: &Job, pool: &rayon::ThreadPool, loaded: Loaded) -> Built {
     }
 }
 
+/// What adaptive sampling took: the mean, the fewest and the most samples per pixel.
+fn print_adaptive(samples: &[u32], err: &mut dyn Write) {
+    let (Some(fewest), Some(most)) = (samples.iter().min(), samples.iter().max()) else {
+        return;
+    };
+    let mean = samples.iter().map(|&n| n as f64).sum::<f64>() / samples.len() as f64;
+    let _ = writeln!(
+        err,
+        "adaptive sampling: {mean:.1} samples per pixel on average ({fewest} to {most})"
+    );
+}
+
 /// `-v`: how long the scene took to load and what is about to be rendered.
 fn print_settings(job: &Job, built: &Built, err: &mut dyn Write) {
     let _ = writeln!(
@@ -300,8 +326,10 @@ fn render(
             .sum(),
         None => tile_count(bounds),
     };
-    let bar = progress_bar.then(|| progress::bar(Unit::Tiles, total_tiles));
-    let log = (!progress_bar).then(|| {
+    // A render in passes prints a line a pass instead.
+    let passes = job.time_budget.is_some();
+    let bar = (progress_bar && !passes).then(|| progress::bar(Unit::Tiles, total_tiles));
+    let log = (!progress_bar && !passes).then(|| {
         ProgressLog::new(
             job.progress_every,
             u64::from(bounds.width()) * u64::from(bounds.height()),
@@ -323,8 +351,39 @@ fn render(
     };
     interrupt.set_phase(Phase::Rendering);
     let render_start = Instant::now();
-    let rendered = match &job.checkpoint {
-        Some(checkpointing) => checkpoint::render(
+    let mut samples_taken = None;
+    let rendered = match (&job.checkpoint, job.time_budget) {
+        (_, Some(budget)) => {
+            let options = glint_io::WriteOptions { png: job.png };
+            let mut write = |film: &Film, stats: &RenderStats, seconds: f64, samples: u32| {
+                let taken = RenderSettings {
+                    samples_per_pixel: samples,
+                    ..settings.clone()
+                };
+                let metadata = built.metadata(&taken, stats.rays, seconds);
+                pool.install(|| {
+                    glint_io::write_image_with_metadata(&job.output, film, &options, &metadata)
+                })
+                .map_err(Failure::Write)
+            };
+            crate::passes::render(
+                pool,
+                &built.scene,
+                settings,
+                budget,
+                &job.output,
+                &progress,
+                interrupt,
+                &mut write,
+                err,
+            )
+            .map(|budgeted| {
+                samples_taken = Some(budgeted.samples);
+                let seconds = render_start.elapsed().as_secs_f64();
+                (budgeted.film, budgeted.stats, seconds)
+            })
+        }
+        (Some(checkpointing), None) => checkpoint::render(
             pool,
             &built.scene,
             settings,
@@ -336,11 +395,13 @@ fn render(
             interrupt,
         )
         .map(|banded| (banded.film, banded.stats, banded.render_seconds)),
-        None => match pool.install(|| glint_render::render(&built.scene, settings, &progress)) {
-            Ok((film, stats)) => Ok((film, stats, render_start.elapsed().as_secs_f64())),
-            Err(RenderError::Invalid(why)) => Err(Failure::Usage(UsageError(why))),
-            Err(RenderError::Cancelled) => Err(Failure::Interrupted),
-        },
+        (None, None) => {
+            match pool.install(|| glint_render::render(&built.scene, settings, &progress)) {
+                Ok((film, stats)) => Ok((film, stats, render_start.elapsed().as_secs_f64())),
+                Err(RenderError::Invalid(why)) => Err(Failure::Usage(UsageError(why))),
+                Err(RenderError::Cancelled) => Err(Failure::Interrupted),
+            }
+        }
     };
     let time = render_start.elapsed();
     if let Some(bar) = &bar {
@@ -360,6 +421,7 @@ fn render(
         stats,
         render_seconds,
         time,
+        samples_taken,
     })
 }
 

@@ -328,6 +328,8 @@ pub const ALBEDO_LAYER: &str = "Denoising Albedo.";
 pub const NORMAL_LAYER: &str = "Denoising Normal.";
 /// The EXR channel of the depth layer (Blender's `Depth` pass, channel `Z`).
 pub const DEPTH_CHANNEL: &str = "Depth.Z";
+/// The EXR channel of the samples each pixel took (`Film::samples`), 32-bit unsigned.
+pub const SAMPLES_CHANNEL: &str = "samples";
 
 /// One EXR part with f32 channels R, G, B (the beauty), the feature layers' channels and the
 /// sample sums, rows from the top, as the `exr` crate stores them; the display window is the
@@ -371,6 +373,12 @@ fn encode_exr(
         channels.push(AnyChannel::new(
             DEPTH_CHANNEL,
             FlatSamples::F32(features.depth.clone()),
+        ));
+    }
+    if let Some(samples) = &film.samples {
+        channels.push(AnyChannel::new(
+            SAMPLES_CHANNEL,
+            FlatSamples::U32(samples.clone()),
         ));
     }
     if let Some(sums) = &film.sums {
@@ -507,11 +515,13 @@ pub fn read_exr(path: &Path) -> Result<ExrFile, ImageReadError> {
         (None, None, None) => None,
         _ => return Err(error("the feature layers are incomplete".into())),
     };
-    let counts = match channel("count") {
-        None => None,
-        Some(exr::prelude::FlatSamples::U32(values)) => Some(values.clone()),
-        Some(_) => return Err(error("channel count is not 32-bit unsigned".into())),
+    let unsigned = |name: &str| match channel(name) {
+        None => Ok(None),
+        Some(exr::prelude::FlatSamples::U32(values)) => Ok(Some(values.clone())),
+        Some(_) => Err(error(format!("channel {name} is not 32-bit unsigned"))),
     };
+    let counts = unsigned("count")?;
+    film.samples = unsigned(SAMPLES_CHANNEL)?;
     film.sums = match (colors("sum.", ["R", "G", "B"])?, counts) {
         (Some(radiance), Some(counts)) => Some(glint_render::SampleSums { radiance, counts }),
         (None, None) => None,

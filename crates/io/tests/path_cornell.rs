@@ -15,14 +15,17 @@
 //!
 //! `cornell_matches_mitsuba_128spp` runs always (N = 128, a few seconds on 2 cores);
 //! `cornell_matches_mitsuba_1024spp` is the full comparison at 1024 spp, also always (about a
-//! minute on 2 cores); `--nocapture` prints the figures.
+//! minute on 2 cores); `cornell_matches_mitsuba_with_adaptive_sampling` is the same comparison
+//! with adaptive sampling on (at most 1024 spp), which must also take fewer samples than that:
+//! stopping pixels on an estimate of their error must not bias the image. `--nocapture`
+//! prints the figures.
 
 mod common;
 
 use std::path::PathBuf;
 
 use glint_render::testing::compare::{judge, scaled, Criterion, Pixel, Reference};
-use glint_render::Scene;
+use glint_render::{AdaptiveSampling, IntegratorKind, RenderSettings, Scene};
 
 const SIZE: u32 = 256;
 /// σ²_r, the reference's own noise in relMSE (module docs).
@@ -44,16 +47,40 @@ fn load_reference() -> Vec<Pixel> {
     common::read_reference(&cornell_dir().join("mitsuba_256_4096spp.exr"), SIZE)
 }
 
-fn render(scene: &Scene, samples: u32, seed: u64) -> Vec<Pixel> {
-    common::render_path(scene, SIZE, samples, seed)
+fn render(
+    scene: &Scene,
+    samples: u32,
+    seed: u64,
+    adaptive: Option<AdaptiveSampling>,
+) -> Vec<Pixel> {
+    let settings = RenderSettings {
+        width: SIZE,
+        height: SIZE,
+        samples_per_pixel: samples,
+        seed,
+        integrator: IntegratorKind::Path,
+        adaptive,
+        ..RenderSettings::default()
+    };
+    let (film, stats) = glint_render::render(scene, &settings, &|_| true).unwrap();
+    assert_eq!(stats.nonfinite_samples, 0);
+    if let Some(taken) = &film.samples {
+        let mean = taken.iter().map(|&n| n as f64).sum::<f64>() / taken.len() as f64;
+        println!("adaptive half, seed {seed}: {mean:.1} samples per pixel of at most {samples}");
+        assert!(
+            mean < 0.8 * samples as f64,
+            "adaptive sampling took {mean:.1} of {samples} samples per pixel"
+        );
+    }
+    glint_render::testing::compare::to_pixels(&film.pixels)
 }
 
-fn compare_with_mitsuba(samples: u32) {
+fn compare_with_mitsuba(samples: u32, adaptive: Option<AdaptiveSampling>) {
     let scene = load_cornell();
     let reference = load_reference();
     let start = std::time::Instant::now();
-    let first = render(&scene, samples / 2, 1);
-    let second = render(&scene, samples / 2, 2);
+    let first = render(&scene, samples / 2, 1, adaptive);
+    let second = render(&scene, samples / 2, 2, adaptive);
     let seconds = start.elapsed().as_secs_f64();
     let criterion = Criterion::new(SIZE, SIZE, BLOCK);
     let mitsuba = Reference::Measured {
@@ -84,11 +111,22 @@ fn compare_with_mitsuba(samples: u32) {
 
 #[test]
 fn cornell_matches_mitsuba_128spp() {
-    compare_with_mitsuba(128);
+    compare_with_mitsuba(128, None);
 }
 
 /// The full comparison at 1024 samples per pixel: about a minute on 2 cores.
 #[test]
 fn cornell_matches_mitsuba_1024spp() {
-    compare_with_mitsuba(1024);
+    compare_with_mitsuba(1024, None);
+}
+
+/// The same with adaptive sampling at a 3% threshold: each half takes from 32 to 512 samples
+/// per pixel.
+#[test]
+fn cornell_matches_mitsuba_with_adaptive_sampling() {
+    let adaptive = AdaptiveSampling {
+        threshold: 0.03,
+        min_samples: 32,
+    };
+    compare_with_mitsuba(1024, Some(adaptive));
 }

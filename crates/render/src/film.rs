@@ -23,6 +23,9 @@ pub struct Film {
     /// Each pixel's unnormalised sum and sample count, when `RenderSettings::sample_range` was
     /// given: what a farm adds up across sample ranges (see [`SampleSums`]).
     pub sums: Option<SampleSums>,
+    /// The samples each pixel took (laid out as `pixels`), when adaptive sampling chose them
+    /// or a progressive render is under way.
+    pub samples: Option<Vec<u32>>,
 }
 
 /// The partial result of a sample range, laid out as `Film::pixels`: `radiance[i]` is the sum
@@ -65,6 +68,7 @@ impl Film {
             full_size: (width, height),
             features: None,
             sums: None,
+            samples: None,
         }
     }
 

@@ -170,6 +170,72 @@ pub struct RenderSettings {
     /// Worker threads; `None` runs on the rayon pool `render` is called in (all cores by
     /// default).
     pub threads: Option<usize>,
+    /// Stop sampling each pixel once its estimated error is small enough
+    /// ([`AdaptiveSampling`]); `None` takes every sample in every pixel.
+    pub adaptive: Option<AdaptiveSampling>,
+}
+
+/// Adaptive sampling: every pixel takes `min_samples` samples, then the render goes on in
+/// passes to fixed sample counts (`check_after`), and after each pass a pixel stops when the
+/// error estimate of its neighbourhood is below `threshold`, or at `samples_per_pixel`, the
+/// cap.
+///
+/// A pixel's own estimate is the relative standard error of its mean, with the dark pixels'
+/// floor of relative MSE: with `n` finite samples of per-channel mean `m` and sample variance
+/// `s²`, `e² = Σ s²/n / (Σ m² + 3·0.01)` over R, G, B (`error_squared`). A pixel stops when
+/// the mean of `e²` over its 3x3 neighbourhood (within the rendered rectangle) is below the
+/// threshold's square. Pooling is what keeps the image unbiased in practice: a pixel judged
+/// on its own samples alone stops early exactly when its first samples happened to miss the
+/// rare bright paths (its variance and its mean are both low), and the image comes out dark
+/// where light arrives along rare paths (20% in the Cornell box's shadows at a 3% threshold);
+/// the neighbours' samples are independent of the pixel's, and outweigh them eight to one.
+/// Cycles, after Dammertz et al., instead compares the mean of all samples with the mean of
+/// half of them and spreads unconverged pixels to their neighbours.
+///
+/// The decisions depend on the rendered rectangle only at its edges, where fewer neighbours
+/// exist: the same settings give the same image on any number of threads, and a crop window
+/// or farm tile gives the same pixels as the whole render except near its edges, where the
+/// samples differ but not the expected value.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AdaptiveSampling {
+    /// The relative error at which a pixel stops (0.01 is 1%).
+    pub threshold: f32,
+    /// Samples every pixel takes before the first check (at least 2: a variance needs two).
+    pub min_samples: u32,
+}
+
+/// Added to the mean's square in `AdaptiveSampling`'s estimate, per channel: relative MSE's
+/// floor for dark pixels, so that they do not take every sample to reach a relative error.
+const DARK_FLOOR: f64 = 0.01;
+
+impl AdaptiveSampling {
+    /// The first sample count above `taken` at which a pixel's error is checked: the minimum,
+    /// then a quarter more each time (at least four samples), so that a pixel stops at most a
+    /// quarter past the count its error first allowed, and is tested only O(log n) times (each
+    /// test is a chance to stop on a lucky run of samples).
+    pub fn check_after(&self, taken: u32) -> u32 {
+        let mut check = self.min_samples.max(2);
+        while check <= taken && check < u32::MAX {
+            check = check.saturating_add((check / 4).max(4));
+        }
+        check
+    }
+
+    /// The squared error estimate `e²` of a pixel whose `n` finite samples sum to `sum`, with
+    /// squares summing to `squares` (infinite below two samples: no variance yet).
+    pub(crate) fn error_squared(sum: Color, squares: [f64; 3], n: u32) -> f64 {
+        if n < 2 {
+            return f64::INFINITY;
+        }
+        let n = n as f64;
+        let (mut variance, mut mean_squared) = (0.0, 0.0);
+        for (total, squares) in sum.to_array().into_iter().zip(squares) {
+            let mean = total as f64 / n;
+            variance += ((squares - n * mean * mean) / (n - 1.0)).max(0.0);
+            mean_squared += mean * mean;
+        }
+        variance / n / (mean_squared + 3.0 * DARK_FLOOR)
+    }
 }
 
 impl Default for RenderSettings {
@@ -186,6 +252,7 @@ impl Default for RenderSettings {
             pixel_bounds: None,
             sample_range: None,
             threads: None,
+            adaptive: None,
         }
     }
 }
@@ -247,6 +314,37 @@ impl RenderSettings {
             if !(aspect.is_finite() && aspect > 0.0) {
                 return Err(format!("the aspect ratio must be positive, not {aspect}"));
             }
+        }
+        if let Some(adaptive) = &self.adaptive {
+            let threshold = adaptive.threshold;
+            if !(threshold.is_finite() && threshold > 0.0) {
+                return Err(format!(
+                    "the noise threshold must be a positive number, not {threshold}"
+                ));
+            }
+            self.check_progressive("adaptive sampling")?;
+        }
+        Ok(())
+    }
+
+    /// Why these settings cannot sample a pixel a few samples at a time (adaptive sampling,
+    /// `ProgressiveRender`), if they cannot: only the path tracers can (the course integrator
+    /// takes its samples on a grid, and the debug views take one), and not in a farm's sample
+    /// range (a range does not know the samples before it).
+    pub fn check_progressive(&self, what: &str) -> Result<(), String> {
+        if !matches!(
+            self.integrator,
+            IntegratorKind::Path | IntegratorKind::VolPath
+        ) {
+            return Err(format!(
+                "{what} is for the path tracers (path, volpath), not the {} integrator",
+                self.integrator.name()
+            ));
+        }
+        if self.sample_range.is_some() {
+            return Err(format!(
+                "{what} cannot render a sample range: a range does not see the samples before it"
+            ));
         }
         Ok(())
     }
@@ -378,6 +476,15 @@ pub fn render(
     progress: &(dyn Fn(&Progress) -> bool + Sync),
 ) -> Result<(Film, RenderStats), RenderError> {
     settings.validate().map_err(RenderError::Invalid)?;
+    if let Some(adaptive) = settings.adaptive {
+        // In passes from one check to the next, the decisions taken between them.
+        let mut passes = ProgressiveRender::new(scene, settings)?;
+        while !passes.is_finished() {
+            let taken = passes.samples_taken();
+            passes.pass(adaptive.check_after(taken) - taken, progress)?;
+        }
+        return Ok((passes.film(), passes.stats()));
+    }
     match settings.threads {
         Some(threads) => {
             let pool = rayon::ThreadPoolBuilder::new()
@@ -442,12 +549,16 @@ struct PixelValue {
     /// The unnormalised sum of the finite samples and their count.
     sum: Color,
     count: u32,
+    /// Samples taken, the dropped ones included.
+    taken: u32,
     albedo: Color,
     normal: Vec3,
     depth: f32,
 }
 
-/// What a pixel's samples add up to while they arrive (`PixelSums::add`), in sample order.
+/// What a pixel's samples add up to while they arrive (`PixelSums::add`), in sample order,
+/// and where the pixel stands: the next sample to take, and whether adaptive sampling has
+/// stopped it. A progressive render keeps one for each pixel between its passes.
 #[derive(Clone, Copy, Debug, Default)]
 struct PixelSums {
     value: PixelValue,
@@ -455,9 +566,43 @@ struct PixelSums {
     valid: u32,
     dropped: u32,
     feature_count: u32,
+    /// The finite samples' squares per channel, for adaptive sampling's variance.
+    squares: [f64; 3],
+    /// The pixel's next sample index, and the first it took.
+    next: u32,
+    first: u32,
+    converged: bool,
 }
 
 impl PixelSums {
+    /// A pixel whose first sample is `first`.
+    fn starting_at(first: u32) -> PixelSums {
+        PixelSums {
+            next: first,
+            first,
+            ..PixelSums::default()
+        }
+    }
+
+    /// Adds a sample's squares (once `add` has added the sample) for adaptive sampling.
+    #[inline]
+    fn add_squares(&mut self, radiance: Color) {
+        if radiance.is_finite() {
+            for (square, v) in self.squares.iter_mut().zip(radiance.to_array()) {
+                *square += (v as f64) * (v as f64);
+            }
+        }
+    }
+
+    /// The pixel's current mean, black before any finite sample: what a preview shows.
+    fn mean(&self) -> Color {
+        if self.valid == 0 {
+            Color::ZERO
+        } else {
+            self.sum / self.valid as f32
+        }
+    }
+
     /// The one place a sample becomes part of a pixel.
     #[inline]
     fn add(&mut self, sample: Sample) {
@@ -484,18 +629,22 @@ impl PixelSums {
         }
     }
 
-    /// The finished pixel (`pixel_index`'s dropped samples counted in `counters`).
-    fn finish(self, features: bool, pixel_index: u64, counters: &mut TileCounters) -> PixelValue {
+    /// The finished pixel and how many of its samples were dropped.
+    fn finish(self, features: bool) -> (PixelValue, u32) {
         let PixelSums {
             mut value,
             sum,
             valid,
             mut dropped,
             feature_count,
+            next,
+            first,
+            ..
         } = self;
         // Unnormalised, for farm parts that are added up later (`Film::sums`).
         value.sum = sum;
         value.count = valid;
+        value.taken = next - first;
         if valid > 0 {
             value.beauty = sum / valid as f32;
             // Finite samples can still overflow their sum (two of 3e38): then none of them is
@@ -519,8 +668,71 @@ impl PixelSums {
                 dropped += feature_count;
             }
         }
-        counters.dropped_samples(pixel_index, dropped);
-        value
+        (value, dropped)
+    }
+}
+
+/// Takes the samples of a run of `pixels` from where each stands (`PixelSums::next`) up to
+/// `end`, in one call. With `adaptive`, pixels that have converged take none, and the others
+/// also add up their samples' squares.
+#[inline]
+fn sample_run<I: Integrator>(
+    integrator: &I,
+    scene: &Scene,
+    pixels: &[PixelContext],
+    sums: &mut [PixelSums],
+    end: u32,
+    adaptive: bool,
+    rays: &mut u64,
+) {
+    if !adaptive {
+        // The pixels of a run start together, at the range's start.
+        let start = sums.first().map_or(end, |s| s.next);
+        if start < end {
+            integrator.run_samples(scene, pixels, start..end, rays, &mut |i, sample| {
+                sums[i].add(sample)
+            });
+            for pixel in sums.iter_mut() {
+                pixel.next = end;
+            }
+        }
+        return;
+    }
+    let Some(&first) = pixels.first() else {
+        return;
+    };
+    let mut active = [0usize; RUN];
+    let mut contexts = [first; RUN];
+    loop {
+        // The pixels still sampling all stand at the same sample, a pass's start; a pixel
+        // behind them has converged.
+        let waiting = |p: &PixelSums| !p.converged && p.next < end;
+        let Some(start) = sums.iter().filter(|p| waiting(p)).map(|p| p.next).min() else {
+            return;
+        };
+        let mut count = 0;
+        for (i, pixel) in sums.iter().enumerate() {
+            if waiting(pixel) && pixel.next == start {
+                active[count] = i;
+                contexts[count] = pixels[i];
+                count += 1;
+            }
+        }
+        integrator.run_samples(
+            scene,
+            &contexts[..count],
+            start..end,
+            rays,
+            &mut |j, sample| {
+                let pixel = &mut sums[active[j]];
+                let radiance = sample.radiance;
+                pixel.add(sample);
+                pixel.add_squares(radiance);
+            },
+        );
+        for &i in &active[..count] {
+            sums[i].next = end;
+        }
     }
 }
 
@@ -535,37 +747,65 @@ fn render_with<I: Integrator>(
     integrator: &I,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
 ) -> Result<(Film, RenderStats), RenderError> {
-    let bounds = settings.bounds();
-    let film = |pixels, features, sums| Film {
-        width: bounds.width(),
-        height: bounds.height(),
-        pixels,
-        origin: (bounds.x0, bounds.y0),
-        full_size: (settings.width, settings.height),
-        features,
-        sums,
-    };
     // The tiles keep what the film takes: the beauty alone (12 bytes a pixel) unless the
-    // features or a sample range's sums are asked for (all of `PixelValue`, 56 bytes): the
-    // tiles of a 1024x1024 frame were 56 MB of fresh pages to fault in and gather from.
-    if !settings.features && settings.sample_range.is_none() {
+    // features, a sample range's sums or adaptive sampling's counts are asked for (all of
+    // `PixelValue`, 60 bytes): the tiles of a 1024x1024 frame were 56 MB of fresh pages to
+    // fault in and gather from.
+    if !settings.features && settings.sample_range.is_none() && settings.adaptive.is_none() {
         let (values, stats) =
             render_values(scene, settings, integrator, progress, |v| v.beauty, |c| *c)?;
-        return Ok((film(values.gather(|c| *c), None, None), stats));
+        let film = Film {
+            pixels: values.gather(|c| *c),
+            ..empty_film(settings)
+        };
+        return Ok((film, stats));
     }
     let (values, stats) =
         render_values(scene, settings, integrator, progress, |v| v, |v| v.beauty)?;
+    let samples = settings.adaptive.is_some();
+    Ok((film_of(&values, settings, samples, |v| *v), stats))
+}
+
+/// The film of `settings` without pixels (its rectangle and the whole image's size).
+fn empty_film(settings: &RenderSettings) -> Film {
+    let bounds = settings.bounds();
+    Film {
+        width: bounds.width(),
+        height: bounds.height(),
+        pixels: Vec::new(),
+        origin: (bounds.x0, bounds.y0),
+        full_size: (settings.width, settings.height),
+        features: None,
+        sums: None,
+        samples: None,
+    }
+}
+
+/// The film of tiles of finished pixels (`value` reads one), with what `settings` asked for
+/// (the feature layers, a sample range's sums) and, if `samples`, the samples each took.
+fn film_of<P: Default + Sync>(
+    values: &TilePixels<P>,
+    settings: &RenderSettings,
+    samples: bool,
+    value: impl Fn(&P) -> PixelValue + Sync + Send,
+) -> Film {
     let features = settings.features.then(|| Features {
-        albedo: values.gather(|v| v.albedo),
-        normal: values.gather(|v| v.normal),
-        depth: values.gather(|v| v.depth),
+        albedo: values.gather(|p| value(p).albedo),
+        normal: values.gather(|p| value(p).normal),
+        depth: values.gather(|p| value(p).depth),
     });
     // Kept only for a sample range, the one case where a farm adds pixels up.
     let sums = settings.sample_range.is_some().then(|| SampleSums {
-        radiance: values.gather(|v| v.sum),
-        counts: values.gather(|v| v.count),
+        radiance: values.gather(|p| value(p).sum),
+        counts: values.gather(|p| value(p).count),
     });
-    Ok((film(values.gather(|v| v.beauty), features, sums), stats))
+    Film {
+        pixels: values.gather(|p| value(p).beauty),
+        features,
+        sums,
+        samples: samples.then(|| values.gather(|p| value(p).taken)),
+        ..empty_film(settings)
+    }
 }
 
 /// The integrator's pixels of `settings.bounds()`, tile by tile, each kept as `keep` makes it
@@ -578,9 +818,42 @@ fn render_values<I: Integrator, P: Copy + Default + Send>(
     keep: impl Fn(PixelValue) -> P + Sync,
     beauty: impl Fn(&P) -> Color + Sync,
 ) -> Result<(TilePixels<P>, RenderStats), RenderError> {
-    let (width, height) = (settings.width, settings.height);
     let samples = settings.samples();
-    let context = |x: u32, y: u32| PixelContext {
+    let context = pixel_context(settings);
+    render_tiles(
+        settings.bounds(),
+        settings.width,
+        progress,
+        beauty,
+        |_tile, xs, y, counters, out| {
+            let mut pixels = [context(xs.start, y); RUN];
+            let count = xs.len();
+            for (pixel, x) in pixels.iter_mut().zip(xs) {
+                pixel.x = x;
+            }
+            let mut sums = [PixelSums::starting_at(samples.start); RUN];
+            sample_run(
+                integrator,
+                scene,
+                &pixels[..count],
+                &mut sums[..count],
+                samples.end,
+                false,
+                &mut counters.rays,
+            );
+            for (pixel, sums) in pixels[..count].iter().zip(sums) {
+                let (value, dropped) = sums.finish(settings.features);
+                counters.dropped_samples(pixel.index(), dropped);
+                out.push(keep(value));
+            }
+        },
+    )
+}
+
+/// The integrator's view of pixel (x, y) under `settings`.
+fn pixel_context(settings: &RenderSettings) -> impl Fn(u32, u32) -> PixelContext + Sync + '_ {
+    let (width, height) = (settings.width, settings.height);
+    move |x, y| PixelContext {
         x,
         y,
         width,
@@ -590,35 +863,247 @@ fn render_values<I: Integrator, P: Copy + Default + Send>(
         samples_per_pixel: settings.samples_per_pixel(),
         max_depth: settings.max_depth(),
         features: settings.features,
-    };
-    render_tiles(
-        settings.bounds(),
-        width,
-        progress,
-        beauty,
-        |xs, y, counters, out| {
-            let mut pixels = [context(xs.start, y); RUN];
-            let count = xs.len();
-            for (pixel, x) in pixels.iter_mut().zip(xs) {
-                pixel.x = x;
+    }
+}
+
+/// A render taken in passes, each adding samples to every pixel still sampling, with the
+/// image available between passes (`film`): what a time budget, a progressive preview and a
+/// page that refines its image stand on. The pixels keep their running sums between passes,
+/// so that the samples a pixel takes, and the order they are added in, do not depend on how
+/// the samples were split into passes: after the last pass the film is the one `render`
+/// gives with the same settings, bit for bit. With `RenderSettings::adaptive`, pixels stop
+/// as they would in `render`.
+///
+/// It holds about 100 bytes a pixel between passes (the sums, the squares adaptive sampling
+/// needs, the features) and twice that during a pass, whose new sums replace the old only when
+/// it completes: a cancelled pass leaves the render as the last pass left it.
+pub struct ProgressiveRender<'a> {
+    scene: &'a Scene,
+    settings: RenderSettings,
+    pool: Option<rayon::ThreadPool>,
+    pixels: TilePixels<PixelSums>,
+    /// Samples `0..taken` of every pixel still sampling have been taken.
+    taken: u32,
+    /// Adaptive sampling decides at the end of the pass that reaches this count.
+    next_check: u32,
+    stats: RenderStats,
+}
+
+impl<'a> ProgressiveRender<'a> {
+    /// A render of `scene` as `settings` say, no sample taken yet. Refuses what `render` does,
+    /// and what cannot sample progressively (`RenderSettings::check_progressive`).
+    pub fn new(
+        scene: &'a Scene,
+        settings: &RenderSettings,
+    ) -> Result<ProgressiveRender<'a>, RenderError> {
+        settings.validate().map_err(RenderError::Invalid)?;
+        settings
+            .check_progressive("a progressive render")
+            .map_err(RenderError::Invalid)?;
+        let pool = match settings.threads {
+            Some(threads) => Some(
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .thread_name(|index| format!("glint-render-{index}"))
+                    .build()
+                    .map_err(|error| {
+                        RenderError::Invalid(format!("cannot start {threads} threads: {error}"))
+                    })?,
+            ),
+            None => None,
+        };
+        let bounds = settings.bounds();
+        let tiles_x = bounds.width().div_ceil(TILE_SIZE);
+        let tiles_y = bounds.height().div_ceil(TILE_SIZE);
+        let tiles = (0..tiles_x * tiles_y)
+            .map(|tile| {
+                let width = TILE_SIZE.min(bounds.width() - (tile % tiles_x) * TILE_SIZE);
+                let height = TILE_SIZE.min(bounds.height() - (tile / tiles_x) * TILE_SIZE);
+                vec![PixelSums::starting_at(0); (width * height) as usize]
+            })
+            .collect();
+        Ok(ProgressiveRender {
+            scene,
+            settings: settings.clone(),
+            pool,
+            pixels: TilePixels {
+                bounds,
+                tiles_x,
+                tiles,
+            },
+            taken: 0,
+            next_check: settings.adaptive.map_or(0, |a| a.check_after(0)),
+            stats: RenderStats::default(),
+        })
+    }
+
+    /// Samples taken so far by every pixel still sampling.
+    pub fn samples_taken(&self) -> u32 {
+        self.taken
+    }
+
+    /// Whether no pass would add a sample: every pixel has its `samples_per_pixel`, or has
+    /// converged.
+    pub fn is_finished(&self) -> bool {
+        self.taken >= self.settings.samples_per_pixel() || self.sampling_pixels() == 0
+    }
+
+    /// Pixels that have not converged (all of them without adaptive sampling).
+    pub fn sampling_pixels(&self) -> u64 {
+        self.pixels
+            .tiles
+            .iter()
+            .flatten()
+            .filter(|p| !p.converged)
+            .count() as u64
+    }
+
+    /// What the passes so far have counted.
+    pub fn stats(&self) -> RenderStats {
+        self.stats
+    }
+
+    /// Takes up to `samples` more samples in every pixel still sampling (at least one, and
+    /// not beyond `samples_per_pixel`), calling `progress` after each tile as `render` does;
+    /// returns what this pass counted. Cancelled, it leaves the render as it was.
+    pub fn pass(
+        &mut self,
+        samples: u32,
+        progress: &(dyn Fn(&Progress) -> bool + Sync),
+    ) -> Result<RenderStats, RenderError> {
+        let end = self
+            .taken
+            .saturating_add(samples.max(1))
+            .min(self.settings.samples_per_pixel());
+        let scene = self.scene;
+        let depth = self.settings.max_depth();
+        let run = || match self.settings.integrator {
+            IntegratorKind::Path => self.run_pass(
+                &PathIntegrator::new(scene, PathSettings::for_scene(scene, depth)),
+                end,
+                progress,
+            ),
+            IntegratorKind::VolPath => self.run_pass(
+                &VolPathIntegrator::new(scene, PathSettings::for_scene(scene, depth)),
+                end,
+                progress,
+            ),
+            other => Err(RenderError::Invalid(format!(
+                "the {} integrator cannot render progressively",
+                other.name()
+            ))),
+        };
+        let (pixels, stats) = match &self.pool {
+            Some(pool) => pool.install(run)?,
+            None => run()?,
+        };
+        self.pixels = pixels;
+        self.taken = end;
+        if let Some(adaptive) = self.settings.adaptive {
+            // Decided at the first pass's end past each check, so that passes ending at the
+            // checks decide as `render` does.
+            if end >= self.next_check {
+                self.next_check = adaptive.check_after(end);
+                let pixels = &mut self.pixels;
+                match &self.pool {
+                    Some(pool) => pool.install(|| stop_converged(pixels, adaptive)),
+                    None => stop_converged(pixels, adaptive),
+                }
             }
-            let mut sums = [PixelSums::default(); RUN];
-            integrator.run_samples(
-                scene,
-                &pixels[..count],
-                samples.clone(),
-                &mut counters.rays,
-                &mut |i, sample| sums[i].add(sample),
-            );
-            for (pixel, sums) in pixels[..count].iter().zip(sums) {
-                out.push(keep(sums.finish(
-                    settings.features,
-                    pixel.index(),
-                    counters,
-                )));
+        }
+        self.stats.rays += stats.rays;
+        self.stats.nonfinite_samples += stats.nonfinite_samples;
+        self.stats.first_nonfinite_pixel = self
+            .stats
+            .first_nonfinite_pixel
+            .or(stats.first_nonfinite_pixel);
+        Ok(stats)
+    }
+
+    /// One pass of `integrator`: every pixel's sums taken up to sample `end`.
+    fn run_pass<I: Integrator>(
+        &self,
+        integrator: &I,
+        end: u32,
+        progress: &(dyn Fn(&Progress) -> bool + Sync),
+    ) -> Result<(TilePixels<PixelSums>, RenderStats), RenderError> {
+        let settings = &self.settings;
+        let context = pixel_context(settings);
+        let before = &self.pixels.tiles;
+        render_tiles(
+            settings.bounds(),
+            settings.width,
+            progress,
+            PixelSums::mean,
+            |tile, xs, y, counters, out| {
+                let count = xs.len();
+                let mut pixels = [context(xs.start, y); RUN];
+                for (pixel, x) in pixels.iter_mut().zip(xs) {
+                    pixel.x = x;
+                }
+                let mut sums = [PixelSums::default(); RUN];
+                let offset = out.len();
+                sums[..count].copy_from_slice(&before[tile][offset..offset + count]);
+                let dropped = sums.map(|p| p.dropped);
+                sample_run(
+                    integrator,
+                    self.scene,
+                    &pixels[..count],
+                    &mut sums[..count],
+                    end,
+                    settings.adaptive.is_some(),
+                    &mut counters.rays,
+                );
+                for i in 0..count {
+                    counters.dropped_samples(pixels[i].index(), sums[i].dropped - dropped[i]);
+                }
+                out.extend_from_slice(&sums[..count]);
+            },
+        )
+    }
+
+    /// The image as the passes so far left it, with the samples each pixel took.
+    pub fn film(&self) -> Film {
+        let features = self.settings.features;
+        let film = || film_of(&self.pixels, &self.settings, true, |p| p.finish(features).0);
+        match &self.pool {
+            Some(pool) => pool.install(film),
+            None => film(),
+        }
+    }
+}
+
+/// Stops every pixel whose neighbourhood's mean squared error estimate is below the
+/// threshold's square (`AdaptiveSampling`).
+fn stop_converged(pixels: &mut TilePixels<PixelSums>, adaptive: AdaptiveSampling) {
+    let bounds = pixels.bounds;
+    let (width, height) = (bounds.width() as usize, bounds.height() as usize);
+    let errors = pixels.gather(|p| AdaptiveSampling::error_squared(p.sum, p.squares, p.valid));
+    let limit = (adaptive.threshold as f64).powi(2);
+    let tiles_x = pixels.tiles_x as usize;
+    let tile = TILE_SIZE as usize;
+    pixels
+        .tiles
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(index, tile_pixels)| {
+            let (x0, y0) = ((index % tiles_x) * tile, (index / tiles_x) * tile);
+            let tile_width = tile.min(width - x0);
+            for (within, pixel) in tile_pixels.iter_mut().enumerate() {
+                if pixel.converged {
+                    continue;
+                }
+                let (x, y) = (x0 + within % tile_width, y0 + within / tile_width);
+                let (mut sum, mut count) = (0.0, 0.0);
+                for ny in y.saturating_sub(1)..(y + 2).min(height) {
+                    for nx in x.saturating_sub(1)..(x + 2).min(width) {
+                        sum += errors[ny * width + nx];
+                        count += 1.0;
+                    }
+                }
+                pixel.converged = sum / count < limit;
             }
-        },
-    )
+        });
 }
 
 /// The pixels of `bounds` as `render_tiles` computed them: one row-major buffer per tile, the
@@ -652,7 +1137,7 @@ impl<P: Default + Sync> TilePixels<P> {
     }
 }
 
-/// The tile scheduler: `run(xs, y, counters, out)` computes the pixels xs of row y (at most
+/// The tile scheduler: `run(tile, xs, y, counters, out)` computes the pixels xs of row y (at most
 /// `RUN` of them, x and y from the top-left of the whole image `width` wide) and pushes them
 /// to `out` in order; tiles of `bounds` run on the current rayon pool, each pixel is computed
 /// by exactly one task and kept in its tile's buffer, so neither thread count nor
@@ -663,7 +1148,7 @@ fn render_tiles<P: Copy + Default + Send>(
     width: u32,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
     beauty: impl Fn(&P) -> Color + Sync,
-    run: impl Fn(Range<u32>, u32, &mut TileCounters, &mut Vec<P>) + Sync,
+    run: impl Fn(usize, Range<u32>, u32, &mut TileCounters, &mut Vec<P>) + Sync,
 ) -> Result<(TilePixels<P>, RenderStats), RenderError> {
     let tiles_x = bounds.width().div_ceil(TILE_SIZE);
     let tiles_y = bounds.height().div_ceil(TILE_SIZE);
@@ -698,7 +1183,13 @@ fn render_tiles<P: Copy + Default + Send>(
             let mut out = Vec::with_capacity((area.width() * area.height()) as usize);
             for y in area.y0..area.y1 {
                 for x in (area.x0..area.x1).step_by(RUN) {
-                    run(x..(x + RUN as u32).min(area.x1), y, &mut counters, &mut out);
+                    run(
+                        tile,
+                        x..(x + RUN as u32).min(area.x1),
+                        y,
+                        &mut counters,
+                        &mut out,
+                    );
                 }
             }
             let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
@@ -830,7 +1321,7 @@ mod tests {
                     64,
                     &|_: &Progress| true,
                     |_: &(u32, u32)| Color::ZERO,
-                    |xs, y, counters, out| {
+                    |_, xs, y, counters, out| {
                         for x in xs {
                             counters.rays += 1;
                             out.push((x, y));
@@ -877,7 +1368,7 @@ mod tests {
                 bounds.width(),
                 &|_: &Progress| true,
                 |_: &()| Color::ZERO,
-                |xs, y, _, out| {
+                |_, xs, y, _, out| {
                     let first_tile = xs.start < TILE_SIZE && y < TILE_SIZE;
                     if first_tile && xs.start == 0 && y == 0 {
                         let start = std::time::Instant::now();

@@ -4,6 +4,7 @@
 //! read files (course scenes, meshes, Mitsuba's references) live in glint-io, which loads them.
 
 mod accel_watertight;
+mod adaptive;
 mod chi2_sampling;
 mod composite_bsdfs;
 mod depth_of_field;

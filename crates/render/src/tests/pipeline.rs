@@ -9,7 +9,7 @@ use crate::{
 };
 
 /// A red Lambertian sphere on a grey floor, a point light, a grey background.
-fn scene(sphere: Material) -> Scene {
+pub(super) fn scene(sphere: Material) -> Scene {
     Scene::new(SceneParts {
         physical: Default::default(),
         camera: Camera::new(
@@ -53,7 +53,7 @@ fn scene(sphere: Material) -> Scene {
     })
 }
 
-fn red() -> Material {
+pub(super) fn red() -> Material {
     Material::Lambertian {
         diffuse: Color::new(0.8, 0.1, 0.1).into(),
     }
