@@ -105,6 +105,9 @@ pub enum Command {
     /// image, refusing parts that do not fit together.
     #[command(after_help = MERGE_AFTER_HELP)]
     Merge(MergeArgs),
+    /// Denoise an EXR written by `glint render` with Open Image Denoise (its albedo and normal
+    /// layers as OIDN's auxiliary images); an EXR output keeps the noisy beauty as a layer.
+    Denoise(crate::denoise::DenoiseArgs),
 }
 
 const MERGE_AFTER_HELP: &str = "\
@@ -324,6 +327,12 @@ pub struct Options {
     /// (Mitsuba's `path`, `volpath`, ...), else `course`]
     #[arg(long, visible_alias = "shader", value_name = "NAME", value_enum)]
     pub integrator: Option<IntegratorArg>,
+
+    /// Denoise the image with Open Image Denoise (`pip install pyoidn`; docs/denoise.md):
+    /// --integrator path or volpath, with the albedo and normal layers, which it turns on. An
+    /// .exr output keeps the noisy beauty as the `Noisy Image` layer.
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub denoise: bool,
 
     /// PNG only: exposure in stops (values times 2^EV) before the tone curve. Giving it, or
     /// --tonemap or --transfer, turns on the display transform for any integrator.

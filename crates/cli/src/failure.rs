@@ -36,6 +36,8 @@ pub enum Failure {
     Memory(String),
     /// Ctrl-C or SIGTERM with `--checkpoint` (exit 130): the finished rows are in the file.
     InterruptedWithCheckpoint(std::path::PathBuf),
+    /// Denoising: OIDN missing or the images unusable (exit 2), or OIDN failed (exit 1).
+    Denoise(glint_denoise::DenoiseError),
 }
 
 impl Failure {
@@ -48,6 +50,7 @@ impl Failure {
             | Failure::GpuUnsupported(_) => 2,
             Failure::Write(_) | Failure::ThreadPool(_) | Failure::Gpu(_) => 1,
             Failure::Interrupted | Failure::InterruptedWithCheckpoint(_) => EXIT_INTERRUPTED,
+            Failure::Denoise(error) => crate::denoise::exit_code(error),
         }
     }
 }
@@ -81,6 +84,7 @@ impl fmt::Display for Failure {
                 "interrupted: the finished rows are in {0}; continue with --resume {0}",
                 file.display()
             ),
+            Failure::Denoise(error) => write!(f, "{error}"),
         }
     }
 }
