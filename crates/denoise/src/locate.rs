@@ -28,8 +28,11 @@ const WHEEL_FOLDER: &str = "oidn/lib";
 const WHEEL_FOLDER: &str = "oidn/bin";
 
 /// Prints the package's folder without importing it: `find_spec` of a top-level package only
-/// reads the import path, so pyoidn's own imports (numpy, ctypes loading OIDN) never run.
-const FIND_PYOIDN: &str = "import importlib.util as u
+/// reads the import path, so pyoidn's own imports (numpy, ctypes loading OIDN) never run. The
+/// current folder, which `-c` puts first on the path, is left out: a folder there named
+/// pyoidn is not the installed package.
+const FIND_PYOIDN: &str = "import importlib.util as u, sys
+if sys.path and sys.path[0] == '': del sys.path[0]
 s = u.find_spec('pyoidn')
 print(s.submodule_search_locations[0] if s and s.submodule_search_locations else '')";
 
