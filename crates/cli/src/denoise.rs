@@ -4,52 +4,16 @@
 //! any work, so that a machine without it hears so at once (exit 2) and gets no file.
 
 use std::io::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::time::Instant;
 
-use clap::{ArgAction, Args};
-use glint_denoise::{DenoiseError, Denoiser, Images, Options};
+use glint_denoise::{Denoiser, Images, Options};
 use glint_io::{DisplayTransform, ExtraLayer, PngEncoding, WriteOptions, NOISY_LAYER};
 use glint_render::{Film, Vec3};
 
+use crate::args::DenoiseArgs;
 use crate::failure::Failure;
 use crate::job::{Job, UsageError};
-
-/// `glint denoise IN.exr -o OUT [--no-prefilter]`
-#[derive(Args, Debug, Clone)]
-#[command(disable_help_flag = true, after_help = DENOISE_AFTER_HELP)]
-pub struct DenoiseArgs {
-    /// An EXR written by `glint render` (with its albedo and normal layers when it has them).
-    #[arg(value_name = "IN.exr")]
-    pub input: PathBuf,
-
-    /// The denoised image, .exr (which keeps the input's beauty as the `Noisy Image` layer,
-    /// and its albedo, normal and depth layers) or .png (the display transform's defaults).
-    #[arg(short = 'o', long = "outputfile", value_name = "FILE", required = true)]
-    pub output: PathBuf,
-
-    /// Give OIDN the albedo and normal layers as they are, without denoising them first.
-    #[arg(long, action = ArgAction::SetTrue)]
-    pub no_prefilter: bool,
-
-    /// OIDN's threads [default: all cores].
-    #[arg(short = 'n', long = "numcpus", value_name = "THREADS",
-          value_parser = clap::value_parser!(u64).range(1..=crate::args::MAX_THREADS))]
-    pub threads: Option<u64>,
-
-    /// Print help.
-    #[arg(short = '?', long, action = ArgAction::Help)]
-    pub help: Option<bool>,
-}
-
-const DENOISE_AFTER_HELP: &str = "\
-Example:
-  glint render scene.json --integrator path -r 16 -o noisy.exr
-  glint denoise noisy.exr -o clean.png
-
-Needs Open Image Denoise 2: `pip install pyoidn`, or GLINT_OIDN_LIB naming
-libOpenImageDenoise.so.2 (docs/denoise.md). Exit status 2 without it, or for an input that is
-not such an EXR; 1 when the output cannot be written.";
 
 /// OIDN for a render with `--denoise`, or `None` without it.
 pub fn open_for(job: &Job) -> Result<Option<Denoiser>, Failure> {
@@ -196,13 +160,4 @@ pub fn run(args: &DenoiseArgs, err: &mut dyn Write) -> Result<(), Failure> {
     )?;
     let _ = writeln!(err, "wrote {}", args.output.display());
     Ok(())
-}
-
-/// The exit status of a denoising failure: 2 when OIDN is missing or the images are unusable
-/// (like a bad argument, nothing was done), 1 when OIDN itself fails.
-pub fn exit_code(error: &DenoiseError) -> u8 {
-    match error {
-        DenoiseError::Unavailable(_) | DenoiseError::Invalid { .. } => 2,
-        DenoiseError::Oidn(_) => 1,
-    }
 }

@@ -50,7 +50,13 @@ impl Failure {
             | Failure::GpuUnsupported(_) => 2,
             Failure::Write(_) | Failure::ThreadPool(_) | Failure::Gpu(_) => 1,
             Failure::Interrupted | Failure::InterruptedWithCheckpoint(_) => EXIT_INTERRUPTED,
-            Failure::Denoise(error) => crate::denoise::exit_code(error),
+            // OIDN missing or the images unusable: like a bad argument, nothing was done.
+            Failure::Denoise(
+                glint_denoise::DenoiseError::Unavailable(_)
+                | glint_denoise::DenoiseError::Invalid { .. },
+            ) => 2,
+            // OIDN itself failed: the machine, not the input.
+            Failure::Denoise(glint_denoise::DenoiseError::Oidn(_)) => 1,
         }
     }
 }
