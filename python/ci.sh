@@ -2,7 +2,9 @@
 # Glint's Python suite.
 #   python/ci.sh install   idempotent: Debian packages (python3, venv) and a virtual environment
 #                          in python/.venv with maturin, numpy, pytest, dask[distributed], ruff,
-#                          OpenEXR (the tests' EXR reader) and mypy (stubtest)
+#                          OpenEXR (the tests' EXR reader), mypy (stubtest) and pyoidn (Open
+#                          Image Denoise 2's library, for glint.denoise and, through
+#                          scripts/test-all.sh, the Rust denoise tests)
 #   python/ci.sh test      builds the wheel once (pip install ./python: maturin, release), builds
 #                          the `glint` CLI for the equality tests, runs pytest, ruff, rustfmt and
 #                          clippy on the module and ruff on bench/ and scripts/; ends with
@@ -15,7 +17,7 @@ REPO="$(dirname "$HERE")"
 VENV="$HERE/.venv"
 REQUIREMENTS=(
     "maturin>=1.16,<2" "numpy>=1.21" "pytest>=7" "dask[distributed]>=2023.1"
-    "ruff>=0.6" "OpenEXR>=3.2" "mypy>=1.11"
+    "ruff>=0.6" "OpenEXR>=3.2" "mypy>=1.11" "pyoidn>=2.5,<3"
 )
 
 install() {

@@ -61,6 +61,19 @@ if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "${XDG_RUNTIME_DIR}" ]; then
   export XDG_RUNTIME_DIR
 fi
 
+# The denoise tests (glint-denoise, crates/cli/tests/denoise.rs) need Open Image Denoise: the
+# pyoidn wheel that python/ci.sh installs into its venv holds it. Named here, because the
+# python3 on the PATH, where glint-denoise would look, is not that venv's.
+if [ -z "${GLINT_OIDN_LIB:-}" ] && [ -x python/.venv/bin/python ]; then
+  oidn_lib=$(python/.venv/bin/python -c 'import importlib.util as u
+s = u.find_spec("pyoidn")
+print(s.submodule_search_locations[0] + "/oidn/lib/libOpenImageDenoise.so.2" if s else "")' || true)
+  if [ -n "$oidn_lib" ] && [ -f "$oidn_lib" ]; then
+    export GLINT_OIDN_LIB="$oidn_lib"
+    echo "== Open Image Denoise: $GLINT_OIDN_LIB"
+  fi
+fi
+
 echo "== cargo test --workspace"
 status=0
 cargo test --workspace --locked --no-fail-fast 2>&1 | tee "$logs/cargo.log" || status=$?

@@ -28,8 +28,10 @@ True
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import os
+import sys
 import warnings
 from collections.abc import Mapping
 from typing import Callable, Union
@@ -37,16 +39,18 @@ from typing import Callable, Union
 import numpy as np
 
 from glint import _glint
-from glint._glint import TILE_SIZE, Scene, SceneError, SceneWarning
+from glint._glint import TILE_SIZE, DenoiserUnavailable, Scene, SceneError, SceneWarning
 
 __all__ = [
     "BALL",
     "INTEGRATORS",
     "RGB",
     "TILE_SIZE",
+    "DenoiserUnavailable",
     "Scene",
     "SceneError",
     "SceneWarning",
+    "denoise",
     "load_scene",
     "load_scene_text",
     "render",
@@ -432,3 +436,66 @@ def to_srgb8(array: np.ndarray, exposure: float = 0.0) -> np.ndarray:
         linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1.0 / 2.4) - 0.055
     )
     return np.round(encoded * 255.0).astype(np.uint8)
+
+
+def _rgb32(name: str, array: object) -> np.ndarray:
+    """``array`` itself when it is a float32 ``(H, W, 3)`` array; otherwise an error naming it."""
+    if not isinstance(array, np.ndarray):
+        raise TypeError(f"{name} must be a numpy array, not {type(array).__name__}")
+    if array.dtype != np.float32:
+        raise TypeError(f"{name} must be a float32 array, not {array.dtype}")
+    if array.ndim != 3 or array.shape[2] != 3:
+        raise ValueError(f"{name} must have shape (H, W, 3), not {array.shape}")
+    return array
+
+
+def _pyoidn_library() -> str | None:
+    """The OIDN library in the ``pyoidn`` package this interpreter would import, if any; found
+    without importing it."""
+    spec = importlib.util.find_spec("pyoidn")
+    if spec is None or not spec.submodule_search_locations:
+        return None
+    folder, name = {
+        "win32": ("bin", "OpenImageDenoise.dll"),
+        "darwin": ("lib", "libOpenImageDenoise.2.dylib"),
+    }.get(sys.platform, ("lib", "libOpenImageDenoise.so.2"))
+    library = os.path.join(spec.submodule_search_locations[0], "oidn", folder, name)
+    return library if os.path.isfile(library) else None
+
+
+def denoise(
+    color: np.ndarray,
+    albedo: np.ndarray | None = None,
+    normal: np.ndarray | None = None,
+    *,
+    prefilter: bool = True,
+) -> np.ndarray:
+    """Denoises an image with Intel's Open Image Denoise 2 (OIDN), as ``glint denoise`` does,
+    and returns a new ``(H, W, 3)`` float32 array; the inputs are left as they are.
+
+    ``color`` is linear radiance (HDR), an ``(H, W, 3)`` float32 array, such as
+    :func:`render`'s image or the ``"beauty"`` of its dict with ``features=True``. ``albedo``
+    (reflectance, in [0, 1]) and ``normal`` (components in [-1, 1]) are that dict's layers,
+    the same shape, OIDN's auxiliary images; a normal layer needs the albedo layer too. They
+    average noisy first hits, so by default each is denoised first and the colour then with
+    OIDN's ``cleanAux``, as OIDN recommends for noisy auxiliary images; ``prefilter=False``
+    gives them to OIDN as they are.
+
+    OIDN is found where the CLI looks (``GLINT_OIDN_LIB``, the system's loader, the ``pyoidn``
+    package of ``python3``) and in this interpreter's ``pyoidn``; without it
+    :class:`DenoiserUnavailable` (a ``RuntimeError``) says what was tried and to
+    ``pip install pyoidn``. An argument of the wrong type or dtype raises ``TypeError``, of the
+    wrong shape or with non-finite values ``ValueError``, naming the argument::
+
+        layers = glint.render(scene, spp=16, integrator="path", features=True)
+        clean = glint.denoise(layers["beauty"], layers["albedo"], layers["normal"])
+    """
+    color = _rgb32("color", color)
+    layers = []
+    for name, layer in (("albedo", albedo), ("normal", normal)):
+        if layer is not None:
+            layer = _rgb32(name, layer)
+            if layer.shape != color.shape:
+                raise ValueError(f"{name} has shape {layer.shape}, but color has {color.shape}")
+        layers.append(layer)
+    return _glint.denoise(color, layers[0], layers[1], bool(prefilter), _pyoidn_library())

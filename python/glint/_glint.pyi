@@ -15,6 +15,8 @@ __all__ = [
     "_restore",
     "render",
     "write_image",
+    "denoise",
+    "DenoiserUnavailable",
     "TILE_SIZE",
 ]
 
@@ -25,6 +27,8 @@ class SceneError(ValueError):
     line: int
     column: int
     message: str
+
+class DenoiserUnavailable(RuntimeError): ...
 
 class SceneWarning(UserWarning):
     file: str
@@ -115,3 +119,10 @@ def write_image(
     normal: npt.NDArray[np.float32] | None = None,
     depth: npt.NDArray[np.float32] | None = None,
 ) -> None: ...
+def denoise(
+    color: npt.NDArray[np.float32],
+    albedo: npt.NDArray[np.float32] | None,
+    normal: npt.NDArray[np.float32] | None,
+    prefilter: bool,
+    pyoidn_library: str | None,
+) -> npt.NDArray[np.float32]: ...

@@ -1,7 +1,7 @@
 //! `glint._glint`: the native half of Glint's Python module. It wraps the renderer's public API
 //! and nothing else (`glint_io::load_scene_with_options` / `load_scene_bytes`,
 //! `load_environment`, `glint_render::Scene`, `RequestedSettings`, `RenderSettings`, `render`,
-//! `glint_io::write_image`); `glint/__init__.py` puts the
+//! `glint_io::write_image`, and glint-denoise's `Denoiser`); `glint/__init__.py` puts the
 //! documented, keyword-friendly functions in front of it (crop slices, feature dicts, sRGB).
 //!
 //! Threads and the GIL: loading, building the acceleration structure, rendering and writing
@@ -12,9 +12,10 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Condvar, Mutex};
+use std::sync::{Condvar, Mutex, OnceLock};
 use std::time::Duration;
 
+use glint_denoise::{DenoiseError, Denoiser, Images, Options as DenoiseOptions};
 use glint_io::{Diagnostic, FileSystem, ImageWriteError, Limits, LoadedScene, ModelOptions};
 use glint_render::{
     Background, Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderDefaults,
@@ -22,7 +23,7 @@ use glint_render::{
 };
 use numpy::ndarray::{Array2, Array3, ArrayView2, ArrayView3};
 use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyOSError, PyUserWarning, PyValueError};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyUserWarning, PyValueError};
 use pyo3::panic::PanicException;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -45,6 +46,15 @@ pyo3::create_exception!(
      Issued through :mod:`warnings` when a scene loads, and kept in ``Scene.warnings``. \
      ``str(warning)`` is the text the ``glint`` CLI prints after ``warning:``; the attributes \
      ``file``, ``line``, ``column`` (1-based) and ``message`` give its parts."
+);
+
+pyo3::create_exception!(
+    glint,
+    DenoiserUnavailable,
+    PyRuntimeError,
+    "Open Image Denoise 2 (OIDN), which :func:`glint.denoise` needs, was not found.\n\n\
+     ``str(error)`` is the message the ``glint`` CLI prints: every place tried, and how to get \
+     it (``pip install pyoidn``, or ``GLINT_OIDN_LIB`` naming the library)."
 );
 
 /// How often the waiting caller checks for Ctrl-C and reports progress.
@@ -549,6 +559,7 @@ fn render<'py>(
         pixel_bounds: bounds.map(|(x0, x1, y0, y1)| PixelBounds { x0, x1, y0, y1 }),
         sample_range: None,
         threads,
+        adaptive: None,
     };
     settings.validate().map_err(PyValueError::new_err)?;
 
@@ -781,6 +792,7 @@ fn write_image(
         full_size: (width as u32, height as u32),
         features,
         sums: None,
+        samples: None,
     };
     let written = py.detach(|| glint_io::write_image(&path, &film));
     written.map_err(|error| match &error {
@@ -792,18 +804,99 @@ fn write_image(
     })
 }
 
+/// OIDN, loaded on the first call and kept: `Denoiser::open`'s search, then the library of the
+/// `pyoidn` package this interpreter imports (`pyoidn_library`), which the search's `python3`
+/// may not be; not when `GLINT_OIDN_LIB` is set, which is then the only place.
+fn denoiser(pyoidn_library: Option<&Path>) -> Result<&'static Denoiser, DenoiseError> {
+    static DENOISER: OnceLock<Denoiser> = OnceLock::new();
+    if let Some(denoiser) = DENOISER.get() {
+        return Ok(denoiser);
+    }
+    let variable = std::env::var_os(glint_denoise::LIBRARY_VARIABLE);
+    let pyoidn_library = pyoidn_library.filter(|_| !variable.is_some_and(|v| !v.is_empty()));
+    let opened = match (Denoiser::open(), pyoidn_library) {
+        (Err(DenoiseError::Unavailable(mut unavailable)), Some(library)) => {
+            Denoiser::open_path(library).map_err(|error| match error {
+                DenoiseError::Unavailable(more) => {
+                    unavailable.tried.extend(more.tried);
+                    DenoiseError::Unavailable(unavailable)
+                }
+                other => other,
+            })
+        }
+        (opened, _) => opened,
+    }?;
+    Ok(DENOISER.get_or_init(|| opened))
+}
+
+/// `color` denoised by OIDN with the `albedo` and `normal` layers (`glint.denoise`).
+#[pyfunction]
+#[pyo3(signature = (color, albedo, normal, prefilter, pyoidn_library))]
+fn denoise<'py>(
+    py: Python<'py>,
+    color: PyReadonlyArray3<'py, f32>,
+    albedo: Option<PyReadonlyArray3<'py, f32>>,
+    normal: Option<PyReadonlyArray3<'py, f32>>,
+    prefilter: bool,
+    pyoidn_library: Option<PathBuf>,
+) -> PyResult<Bound<'py, PyArray3<f32>>> {
+    let shape = color.shape();
+    let (height, width) = (shape[0], shape[1]);
+    check_rgb("color", shape, (height, width))?;
+    // Row-major copies, whatever the arrays' strides.
+    let flat = |array: &PyReadonlyArray3<'py, f32>| -> Vec<f32> {
+        array.as_array().iter().copied().collect()
+    };
+    let layer = |name: &str, array: &Option<PyReadonlyArray3<'py, f32>>| {
+        array
+            .as_ref()
+            .map(|array| {
+                check_rgb(name, array.shape(), (height, width))?;
+                Ok::<_, PyErr>(flat(array))
+            })
+            .transpose()
+    };
+    let (albedo, normal) = (layer("albedo", &albedo)?, layer("normal", &normal)?);
+    let color = flat(&color);
+    let denoised = py.detach(|| {
+        let images = Images {
+            width,
+            height,
+            color: &color,
+            albedo: albedo.as_deref(),
+            normal: normal.as_deref(),
+        };
+        glint_denoise::validate(&images)?;
+        let options = DenoiseOptions {
+            prefilter,
+            threads: None,
+        };
+        denoiser(pyoidn_library.as_deref())?.denoise(&images, &options)
+    });
+    let denoised = denoised.map_err(|error| match &error {
+        DenoiseError::Unavailable(_) => DenoiserUnavailable::new_err(error.to_string()),
+        DenoiseError::Invalid { .. } => PyValueError::new_err(error.to_string()),
+        DenoiseError::Oidn(_) => PyRuntimeError::new_err(error.to_string()),
+    })?;
+    let array = Array3::from_shape_vec((height, width, 3), denoised)
+        .expect("OIDN's output is the colour's size");
+    Ok(PyArray3::from_owned_array(py, array))
+}
+
 /// The native half of `glint`; import `glint` instead.
 #[pymodule]
 fn _glint(module: &Bound<'_, PyModule>) -> PyResult<()> {
     let py = module.py();
     module.add("SceneError", py.get_type::<SceneError>())?;
     module.add("SceneWarning", py.get_type::<SceneWarning>())?;
+    module.add("DenoiserUnavailable", py.get_type::<DenoiserUnavailable>())?;
     module.add_class::<PyScene>()?;
     module.add_function(wrap_pyfunction!(load_scene, module)?)?;
     module.add_function(wrap_pyfunction!(load_scene_text, module)?)?;
     module.add_function(wrap_pyfunction!(_restore, module)?)?;
     module.add_function(wrap_pyfunction!(render, module)?)?;
     module.add_function(wrap_pyfunction!(write_image, module)?)?;
+    module.add_function(wrap_pyfunction!(denoise, module)?)?;
     module.add("TILE_SIZE", glint_render::TILE_SIZE)?;
     Ok(())
 }

@@ -105,6 +105,9 @@ pub enum Command {
     /// image, refusing parts that do not fit together.
     #[command(after_help = MERGE_AFTER_HELP)]
     Merge(MergeArgs),
+    /// Denoise an EXR written by `glint render` with Open Image Denoise (its albedo and normal
+    /// layers as OIDN's auxiliary images); an EXR output keeps the noisy beauty as a layer.
+    Denoise(DenoiseArgs),
 }
 
 const MERGE_AFTER_HELP: &str = "\
@@ -128,6 +131,42 @@ pub struct MergeArgs {
     #[arg(value_name = "PART", required = true, num_args = 1..)]
     pub parts: Vec<PathBuf>,
 }
+
+/// `glint denoise IN.exr -o OUT [--no-prefilter]`
+#[derive(Args, Debug, Clone)]
+#[command(disable_help_flag = true, after_help = DENOISE_AFTER_HELP)]
+pub struct DenoiseArgs {
+    /// An EXR written by `glint render` (with its albedo and normal layers when it has them).
+    #[arg(value_name = "IN.exr")]
+    pub input: PathBuf,
+
+    /// The denoised image, .exr (which keeps the input's beauty as the `Noisy Image` layer,
+    /// and its albedo, normal and depth layers) or .png (the display transform's defaults).
+    #[arg(short = 'o', long = "outputfile", value_name = "FILE", required = true)]
+    pub output: PathBuf,
+
+    /// Give OIDN the albedo and normal layers as they are, without denoising them first.
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub no_prefilter: bool,
+
+    /// OIDN's threads [default: all cores].
+    #[arg(short = 'n', long = "numcpus", value_name = "THREADS",
+          value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
+    pub threads: Option<u64>,
+
+    /// Print help.
+    #[arg(short = '?', long, action = ArgAction::Help)]
+    pub help: Option<bool>,
+}
+
+const DENOISE_AFTER_HELP: &str = "\
+Example:
+  glint render scene.json --integrator path -r 16 -o noisy.exr
+  glint denoise noisy.exr -o clean.png
+
+Needs Open Image Denoise 2: `pip install pyoidn`, or GLINT_OIDN_LIB naming
+libOpenImageDenoise.so.2 (docs/denoise.md). Exit status 2 without it, or for an input that is
+not such an EXR; 1 when the output cannot be written.";
 
 /// How strict a load is and what it may take: shared by rendering and `glint check`.
 #[derive(Args, Debug, Clone, PartialEq)]
@@ -345,6 +384,12 @@ pub struct Options {
     /// (Mitsuba's `path`, `volpath`, ...), else `course`]
     #[arg(long, visible_alias = "shader", value_name = "NAME", value_enum)]
     pub integrator: Option<IntegratorArg>,
+
+    /// Denoise the image with Open Image Denoise (`pip install pyoidn`; docs/denoise.md):
+    /// --integrator path or volpath, with the albedo and normal layers, which it turns on. An
+    /// .exr output keeps the noisy beauty as the `Noisy Image` layer.
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub denoise: bool,
 
     /// PNG only: exposure in stops (values times 2^EV) before the tone curve. Giving it, or
     /// --tonemap or --transfer, turns on the display transform for any integrator.

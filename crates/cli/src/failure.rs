@@ -39,6 +39,8 @@ pub enum Failure {
     /// Ctrl-C or SIGTERM during a `--time` render (exit 130): the image of the last finished
     /// pass, `samples` per pixel, is in `output`.
     InterruptedAfterPass { output: PathBuf, samples: u32 },
+    /// Denoising: OIDN missing or the images unusable (exit 2), or OIDN failed (exit 1).
+    Denoise(glint_denoise::DenoiseError),
 }
 
 impl Failure {
@@ -53,6 +55,13 @@ impl Failure {
             Failure::Interrupted
             | Failure::InterruptedWithCheckpoint(_)
             | Failure::InterruptedAfterPass { .. } => EXIT_INTERRUPTED,
+            // OIDN missing or the images unusable: like a bad argument, nothing was done.
+            Failure::Denoise(
+                glint_denoise::DenoiseError::Unavailable(_)
+                | glint_denoise::DenoiseError::Invalid { .. },
+            ) => 2,
+            // OIDN itself failed: the machine, not the input.
+            Failure::Denoise(glint_denoise::DenoiseError::Oidn(_)) => 1,
         }
     }
 }
@@ -92,6 +101,7 @@ impl fmt::Display for Failure {
                 "interrupted: the finished rows are in {0}; continue with --resume {0}",
                 file.display()
             ),
+            Failure::Denoise(error) => write!(f, "{error}"),
         }
     }
 }

@@ -71,6 +71,8 @@ pub struct Job {
     pub max_memory: u64,
     /// `--checkpoint` / `--resume`.
     pub checkpoint: Option<Checkpointing>,
+    /// `--denoise`: the image is denoised by OIDN before it is written.
+    pub denoise: bool,
     /// Between progress lines when stderr is not a terminal.
     pub progress_every: Duration,
     /// `--time`: render in passes for this long, writing the image after each.
@@ -93,6 +95,9 @@ impl Job {
     /// and depth) wherever the user gave no flag; the same job for scenes that set none.
     pub fn with_scene_defaults(&self, defaults: &RenderDefaults) -> Result<Job, UsageError> {
         if *defaults == RenderDefaults::default() {
+            if self.denoise {
+                check_denoise(Some(self.settings.integrator), false)?;
+            }
             return Ok(self.clone());
         }
         let settled = self.options.settle(&self.output, defaults)?;
@@ -141,6 +146,9 @@ impl Cli {
                 }
                 Some(Command::Merge(_)) => {
                     return Err(UsageError("`glint merge` is not a render".to_string()))
+                }
+                Some(Command::Denoise(_)) => {
+                    return Err(UsageError("`glint denoise` is not a render".to_string()))
                 }
                 None => match self.input {
                     Some(scene) if !scene.as_os_str().is_empty() => (scene, self.options),
@@ -211,6 +219,13 @@ impl Options {
                 )));
             }
         }
+        if self.denoise && self.device == DeviceArg::Gpu {
+            return Err(UsageError(
+                "--denoise is not available with --device gpu yet; render an .exr and run \
+                 `glint denoise` on it"
+                    .to_string(),
+            ));
+        }
         let (limits, max_memory) = self.limits.resolve();
         Ok(Job {
             strict: self.limits.strict,
@@ -243,6 +258,7 @@ impl Options {
             preview_close: self.preview_close,
             notes,
             checkpoint,
+            denoise: self.denoise,
             progress_every: Duration::from_secs_f64(self.progress_every),
             time_budget: self.time_budget.map(Duration::from_secs_f64),
             options,
@@ -293,12 +309,21 @@ impl Options {
                 output.display()
             )));
         }
+        // Without --integrator the scene may still name a path tracer: checked once loaded.
+        let integrator_known = self.integrator.is_some() || *defaults != RenderDefaults::default();
+        if self.denoise {
+            check_denoise(
+                integrator_known.then_some(integrator),
+                sample_range.is_some(),
+            )?;
+        }
         let settings = RenderSettings {
             aspect: self.aspect,
             seed: self.seed,
             // Feature layers cost a first-hit ray per sample; only an EXR keeps them, and
-            // only a whole range of samples averages them (merge cannot add them up).
-            features: output_is_exr(output) && sample_range.is_none(),
+            // only a whole range of samples averages them (merge cannot add them up). The
+            // denoiser needs them whatever the output.
+            features: (output_is_exr(output) && sample_range.is_none()) || self.denoise,
             pixel_bounds,
             sample_range,
             adaptive: self.noise_threshold.map(|threshold| AdaptiveSampling {
@@ -377,6 +402,28 @@ pub fn png_encoding(
             TransferArg::Linear => Transfer::Linear,
         }),
     })
+}
+
+/// `--denoise` is for the path tracers' whole images: the course's images are exact and the
+/// debug views noiseless, and a sample range is denoised after `glint merge`.
+/// `integrator` is `None` while the scene may still choose it.
+fn check_denoise(integrator: Option<IntegratorKind>, sample_range: bool) -> Result<(), UsageError> {
+    if let Some(integrator) =
+        integrator.filter(|i| !matches!(i, IntegratorKind::Path | IntegratorKind::VolPath))
+    {
+        return Err(UsageError(format!(
+            "--denoise is for the path tracers (--integrator path or volpath), not `{}`",
+            integrator.name()
+        )));
+    }
+    if sample_range {
+        return Err(UsageError(
+            "--denoise cannot denoise a --sample-range part: merge the parts with `glint merge` \
+             and run `glint denoise` on the merged EXR"
+                .to_string(),
+        ));
+    }
+    Ok(())
 }
 
 /// The scene's file name with `.png`, in the current directory.

@@ -10,6 +10,7 @@ mod args;
 mod bench;
 mod check;
 mod checkpoint;
+mod denoise;
 mod diff;
 mod failure;
 mod farm;
@@ -72,6 +73,12 @@ fn main() -> ExitCode {
             unreachable!("matched just above");
         };
         return match merge::run(&args, &mut std::io::stderr()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(failure) => fail(&failure),
+        };
+    }
+    if let Some(crate::args::Command::Denoise(args)) = &cli.command {
+        return match denoise::run(args, &mut std::io::stderr()) {
             Ok(()) => ExitCode::SUCCESS,
             Err(failure) => fail(&failure),
         };

@@ -60,6 +60,8 @@ pub fn run(
         let _ = writeln!(err, "note: {note}");
     }
     let job = &settled;
+    // After the scene has settled the integrator, which --denoise needs to be a path tracer.
+    let denoiser = crate::denoise::open_for(job)?;
     let film_bytes = memory::film_bytes(&job.settings, job.time_budget.is_some());
     check_memory(job, film_bytes, &loaded.parts)?;
     if job.device == DeviceArg::Gpu {
@@ -83,7 +85,7 @@ pub fn run(
         print_adaptive(samples, err);
     }
     warn_nonfinite(Device::Cpu, &rendered.stats, err);
-    let write_time = write(job, &pool, &built, &rendered, err)?;
+    let write_time = write(job, &pool, &built, &rendered, denoiser.as_ref(), err)?;
     let (rays, stats) = (rendered.stats.rays, rendered.stats);
     let summary = finish(job, Device::Cpu, rays, stats, rendered.time, err);
     if job.stats {
@@ -425,13 +427,14 @@ fn render(
     })
 }
 
-/// Writes the image with its metadata and removes the checkpoint it completes; returns the
-/// time that took.
+/// Writes the image with its metadata (denoised first with `--denoise`) and removes the
+/// checkpoint it completes; returns the time that took.
 fn write(
     job: &Job,
     pool: &rayon::ThreadPool,
     built: &Built,
     rendered: &Rendered,
+    denoiser: Option<&glint_denoise::Denoiser>,
     err: &mut dyn Write,
 ) -> Result<Duration, Failure> {
     let start = Instant::now();
@@ -439,10 +442,22 @@ fn write(
     let metadata = built.metadata(&job.settings, rendered.stats.rays, rendered.render_seconds);
     // In the pool: the PNG's 8-bit conversion runs on `-n` threads, and `-n 1` keeps the
     // EXR's compression on one.
-    pool.install(|| {
-        glint_io::write_image_with_metadata(&job.output, &rendered.film, &options, &metadata)
-    })
-    .map_err(Failure::Write)?;
+    match denoiser {
+        Some(denoiser) => {
+            let film = &rendered.film;
+            crate::denoise::write_render(denoiser, job, pool, film, &options, &metadata, err)?
+        }
+        None => pool
+            .install(|| {
+                glint_io::write_image_with_metadata(
+                    &job.output,
+                    &rendered.film,
+                    &options,
+                    &metadata,
+                )
+            })
+            .map_err(Failure::Write)?,
+    }
     if let Some(checkpoint) = &job.checkpoint {
         // The image is complete: the checkpoint is stale now.
         match std::fs::remove_file(&checkpoint.file) {

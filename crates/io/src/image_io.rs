@@ -114,8 +114,34 @@ pub fn write_image_with_metadata(
     options: &WriteOptions,
     metadata: &[(String, String)],
 ) -> Result<(), ImageWriteError> {
+    write_image_with_layers(path, film, options, metadata, &[])
+}
+
+/// An extra RGB layer of an EXR, beside the film's own: a pass name (its channels are
+/// `NAME.R/G/B`) and one colour per pixel of the film.
+#[derive(Clone, Copy, Debug)]
+pub struct ExtraLayer<'a> {
+    pub name: &'a str,
+    pub pixels: &'a [Vec3],
+}
+
+/// The pass name of the beauty before denoising (Blender's), kept beside the denoised one.
+pub const NOISY_LAYER: &str = "Noisy Image";
+
+/// `write_image_with_metadata`, with `layers` in an EXR (a PNG holds the beauty alone and
+/// ignores them): each layer must have one colour per pixel of the film.
+pub fn write_image_with_layers(
+    path: &Path,
+    film: &Film,
+    options: &WriteOptions,
+    metadata: &[(String, String)],
+    layers: &[ExtraLayer],
+) -> Result<(), ImageWriteError> {
     let format = output_format(path)?;
-    if !film_is_whole(film) {
+    let layers_fit = layers
+        .iter()
+        .all(|layer| layer.pixels.len() == film.pixels.len());
+    if !film_is_whole(film) || !layers_fit {
         return Err(ImageWriteError::InvalidFilm {
             path: path.to_path_buf(),
             width: film.width,
@@ -134,7 +160,7 @@ pub fn write_image_with_metadata(
     // Encoded in memory first, so the temporary file exists only for the write and rename:
     // a process killed while encoding leaves nothing behind.
     let mut encoded = std::io::Cursor::new(Vec::new());
-    encode_to(film, format, &options.png, metadata, &mut encoded).map_err(|source| {
+    encode_to(film, format, &options.png, metadata, layers, &mut encoded).map_err(|source| {
         ImageWriteError::Encode {
             path: path.to_path_buf(),
             source,
@@ -249,7 +275,7 @@ pub fn encode_image(
         .into());
     }
     let mut bytes = std::io::Cursor::new(Vec::new());
-    encode_to(film, format, &options.png, &[], &mut bytes)?;
+    encode_to(film, format, &options.png, &[], &[], &mut bytes)?;
     Ok(bytes.into_inner())
 }
 
@@ -280,11 +306,12 @@ fn encode_to(
     format: OutputFormat,
     png: &PngEncoding,
     metadata: &[(String, String)],
+    layers: &[ExtraLayer],
     writer: &mut (impl Write + std::io::Seek),
 ) -> Result<(), EncodeError> {
     match format {
         OutputFormat::Png => encode_png(film, png, metadata, writer),
-        OutputFormat::Exr => encode_exr(film, metadata, writer),
+        OutputFormat::Exr => encode_exr(film, metadata, layers, writer),
     }
 }
 
@@ -332,11 +359,12 @@ pub const DEPTH_CHANNEL: &str = "Depth.Z";
 pub const SAMPLES_CHANNEL: &str = "samples";
 
 /// One EXR part with f32 channels R, G, B (the beauty), the feature layers' channels and the
-/// sample sums, rows from the top, as the `exr` crate stores them; the display window is the
-/// whole image, the data window the film's rectangle.
+/// sample sums and the extra layers, rows from the top, as the `exr` crate stores them; the
+/// display window is the whole image, the data window the film's rectangle.
 fn encode_exr(
     film: &Film,
     metadata: &[(String, String)],
+    layers: &[ExtraLayer],
     writer: &mut (impl Write + std::io::Seek),
 ) -> Result<(), EncodeError> {
     use exr::prelude::{
@@ -380,6 +408,10 @@ fn encode_exr(
             SAMPLES_CHANNEL,
             FlatSamples::U32(samples.clone()),
         ));
+    }
+    for layer in layers {
+        let prefix = format!("{}.", layer.name);
+        rgb(&prefix, ["R", "G", "B"], layer.pixels, &mut channels);
     }
     if let Some(sums) = &film.sums {
         rgb("sum.", ["R", "G", "B"], &sums.radiance, &mut channels);
@@ -622,6 +654,46 @@ mod tests {
         }
         film.pixels.pop();
         assert!(encode_image(&film, OutputFormat::Png, &WriteOptions::default()).is_err());
+    }
+
+    #[test]
+    fn extra_layers_are_exr_passes_of_the_film_size() {
+        let film = Film {
+            pixels: vec![Color::new(1.0, 2.0, 3.0); 6],
+            ..Film::new(3, 2)
+        };
+        let noisy: Vec<Vec3> = (0..6).map(|i| Vec3::new(i as f32, 0.5, 0.25)).collect();
+        let layer = ExtraLayer {
+            name: NOISY_LAYER,
+            pixels: &noisy,
+        };
+        let directory = tempfile::tempdir().unwrap();
+        let path = directory.path().join("out.exr");
+        let options = WriteOptions::default();
+        write_image_with_layers(&path, &film, &options, &[], &[layer]).unwrap();
+        let image = exr::prelude::read_first_flat_layer_from_file(&path).unwrap();
+        let channel = |name: &str| {
+            let channel = image.layer_data.channel_data.list.iter();
+            match &channel
+                .clone()
+                .find(|c| c.name.eq(name))
+                .unwrap()
+                .sample_data
+            {
+                exr::prelude::FlatSamples::F32(values) => values.clone(),
+                _ => panic!("{name} is not f32"),
+            }
+        };
+        assert_eq!(channel("Noisy Image.R"), [0.0, 1.0, 2.0, 3.0, 4.0, 5.0]);
+        assert_eq!(channel("Noisy Image.B"), [0.25; 6]);
+        assert_eq!(channel("R"), [1.0; 6]);
+        assert_eq!(read_exr(&path).unwrap().film, film);
+        let short = ExtraLayer {
+            pixels: &noisy[1..],
+            ..layer
+        };
+        let refused = write_image_with_layers(&path, &film, &options, &[], &[short]);
+        assert!(matches!(refused, Err(ImageWriteError::InvalidFilm { .. })));
     }
 
     #[test]

@@ -77,8 +77,9 @@ pub use display::{
 pub use gltf::ModelOptions;
 pub use image_io::{
     encode_image, output_format, read_exr, remove_stale_partials, write_image, write_image_with,
-    write_image_with_metadata, EncodeError, ExrFile, ImageReadError, ImageWriteError, OutputFormat,
-    WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL, NORMAL_LAYER,
+    write_image_with_layers, write_image_with_metadata, EncodeError, ExrFile, ExtraLayer,
+    ImageReadError, ImageWriteError, OutputFormat, WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL,
+    NOISY_LAYER, NORMAL_LAYER,
 };
 pub use limits::{format_bytes, Limits, BYTES_PER_TEXEL};
 pub use mesh::Mesh;

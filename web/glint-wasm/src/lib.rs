@@ -375,6 +375,7 @@ pub fn encode(
         full_size: (width, height),
         features,
         sums: None,
+        samples: None,
     };
     let options = WriteOptions {
         png: PngEncoding::default_for(integrator),
