@@ -51,7 +51,7 @@ pub fn render(
         RenderError::Invalid(why) => Failure::Usage(UsageError(why)),
         RenderError::Cancelled => Failure::Interrupted,
     };
-    let mut render = ProgressiveRender::new(scene, settings).map_err(invalid)?;
+    let mut render = ProgressiveRender::new(settings).map_err(invalid)?;
     let mut samples = 1;
     let mut passes = 0;
     // Samples per pixel of the image last written.
@@ -66,7 +66,7 @@ pub fn render(
     loop {
         let pass_start = Instant::now();
         let before = render.samples_taken();
-        match pool.install(|| render.pass(samples, progress)) {
+        match pool.install(|| render.pass(scene, samples, progress)) {
             Ok(_) => {}
             Err(RenderError::Cancelled) => return Err(interrupted(written)),
             Err(error) => return Err(invalid(error)),

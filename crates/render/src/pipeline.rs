@@ -478,10 +478,10 @@ pub fn render(
     settings.validate().map_err(RenderError::Invalid)?;
     if let Some(adaptive) = settings.adaptive {
         // In passes from one check to the next, the decisions taken between them.
-        let mut passes = ProgressiveRender::new(scene, settings)?;
+        let mut passes = ProgressiveRender::new(settings)?;
         while !passes.is_finished() {
             let taken = passes.samples_taken();
-            passes.pass(adaptive.check_after(taken) - taken, progress)?;
+            passes.pass(scene, adaptive.check_after(taken) - taken, progress)?;
         }
         return Ok((passes.film(), passes.stats()));
     }
@@ -877,8 +877,10 @@ fn pixel_context(settings: &RenderSettings) -> impl Fn(u32, u32) -> PixelContext
 /// It holds about 100 bytes a pixel between passes (the sums, the squares adaptive sampling
 /// needs, the features) and twice that during a pass, whose new sums replace the old only when
 /// it completes: a cancelled pass leaves the render as the last pass left it.
-pub struct ProgressiveRender<'a> {
-    scene: &'a Scene,
+///
+/// It does not hold the scene, which each pass is given (the same scene every time), so that
+/// a front end can keep one beside the scene it owns.
+pub struct ProgressiveRender {
     settings: RenderSettings,
     pool: Option<rayon::ThreadPool>,
     pixels: TilePixels<PixelSums>,
@@ -889,13 +891,10 @@ pub struct ProgressiveRender<'a> {
     stats: RenderStats,
 }
 
-impl<'a> ProgressiveRender<'a> {
-    /// A render of `scene` as `settings` say, no sample taken yet. Refuses what `render` does,
-    /// and what cannot sample progressively (`RenderSettings::check_progressive`).
-    pub fn new(
-        scene: &'a Scene,
-        settings: &RenderSettings,
-    ) -> Result<ProgressiveRender<'a>, RenderError> {
+impl ProgressiveRender {
+    /// A render as `settings` say, no sample taken yet. Refuses what `render` does, and what
+    /// cannot sample progressively (`RenderSettings::check_progressive`).
+    pub fn new(settings: &RenderSettings) -> Result<ProgressiveRender, RenderError> {
         settings.validate().map_err(RenderError::Invalid)?;
         settings
             .check_progressive("a progressive render")
@@ -923,7 +922,6 @@ impl<'a> ProgressiveRender<'a> {
             })
             .collect();
         Ok(ProgressiveRender {
-            scene,
             settings: settings.clone(),
             pool,
             pixels: TilePixels {
@@ -963,11 +961,13 @@ impl<'a> ProgressiveRender<'a> {
         self.stats
     }
 
-    /// Takes up to `samples` more samples in every pixel still sampling (at least one, and
-    /// not beyond `samples_per_pixel`), calling `progress` after each tile as `render` does;
-    /// returns what this pass counted. Cancelled, it leaves the render as it was.
+    /// Takes up to `samples` more samples of `scene` in every pixel still sampling (at least
+    /// one, and not beyond `samples_per_pixel`), calling `progress` after each tile as
+    /// `render` does; returns what this pass counted. Cancelled, it leaves the render as it
+    /// was.
     pub fn pass(
         &mut self,
+        scene: &Scene,
         samples: u32,
         progress: &(dyn Fn(&Progress) -> bool + Sync),
     ) -> Result<RenderStats, RenderError> {
@@ -975,15 +975,16 @@ impl<'a> ProgressiveRender<'a> {
             .taken
             .saturating_add(samples.max(1))
             .min(self.settings.samples_per_pixel());
-        let scene = self.scene;
         let depth = self.settings.max_depth();
         let run = || match self.settings.integrator {
             IntegratorKind::Path => self.run_pass(
+                scene,
                 &PathIntegrator::new(scene, PathSettings::for_scene(scene, depth)),
                 end,
                 progress,
             ),
             IntegratorKind::VolPath => self.run_pass(
+                scene,
                 &VolPathIntegrator::new(scene, PathSettings::for_scene(scene, depth)),
                 end,
                 progress,
@@ -1023,6 +1024,7 @@ impl<'a> ProgressiveRender<'a> {
     /// One pass of `integrator`: every pixel's sums taken up to sample `end`.
     fn run_pass<I: Integrator>(
         &self,
+        scene: &Scene,
         integrator: &I,
         end: u32,
         progress: &(dyn Fn(&Progress) -> bool + Sync),
@@ -1047,7 +1049,7 @@ impl<'a> ProgressiveRender<'a> {
                 let dropped = sums.map(|p| p.dropped);
                 sample_run(
                     integrator,
-                    self.scene,
+                    scene,
                     &pixels[..count],
                     &mut sums[..count],
                     end,

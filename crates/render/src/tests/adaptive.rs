@@ -197,7 +197,7 @@ fn passes_add_up_to_the_single_render_bit_for_bit() {
     for adaptive in [None, Some(ADAPTIVE)] {
         let whole = settings(adaptive);
         let (single, _) = render(&scene, &whole, &|_| true).unwrap();
-        let mut progressive = ProgressiveRender::new(&scene, &whole).unwrap();
+        let mut progressive = ProgressiveRender::new(&whole).unwrap();
         let mut passes = 0;
         let mut sizes = [1, 3, 2, 9].into_iter().chain(std::iter::repeat(16));
         while !progressive.is_finished() {
@@ -208,7 +208,7 @@ fn passes_add_up_to_the_single_render_bit_for_bit() {
                 None => sizes.next().unwrap(),
                 Some(adaptive) => (adaptive.check_after(taken) - taken).div_ceil(2),
             };
-            progressive.pass(samples, &|_| true).unwrap();
+            progressive.pass(&scene, samples, &|_| true).unwrap();
             passes += 1;
             let film = progressive.film();
             let taken = film.samples.as_ref().unwrap();
@@ -233,10 +233,10 @@ fn passes_add_up_to_the_single_render_bit_for_bit() {
 #[test]
 fn a_cancelled_pass_leaves_the_render_as_it_was() {
     let scene = scene(red());
-    let mut progressive = ProgressiveRender::new(&scene, &settings(None)).unwrap();
-    progressive.pass(4, &|_| true).unwrap();
+    let mut progressive = ProgressiveRender::new(&settings(None)).unwrap();
+    progressive.pass(&scene, 4, &|_| true).unwrap();
     let before = progressive.film();
-    assert!(progressive.pass(4, &|_| false).is_err());
+    assert!(progressive.pass(&scene, 4, &|_| false).is_err());
     assert_eq!(progressive.samples_taken(), 4);
     assert_eq!(progressive.film(), before);
 }
@@ -256,12 +256,12 @@ fn only_the_path_tracers_sample_adaptively_and_never_in_a_sample_range() {
         ..settings(Some(ADAPTIVE))
     };
     assert!(ranged.validate().unwrap_err().contains("sample range"));
-    assert!(ProgressiveRender::new(&scene, &settings(None).clone()).is_ok());
+    assert!(ProgressiveRender::new(&settings(None).clone()).is_ok());
     let course = RenderSettings {
         adaptive: None,
         ..course
     };
-    assert!(ProgressiveRender::new(&scene, &course).is_err());
+    assert!(ProgressiveRender::new(&course).is_err());
     for threshold in [0.0, -1.0, f32::NAN, f32::INFINITY] {
         let bad = settings(Some(AdaptiveSampling {
             threshold,
