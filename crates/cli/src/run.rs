@@ -445,7 +445,19 @@ fn write(
     match denoiser {
         Some(denoiser) => {
             let film = &rendered.film;
-            crate::denoise::write_render(denoiser, job, pool, film, &options, &metadata, err)?
+            // Without a lens, the layers are antialiased first hits, nearly clean already.
+            let noisy_layers = built.scene.camera.lens.is_some();
+            let written = crate::denoise::write_render(
+                denoiser,
+                job,
+                pool,
+                film,
+                noisy_layers,
+                &options,
+                &metadata,
+                err,
+            );
+            written?
         }
         None => pool
             .install(|| {
