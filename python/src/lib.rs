@@ -560,6 +560,7 @@ fn render<'py>(
         sample_range: None,
         threads,
         adaptive: None,
+        progressive_order: false,
     };
     settings.validate().map_err(PyValueError::new_err)?;
 

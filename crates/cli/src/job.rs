@@ -330,6 +330,8 @@ impl Options {
                 threshold,
                 min_samples: self.min_spp.unwrap_or(DEFAULT_MIN_SAMPLES),
             }),
+            // A budget may end at any sample count: each prefix should be stratified.
+            progressive_order: self.time_budget.is_some(),
             ..scene_settled
         };
         settings.validate().map_err(|why| {

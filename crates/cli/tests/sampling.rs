@@ -285,3 +285,84 @@ fn what_cannot_sample_progressively_is_refused_before_rendering() {
         );
     }
 }
+
+/// An adaptive render stopped by SIGTERM and resumed from its checkpoint is the uninterrupted
+/// checkpointed render, samples included: the bands decide as they would have.
+#[test]
+fn an_adaptive_render_resumes_from_its_checkpoint() {
+    let Some(scene) = cornell() else { return };
+    let dir = TempDir::new().unwrap();
+    let d = dir.path();
+    let base = [
+        "render",
+        scene.to_str().unwrap(),
+        "--integrator",
+        "path",
+        "-w",
+        "96",
+        "-h",
+        "96",
+        "--spp",
+        "256",
+        "--noise-threshold",
+        "0.05",
+        "-n",
+        "1",
+    ];
+    let run = |extra: &[&str]| {
+        let mut args = base.to_vec();
+        args.extend(extra);
+        glint(d, &args)
+    };
+    let whole = run(&["-o", "whole.exr", "--checkpoint", "ck.exr"]);
+    assert!(whole.status.success(), "{}", stderr(&whole));
+    let mut args = base.to_vec();
+    args.extend([
+        "-o",
+        "out.exr",
+        "--checkpoint",
+        "ck.exr",
+        "--checkpoint-every",
+        "0",
+    ]);
+    let child = Command::new(GLINT)
+        .args(&args)
+        .current_dir(d)
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    while !d.join("ck.exr").exists() && start.elapsed() < Duration::from_secs(30) {
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    let output = child.wait_with_output().unwrap();
+    if output.status.success() {
+        println!("SKIPPED: the render finished before SIGTERM");
+        return;
+    }
+    assert_eq!(output.status.code(), Some(130), "{}", stderr(&output));
+    let resumed = run(&["-o", "out.exr", "--resume", "ck.exr"]);
+    assert!(resumed.status.success(), "{}", stderr(&resumed));
+    assert!(
+        stderr(&resumed).contains("rows done"),
+        "{}",
+        stderr(&resumed)
+    );
+    let (a, b) = (
+        glint_io::read_exr(&d.join("whole.exr")).unwrap().film,
+        glint_io::read_exr(&d.join("out.exr")).unwrap().film,
+    );
+    assert!(a.samples.is_some());
+    assert_eq!(a.samples, b.samples);
+    let bits = |film: &glint_render::Film| -> Vec<[u32; 3]> {
+        film.pixels
+            .iter()
+            .map(|c| c.to_array().map(f32::to_bits))
+            .collect()
+    };
+    assert!(bits(&a) == bits(&b), "the resumed image differs");
+}

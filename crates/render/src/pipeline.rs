@@ -173,6 +173,11 @@ pub struct RenderSettings {
     /// Stop sampling each pixel once its estimated error is small enough
     /// ([`AdaptiveSampling`]); `None` takes every sample in every pixel.
     pub adaptive: Option<AdaptiveSampling>,
+    /// Give the path tracers' samples in an order whose every prefix is stratified, for a
+    /// render that may stop after any number of them (a time budget); adaptive sampling
+    /// always does. Off, a pixel's `samples_per_pixel` samples are stratified as a whole and
+    /// a prefix of them is a random subset (the images differ, not their expected value).
+    pub progressive_order: bool,
 }
 
 /// Adaptive sampling: every pixel takes `min_samples` samples, then the render goes on in
@@ -253,6 +258,7 @@ impl Default for RenderSettings {
             sample_range: None,
             threads: None,
             adaptive: None,
+            progressive_order: false,
         }
     }
 }
@@ -863,6 +869,7 @@ fn pixel_context(settings: &RenderSettings) -> impl Fn(u32, u32) -> PixelContext
         samples_per_pixel: settings.samples_per_pixel(),
         max_depth: settings.max_depth(),
         features: settings.features,
+        progressive_order: settings.adaptive.is_some() || settings.progressive_order,
     }
 }
 

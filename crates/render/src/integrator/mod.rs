@@ -39,9 +39,23 @@ pub(crate) struct PixelContext {
     pub max_depth: u32,
     /// Whether samples should carry first-hit features.
     pub features: bool,
+    /// Whether the pixel may stop after any number of samples, so that every prefix of its
+    /// samples should be stratified (`SobolPixel::progressive`).
+    pub progressive_order: bool,
 }
 
 impl PixelContext {
+    /// The pixel's Sobol' samples (the path tracers'), in the order its render needs.
+    #[inline]
+    pub fn sobol(&self) -> crate::sampling::sobol::SobolPixel {
+        use crate::sampling::sobol::SobolPixel;
+        if self.progressive_order {
+            SobolPixel::progressive(self.seed, self.index())
+        } else {
+            SobolPixel::new(self.seed, self.index(), self.samples_per_pixel)
+        }
+    }
+
     /// The row-major index of the pixel in the whole image: with the seed and the sample
     /// index, the key of every random number.
     #[inline]

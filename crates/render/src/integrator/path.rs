@@ -34,7 +34,7 @@ use crate::material::{Material, MaterialId};
 use crate::math::Color;
 use crate::math::Frame;
 use crate::ray::Ray;
-use crate::sampling::sobol::{PathSampler, SobolPixel};
+use crate::sampling::sobol::PathSampler;
 use crate::scene::physical::PixelFilter;
 use crate::scene::{AnyHit, Scene, SurfaceNeeds};
 
@@ -540,7 +540,7 @@ impl Integrator for PathIntegrator {
         rays: &mut u64,
         sink: &mut impl FnMut(Sample),
     ) {
-        let sobol = SobolPixel::new(pixel.seed, pixel.index(), pixel.samples_per_pixel);
+        let sobol = pixel.sobol();
         let dimension = first_path_dimension(scene);
         // Sample `s`'s camera ray (with a unit direction) and sampler, the first vertex's
         // look-ahead started.

@@ -42,7 +42,7 @@ use crate::material::MaterialId;
 use crate::math::{Color, Frame, Vec3};
 use crate::medium::{Medium, MediumId};
 use crate::ray::{Ray, SPAWN_EPSILON};
-use crate::sampling::sobol::{PathSampler, SobolPixel};
+use crate::sampling::sobol::PathSampler;
 use crate::scene::{Scene, SurfaceNeeds};
 
 /// The most surfaces a shadow ray crosses before it counts as blocked (a bound on the work of
@@ -653,7 +653,7 @@ impl Integrator for VolPathIntegrator {
         rays: &mut u64,
         sink: &mut impl FnMut(Sample),
     ) {
-        let sobol = SobolPixel::new(pixel.seed, pixel.index(), pixel.samples_per_pixel);
+        let sobol = pixel.sobol();
         for s in samples {
             let mut sampler = sobol.sampler(s);
             let (ox, oy) = self.filter.offset(sampler.sample_2d(0));

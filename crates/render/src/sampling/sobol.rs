@@ -66,6 +66,8 @@ pub const QMC_DIMENSIONS: u32 = 32;
 pub struct SobolPixel {
     /// `Rng::pixel_key(seed, pixel)`.
     rng_key: u64,
+    /// Shuffle the index by nesting (`nested_shuffle`) instead of by `Permutation`.
+    progressive: bool,
     dimensions: [DimensionSeeds; QMC_DIMENSIONS as usize],
 }
 
@@ -216,7 +218,21 @@ impl SobolPixel {
         });
         SobolPixel {
             rng_key: Rng::pixel_key(seed, pixel),
+            progressive: false,
             dimensions,
+        }
+    }
+
+    /// Pixel `pixel` for a render that may stop it after any number of samples (adaptive
+    /// sampling, a time budget): the index is shuffled by `nested_shuffle`, so that every
+    /// prefix of its samples is stratified (the first 2^k samples are an aligned block of 2^k
+    /// Sobol' points in each dimension pair: a (0, k, 2)-net in the pair of `sample_2d`),
+    /// where `new`'s permutation stratifies only the whole set of `sample_count` samples and
+    /// makes any prefix a random subset of it. The values differ from `new`'s.
+    pub fn progressive(seed: u64, pixel: u64) -> SobolPixel {
+        SobolPixel {
+            progressive: true,
+            ..SobolPixel::new(seed, pixel, 1)
         }
     }
 
@@ -252,6 +268,9 @@ impl SobolSampler<'_> {
         let seeds = &self.pixel.dimensions[dimension as usize];
         let index = match self.prepared {
             (d, index) if d == dimension => index,
+            _ if self.pixel.progressive => {
+                nested_shuffle(self.sample_index, seeds.permutation.seed)
+            }
             _ => seeds.permutation.apply(self.sample_index),
         };
         (index, seeds)
@@ -278,7 +297,12 @@ impl PathSampler for SobolSampler<'_> {
     fn prepare(&mut self, dimension: u32) {
         if dimension < QMC_DIMENSIONS {
             let seeds = &self.pixel.dimensions[dimension as usize];
-            self.prepared = (dimension, seeds.permutation.apply_ahead(self.sample_index));
+            let index = if self.pixel.progressive {
+                nested_shuffle(self.sample_index, seeds.permutation.seed)
+            } else {
+                seeds.permutation.apply_ahead(self.sample_index)
+            };
+            self.prepared = (dimension, index);
         }
     }
 
@@ -424,6 +448,15 @@ const fn sobol_tables(s: usize, a: u32, m: [u32; 3]) -> [[u32; 256]; 4] {
     tables
 }
 
+/// The sample index `i` shuffled by a nested uniform scramble of its bits, most significant
+/// first (Burley 2020, section 4): indices that agree in their top bits map to indices that
+/// agree in theirs, so 0..2^k maps onto an aligned block of 2^k indices, in an order the seed
+/// chooses. `owen_hash` scrambles a bit-reversed value that way.
+#[inline(always)]
+fn nested_shuffle(i: u32, seed: u32) -> u32 {
+    owen_hash(i.reverse_bits(), seed).reverse_bits()
+}
+
 /// `owen_scramble_reversed` before its final reversal.
 #[inline(always)]
 fn owen_hash(reversed: u32, seed: u32) -> u32 {
@@ -446,6 +479,43 @@ fn unit_float(bits: u32) -> f32 {
 mod tests {
     use super::*;
     use crate::integrator::course::permute;
+
+    /// How many cells of a 2^k x 2^k grid the first 4^k samples of the pair at
+    /// `dimension` leave empty, for `pixel`'s samples.
+    fn empty_cells(pixel: &SobolPixel, dimension: u32, k: u32) -> usize {
+        let side = 1usize << k;
+        let mut hit = vec![false; side * side];
+        for s in 0..(side * side) as u32 {
+            let (u, v) = pixel.sampler(s).sample_2d(dimension);
+            hit[(v * side as f32) as usize * side + (u * side as f32) as usize] = true;
+        }
+        hit.iter().filter(|&&h| !h).count()
+    }
+
+    /// A progressive pixel's first 4, 16, 64 and 256 samples each fill every cell of a
+    /// 2x2 ... 16x16 grid in each dimension pair: any prefix a render stops at is stratified.
+    /// The whole-set shuffle's prefixes do not (the negative control): they are random
+    /// subsets of its 1024 samples.
+    #[test]
+    fn every_power_of_four_prefix_of_a_progressive_pixel_is_stratified() {
+        let mut whole_empty = 0;
+        for pixel in 0..20u64 {
+            let progressive = SobolPixel::progressive(3, pixel);
+            let whole = SobolPixel::new(3, pixel, 1024);
+            for dimension in [0, 2, 6, 12] {
+                for k in 1..=4 {
+                    assert_eq!(
+                        empty_cells(&progressive, dimension, k),
+                        0,
+                        "pixel {pixel}, dimension {dimension}, first {} samples",
+                        1 << (2 * k)
+                    );
+                    whole_empty += empty_cells(&whole, dimension, k);
+                }
+            }
+        }
+        assert!(whole_empty > 100, "{whole_empty}");
+    }
 
     #[test]
     fn first_points_are_stratified() {

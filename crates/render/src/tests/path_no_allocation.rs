@@ -260,6 +260,7 @@ fn tracing_paths_does_not_allocate() {
                 samples_per_pixel: 12,
                 max_depth: PathSettings::default().max_depth,
                 features: true,
+                progressive_order: false,
             };
             integrator.pixel_samples(&scene, &pixel, 0..12, &mut rays, &mut |sample| {
                 sum += sample.radiance;
