@@ -1,7 +1,8 @@
 // The page: choose or drop a scene or a glTF model, check it with the renderer (diagnostics as
-// the CLI prints them), render it in tiles on a pool of Web Workers, and download the image
-// encoded by the same Rust code as the CLI's.
-import init, { Files, encode, load_bytes as loadBytes } from './pkg/glint_wasm.js';
+// the CLI prints them), render it in tiles on a pool of Web Workers (the path tracers in passes
+// over the whole image, optionally to a time budget), and download the image encoded by the same
+// Rust code as the CLI's.
+import init, { Files, Settings, encode, load_bytes as loadBytes } from './pkg/glint_wasm.js';
 
 const EXAMPLES = [
   { name: 'Three spheres', root: 'scenes/', scene: 'three_spheres.xml', assets: [] },
@@ -13,6 +14,8 @@ const EXAMPLES = [
   },
 ];
 const TILE = 32;
+// The longest time budget, as `glint render --time` takes: a year.
+const MAX_TIME_BUDGET = 365 * 24 * 3600;
 const SCENE_FILE = /\.(xml|json|gltf|glb)$/i;
 // A GLB is binary: it is loaded from the dropped bytes and its text is not shown or edited.
 const BINARY_SCENE = /\.glb$/i;
@@ -23,7 +26,7 @@ const ui = {
   openFolder: $('open-folder'), sceneFile: $('scene-file'), sceneText: $('scene-text'),
   assetList: $('asset-list'), diagnostics: $('diagnostics'), width: $('width'),
   height: $('height'), spp: $('spp'), integrator: $('integrator'), maxDepth: $('max-depth'),
-  seed: $('seed'), features: $('features'), render: $('render'), cancel: $('cancel'),
+  seed: $('seed'), time: $('time'), features: $('features'), render: $('render'), cancel: $('cancel'),
   downloadPng: $('download-png'), downloadExr: $('download-exr'), status: $('status'),
   progress: $('progress'), tiles: $('tiles'), elapsed: $('elapsed'),
   raysPerSecond: $('rays-per-second'), firstPixel: $('first-pixel'), workers: $('workers'),
@@ -45,6 +48,13 @@ const workerCount = Number(new URLSearchParams(location.search).get('workers'))
 function setStatus(state, text) {
   ui.status.dataset.state = state;
   ui.status.textContent = text;
+}
+
+// A render in passes also marks its status with the passes complete and the samples per pixel
+// they reached (what the canvas and the downloads hold), for whoever watches it.
+function markPass(passes, samples) {
+  ui.status.dataset.pass = String(passes);
+  ui.status.dataset.samples = String(samples);
 }
 
 function startPool() {
@@ -203,7 +213,26 @@ function readSettings() {
     seed: integer(ui.seed),
     maxDepth: ui.maxDepth.value === '' ? undefined : integer(ui.maxDepth),
     features: ui.features.checked,
+    // Seconds, or null for no budget; checked in startRender.
+    time: ui.time.value.trim() === '' ? null : Number(ui.time.value),
   };
+}
+
+// Why these settings cannot render in passes (glint-render's rule, in its words, naming `what`),
+// or null when they can. Throws what the workers would for settings that cannot render at all.
+function progressiveRefusal(settings, what) {
+  const s = settings;
+  const renderSettings = new Settings(
+    s.width, s.height, s.spp, s.integrator, BigInt(s.seed), s.maxDepth, s.features,
+  );
+  try {
+    renderSettings.check_progressive(what);
+    return null;
+  } catch (error) {
+    return String(error);
+  } finally {
+    renderSettings.free();
+  }
 }
 
 function startRender() {
@@ -213,11 +242,24 @@ function startRender() {
     return;
   }
   const settings = readSettings();
+  let refusal;
+  try {
+    if (settings.time !== null && !(settings.time > 0 && settings.time <= MAX_TIME_BUDGET)) {
+      throw new Error(`the time budget must be a number of seconds above 0 and at most ${MAX_TIME_BUDGET}`);
+    }
+    refusal = progressiveRefusal(settings, 'a time budget');
+    if (refusal && settings.time !== null) throw new Error(refusal);
+  } catch (error) {
+    setStatus('error', `the render failed: ${error.message ?? error}`);
+    return;
+  }
   const { width, height } = settings;
   const tiles = [];
   for (let y0 = 0; y0 < height; y0 += TILE) {
     for (let x0 = 0; x0 < width; x0 += TILE) {
-      tiles.push({ x0, y0, x1: Math.min(x0 + TILE, width), y1: Math.min(y0 + TILE, height) });
+      tiles.push({
+        index: tiles.length, x0, y0, x1: Math.min(x0 + TILE, width), y1: Math.min(y0 + TILE, height),
+      });
     }
   }
   const pixelCount = width * height;
@@ -225,9 +267,18 @@ function startRender() {
     job: ++jobCounter,
     running: true,
     settings,
-    queue: tiles,
+    tiles,
+    queue: [...tiles],
     total: tiles.length,
     done: 0,
+    // In passes (the path tracers): the pass in flight, the samples per pixel it reaches, and
+    // those of the last pass complete (what the image holds). Workers' own queues from pass 2.
+    progressive: refusal === null,
+    pass: 1,
+    target: 1,
+    taken: 0,
+    passStart: null,
+    queues: null,
     rays: 0,
     nonfinite: 0,
     start: performance.now(),
@@ -246,7 +297,12 @@ function startRender() {
   ui.cancel.disabled = false;
   ui.downloadPng.disabled = true;
   ui.downloadExr.disabled = true;
-  setStatus('rendering', 'rendering…');
+  delete ui.status.dataset.pass;
+  delete ui.status.dataset.samples;
+  setStatus('rendering', render.progressive
+    ? `rendering pass 1 (1 of ${settings.spp} samples per pixel)…`
+    : 'rendering…');
+  render.passStart = render.start;
   showProgress();
   const message = {
     type: 'job',
@@ -260,9 +316,24 @@ function startRender() {
   render.timer = setInterval(showProgress, 250);
 }
 
+// Hands `worker` its next tile. In passes, pass 1 shares one queue (so the workers balance their
+// load) and each tile stays with the worker that took it, which holds its running sums; later
+// passes give each worker its own tiles.
 function nextTile(worker) {
-  const tile = render.queue.shift();
-  if (tile) worker.postMessage({ type: 'tile', job: render.job, tile });
+  const queue = render.queues ? render.queues.get(worker) : render.queue;
+  const tile = queue?.shift();
+  if (!tile) return;
+  if (!render.progressive) {
+    worker.postMessage({ type: 'tile', job: render.job, tile });
+    return;
+  }
+  tile.worker = worker;
+  worker.postMessage({ type: 'tile', job: render.job, tile: tileBounds(tile), samples: render.target });
+}
+
+// A tile as a message carries it: its index and bounds (not its worker).
+function tileBounds({ index, x0, y0, x1, y1 }) {
+  return { index, x0, y0, x1, y1 };
 }
 
 function onWorkerMessage(worker, data) {
@@ -272,7 +343,10 @@ function onWorkerMessage(worker, data) {
   } else if (data.type === 'tile') {
     storeTile(data);
     nextTile(worker);
-    if (render.done === render.total) finishRender();
+    if (render.done === render.total) {
+      if (render.progressive) passDone();
+      else finishRender();
+    }
   } else if (data.type === 'failed') {
     failRender(data.error);
   }
@@ -310,9 +384,49 @@ function storeTile({ tile, rgb8, pixels, albedo, normal, depth, rays, nonfinite 
   render.nonfinite += nonfinite;
 }
 
+// Every tile has the pass's samples: the image is whole at `render.target` samples per pixel.
+// The next pass doubles the samples (capped at the spp control) unless that was the last, or
+// the time budget is spent; with a budget, it also takes no more samples than the last pass's
+// time per sample says fit in what is left (at least one), as `glint render --time` does.
+function passDone() {
+  const now = performance.now();
+  const added = render.target - render.taken;
+  const perSample = (now - render.passStart) / 1000 / added;
+  render.taken = render.target;
+  const { spp, time } = render.settings;
+  markPass(render.pass, render.taken);
+  ui.downloadPng.disabled = false;
+  ui.downloadExr.disabled = false;
+  const seconds = (now - render.start) / 1000;
+  if (render.taken >= spp || (time !== null && seconds >= time)) {
+    finishRender();
+    return;
+  }
+  let samples = Math.min(render.taken, spp - render.taken);
+  if (time !== null) samples = Math.max(1, Math.min(samples, Math.floor((time - seconds) / perSample)));
+  render.pass += 1;
+  render.target = render.taken + samples;
+  render.passStart = now;
+  render.done = 0;
+  render.queues = new Map(pool.map((worker) => [worker, []]));
+  for (const tile of render.tiles) render.queues.get(tile.worker).push(tile);
+  setStatus('rendering', `${passText()}; rendering pass ${render.pass} (${render.target} samples)…`);
+  showProgress();
+  for (const worker of pool) nextTile(worker);
+}
+
+// "pass 3: 4 of 64 samples per pixel": the last pass complete.
+function passText() {
+  const passes = render.target === render.taken ? render.pass : render.pass - 1;
+  return `pass ${passes}: ${render.taken} of ${render.settings.spp} samples per pixel`;
+}
+
 function showProgress() {
   const seconds = (performance.now() - render.start) / 1000;
-  ui.progress.value = render.done / render.total;
+  // In passes, the share of the spp control's samples taken, the pass in flight's tiles included.
+  ui.progress.value = render.progressive
+    ? (render.taken + (render.target - render.taken) * (render.done / render.total)) / render.settings.spp
+    : render.done / render.total;
   ui.tiles.textContent = `${render.done} / ${render.total}`;
   ui.elapsed.textContent = `${seconds.toFixed(2)} s`;
   ui.elapsed.dataset.seconds = String(seconds);
@@ -338,19 +452,33 @@ function finishRender() {
   endRender();
   ui.downloadPng.disabled = false;
   ui.downloadExr.disabled = false;
-  const { width, height } = render.settings;
+  const { width, height, spp, time } = render.settings;
   const dropped = render.nonfinite
     ? `; ${render.nonfinite} samples returned NaN or infinity and were left out of the image`
     : '';
-  setStatus('done', `rendered ${width}x${height} in ${ui.elapsed.textContent}${dropped}`);
+  let passes = '';
+  if (render.progressive) {
+    const count = `${render.pass} pass${render.pass === 1 ? '' : 'es'}`;
+    passes = render.taken < spp
+      ? `: the ${time} s time budget ran out after ${count}, at ${render.taken} of ${spp} samples per pixel`
+      : `: ${count}, ${spp} samples per pixel`;
+  }
+  setStatus('done', `rendered ${width}x${height} in ${ui.elapsed.textContent}${passes}${dropped}`);
 }
 
+// In passes, what the last complete pass left stays on the canvas and can be downloaded: a user
+// may stop a render once its image is good enough.
 function cancelRender() {
   if (!render?.running) return;
   endRender();
   stopPool();
   startPool();
-  setStatus('cancelled', `cancelled after ${render.done} of ${render.total} tiles`);
+  if (render.progressive && render.taken > 0) {
+    setStatus('cancelled', `cancelled in pass ${render.pass} after ${render.done} of ${render.total} `
+      + `tiles; ${passText()}`);
+  } else {
+    setStatus('cancelled', `cancelled after ${render.done} of ${render.total} tiles`);
+  }
 }
 
 function failRender(error) {

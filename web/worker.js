@@ -1,12 +1,15 @@
 // One render worker: loads the scene into its own copy of the renderer, then renders the tiles
-// the page hands it, one at a time, until the page terminates it.
+// the page hands it, one at a time, until the page terminates it. For the path tracers a tile
+// comes once a pass: the worker keeps its running sums (`TilePasses`) from pass to pass, and the
+// page sends each tile back to the worker that rendered its first pass.
 import init, { Files, Settings, load_bytes as loadBytes } from './pkg/glint_wasm.js';
 
 const ready = init();
-let current = null; // { job, loaded, settings }
+let current = null; // { job, loaded, settings, passes: Map(tile index -> TilePasses) }
 
 function release() {
   if (current) {
+    for (const passes of current.passes.values()) passes.free();
     current.loaded.free();
     current.settings.free();
     current = null;
@@ -28,17 +31,32 @@ function startJob({ job, bytes, path, files, settings }) {
   const renderSettings = new Settings(
     s.width, s.height, s.spp, s.integrator, BigInt(s.seed), s.maxDepth, s.features,
   );
-  current = { job, loaded, settings: renderSettings };
+  current = { job, loaded, settings: renderSettings, passes: new Map() };
   return { type: 'ready', job };
 }
 
-function renderTile({ job, tile }) {
+// Takes `tile` to `samples` samples per pixel, starting its passes on its first.
+function passTile(tile, samples) {
+  let passes = current.passes.get(tile.index);
+  if (!passes) {
+    passes = current.loaded.start_passes(current.settings, tile.x0, tile.y0, tile.x1, tile.y1);
+    current.passes.set(tile.index, passes);
+  }
+  const result = passes.pass(current.loaded, samples - passes.samples_taken);
+  return { result, taken: passes.samples_taken };
+}
+
+// `samples` (the samples per pixel the tile's pass reaches) is there only for a render in passes.
+function renderTile({ job, tile, samples }) {
   if (!current || current.job !== job) return { type: 'failed', job, error: 'no scene loaded' };
-  const result = current.loaded.render_tile(current.settings, tile.x0, tile.y0, tile.x1, tile.y1);
+  const { result, taken } = samples === undefined
+    ? { result: current.loaded.render_tile(current.settings, tile.x0, tile.y0, tile.x1, tile.y1) }
+    : passTile(tile, samples);
   const message = {
     type: 'tile',
     job,
     tile,
+    taken,
     rgb8: result.rgb8,
     pixels: result.pixels,
     albedo: result.albedo,

@@ -179,36 +179,138 @@ test('the page renders the example scene with its assets exactly as the CLI', as
   await context.close();
 });
 
-test('the path tracer\'s PNG on the page is the CLI\'s, display transform included', async () => {
+/** The largest difference between two RGBA images' colour channels, and how many differ. */
+function channelDifference(a, b) {
+  assert.equal(a.length, b.length);
+  let largest = 0;
+  let differing = 0;
+  for (let i = 0; i < a.length; i += 1) {
+    if (i % 4 === 3) continue;
+    const difference = Math.abs(a[i] - b[i]);
+    largest = Math.max(largest, difference);
+    if (difference) differing += 1;
+  }
+  return { largest, differing };
+}
+
+/** Renders the three spheres with the path tracer through the CLI; returns its PNG decoded. */
+function cliPath(name, { width, height, spp }) {
+  const file = path.join(output, name);
+  const run = runGlint(['render', path.join(web, 'scenes', 'three_spheres.xml'), '-o', file,
+    '--integrator', 'path', '-w', String(width), '-h', String(height), '-r', String(spp)]);
+  assert.equal(run.status, 0, run.stderr);
+  return decodePng(fs.readFileSync(file));
+}
+
+/**
+ * Records, in the page, every status text and the canvas as it stands when the status first
+ * says a pass is complete: taken in the same task as the pass's last tile (a MutationObserver
+ * runs before the next worker message), so it is exactly the first pass's image.
+ */
+async function watchPasses(page) {
+  await page.evaluate(() => {
+    const status = document.getElementById('status');
+    const canvas = document.getElementById('canvas');
+    window.passLog = { texts: [], firstPass: null };
+    new MutationObserver(() => {
+      const log = window.passLog;
+      if (log.texts.at(-1) !== status.textContent) log.texts.push(status.textContent);
+      if (status.dataset.pass && !log.firstPass) {
+        const { data } = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height);
+        log.firstPass = { pass: status.dataset.pass, data: Array.from(data) };
+      }
+    }).observe(status, { attributes: true, childList: true, characterData: true, subtree: true });
+  });
+}
+
+async function canvasPixels(page) {
+  return page.evaluate(() => {
+    const element = document.getElementById('canvas');
+    return Array.from(element.getContext('2d').getImageData(0, 0, element.width, element.height).data);
+  });
+}
+
+test('the path tracer renders in passes, the first on screen early, and ends as the CLI\'s PNG', async () => {
   const settings = { width: 64, height: 48, spp: 4 };
   const cliPng = path.join(output, 'cli-path.png');
-  const run = runGlint(['render', path.join(web, 'scenes', 'three_spheres.xml'), '-o', cliPng,
-    '--integrator', 'path', '-w', String(settings.width), '-h', String(settings.height),
-    '-r', String(settings.spp)]);
-  assert.equal(run.status, 0, run.stderr);
+  const cli = cliPath('cli-path.png', settings);
 
   const { page, context, errors } = await openPage();
   await chooseExample(page, 0);
   await setSettings(page, settings);
   await page.selectOption('#integrator', 'path');
+  await watchPasses(page);
   await page.click('#render');
   await page.waitForSelector('#status[data-state="done"]', { timeout: 120_000 });
+  const { texts, firstPass } = await page.evaluate(() => window.passLog);
+  const final = await canvasPixels(page);
   const png = await downloadBytes(page, '#download-png');
   fs.writeFileSync(path.join(output, 'page-path.png'), png);
-  const cli = decodePng(fs.readFileSync(cliPng));
   const ours = decodePng(png);
-  let largest = 0;
-  let differing = 0;
-  for (let i = 0; i < cli.data.length; i += 1) {
-    const difference = Math.abs(cli.data[i] - ours.data[i]);
-    largest = Math.max(largest, difference);
-    if (difference) differing += 1;
+
+  // Passes of 1, 2 and 4 samples per pixel, each announced, each whole before the next.
+  const passes = texts.filter((text) => /^pass \d+:/.test(text));
+  assert.deepEqual(passes.map((text) => text.split(';')[0]),
+    ['pass 1: 1 of 4 samples per pixel', 'pass 2: 2 of 4 samples per pixel'], texts.join('\n'));
+  assert.match(texts.at(-1), /^rendered 64x48 in .*: 3 passes, 4 samples per pixel$/);
+  assert.equal(await page.getAttribute('#status', 'data-pass'), '3');
+  assert.equal(await page.getAttribute('#status', 'data-samples'), '4');
+
+  // The first pass's canvas, on screen while the render went on: the whole image at one sample
+  // per pixel, not blank, and not the final image. (Not the CLI's -r 1: a pixel's samples are
+  // drawn in an order that depends on the samples per pixel asked for.)
+  assert.equal(firstPass?.pass, '1');
+  const colours = new Set();
+  for (let i = 0; i < firstPass.data.length; i += 4) {
+    colours.add(firstPass.data.slice(i, i + 3).join());
+    assert.equal(firstPass.data[i + 3], 255, 'a pixel of the first pass is not drawn');
   }
+  assert.ok(colours.size > 16, `a blank first pass: ${colours.size} colours`);
+  const refined = channelDifference(firstPass.data, final);
+  assert.ok(refined.differing > final.length / 8, `the passes changed ${refined.differing} channels`);
+
+  const { largest, differing } = channelDifference(cli.data, ours.data);
   console.log(`# path tracer, page PNG vs CLI PNG: largest difference ${largest}/255 in ${differing} channels`
-    + `; bytes ${png.equals(fs.readFileSync(cliPng)) ? 'equal' : 'differ'}`);
+    + `; bytes ${png.equals(fs.readFileSync(cliPng)) ? 'equal' : 'differ'}; `
+    + `the passes after the first changed ${refined.differing} channels`);
   // The same encoder and transform; wasm's libm may round a float differently in the last bit,
   // which can move an 8-bit value by one level and no more.
   assert.ok(largest <= 1, `largest difference ${largest}/255`);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('a time budget stops the passes early and says how many samples it reached', async () => {
+  const settings = { width: 160, height: 120, spp: 65536 };
+  const { page, context, errors } = await openPage();
+  await chooseExample(page, 0);
+  await setSettings(page, settings);
+
+  // As the CLI, only for the path tracers.
+  await page.fill('#time', '1');
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="error"]');
+  assert.match(await page.textContent('#status'),
+    /a time budget is for the path tracers \(path, volpath\), not the course integrator/);
+
+  await page.selectOption('#integrator', 'path');
+  await page.click('#render');
+  // 65536 samples per pixel would take hours: only the budget ends this render in time.
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 60_000 });
+  const text = await page.textContent('#status');
+  const samples = Number(await page.getAttribute('#status', 'data-samples'));
+  const passes = Number(await page.getAttribute('#status', 'data-pass'));
+  const seconds = Number(await page.getAttribute('#elapsed', 'data-seconds'));
+  console.log(`# time budget 1 s: ${text}`);
+  assert.ok(samples >= 1 && samples < settings.spp, text);
+  assert.match(text, new RegExp(`the 1 s time budget ran out after ${passes} pass(es)?, `
+    + `at ${samples} of 65536 samples per pixel`));
+  assert.ok(seconds >= 1 && seconds < 30, `${seconds} s`);
+  // The download is the image on the canvas: the passes' image, not blank.
+  const ours = decodePng(await downloadBytes(page, '#download-png'));
+  const canvas = await canvasPixels(page);
+  assert.ok(Buffer.from(ours.data).equals(Buffer.from(canvas)), 'the PNG is not the canvas');
+  assert.ok(new Set(canvas.filter((_, i) => i % 4 === 0)).size > 16, 'a blank image');
   assert.deepEqual(errors, []);
   await context.close();
 });
@@ -290,6 +392,24 @@ test('Cancel stops a render, and the next render runs', async () => {
   await page.click('#render');
   await page.waitForSelector('#status[data-state="done"]', { timeout: 60_000 });
   assert.equal(await page.textContent('#tiles'), '4 / 4');
+
+  // In passes, Cancel keeps the image of the passes complete, to download.
+  await page.selectOption('#integrator', 'path');
+  await setSettings(page, { width: 640, height: 480, spp: 4096 });
+  await page.click('#render');
+  await page.waitForSelector('#status[data-pass="1"]', { timeout: 60_000 });
+  await page.click('#cancel');
+  await page.waitForSelector('#status[data-state="cancelled"]');
+  const cancelled = await page.textContent('#status');
+  const pass = Number(await page.getAttribute('#status', 'data-pass'));
+  const samples = await page.getAttribute('#status', 'data-samples');
+  assert.match(cancelled, new RegExp(`^cancelled in pass ${pass + 1} after \\d+ of 300 tiles; `
+    + `pass ${pass}: ${samples} of 4096 samples per pixel$`));
+  const passTiles = await page.textContent('#tiles');
+  await page.waitForTimeout(1500);
+  assert.equal(await page.textContent('#tiles'), passTiles, 'tiles kept arriving after Cancel');
+  assert.ok(!await page.isDisabled('#download-png'));
+  assert.deepEqual(decodePng(await downloadBytes(page, '#download-png')).width, 640);
   assert.deepEqual(errors, []);
   await context.close();
 });

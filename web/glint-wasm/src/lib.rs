@@ -8,6 +8,9 @@
 //!   [`load_bytes`] does the same from a file's bytes, for glTF models (`.glb` is binary);
 //! - [`Loaded::render_tile`] renders one rectangle of the image with `RenderSettings::pixel_bounds`,
 //!   so tiles rendered by separate Web Workers are the pixels of the whole render;
+//! - [`Loaded::start_passes`] starts one such rectangle rendered in passes ([`TilePasses`],
+//!   glint-render's `ProgressiveRender`), for the path tracers: each pass adds samples to
+//!   every pixel and gives the image so far, and the last is `render_tile`'s bit for bit;
 //! - [`encode`] turns the assembled film into PNG or EXR bytes with glint-io's own encoder, so the
 //!   page's files equal the CLI's byte for byte.
 //!
@@ -19,14 +22,15 @@
 #![forbid(unsafe_code)]
 
 use std::path::Path;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use glint_io::{
     Diagnostic, Limits, LoadedScene, MemoryAssets, ModelOptions, OutputFormat, PngEncoding,
     SceneError, Severity, WriteOptions,
 };
 use glint_render::{
-    Color, Features, Film, IntegratorKind, PixelBounds, RenderDefaults, RenderSettings,
-    RequestedSettings, Scene, Vec3,
+    Color, Features, Film, IntegratorKind, PixelBounds, ProgressiveRender, RenderDefaults,
+    RenderSettings, RenderStats, RequestedSettings, Scene, Vec3,
 };
 use wasm_bindgen::prelude::*;
 
@@ -97,6 +101,16 @@ pub struct Loaded {
     messages: Vec<Message>,
     /// What the scene file asks of its render (a Mitsuba scene's film, sampler, integrator).
     defaults: RenderDefaults,
+    /// Which load this is, so that a [`TilePasses`] refuses any scene but the one it began
+    /// with (its sums mean nothing for another).
+    id: u64,
+}
+
+/// Numbers each `Loaded`; never 0.
+static NEXT_LOAD: AtomicU64 = AtomicU64::new(1);
+
+fn next_load() -> u64 {
+    NEXT_LOAD.fetch_add(1, Ordering::Relaxed)
 }
 
 /// What a scene asks of its render, in the page's terms (`RequestedSettings::from_scene`):
@@ -173,12 +187,14 @@ impl Loaded {
                     defaults: loaded.parts.physical.defaults,
                     scene: Some(Scene::new(loaded.parts)),
                     messages,
+                    id: next_load(),
                 }
             }
             Err(SceneError::Invalid(diagnostic)) => Loaded {
                 scene: None,
                 messages: vec![Message::from_diagnostic(&diagnostic)],
                 defaults: RenderDefaults::default(),
+                id: next_load(),
             },
             Err(error) => Loaded {
                 scene: None,
@@ -192,6 +208,7 @@ impl Loaded {
                     text: format!("error: {error}"),
                 }],
                 defaults: RenderDefaults::default(),
+                id: next_load(),
             },
         }
     }
@@ -236,6 +253,12 @@ impl Settings {
     #[wasm_bindgen(getter)]
     pub fn samples_per_pixel(&self) -> u32 {
         self.0.samples_per_pixel()
+    }
+
+    /// Whether these settings can render in passes ([`Loaded::start_passes`]); if not, throws
+    /// why, naming `what` (e.g. `a time budget`) as `glint render` does.
+    pub fn check_progressive(&self, what: &str) -> Result<(), String> {
+        self.0.check_progressive(what)
     }
 }
 
@@ -305,7 +328,38 @@ impl Loaded {
         };
         let (film, stats) =
             glint_render::render(scene, &settings, &|_| true).map_err(|error| error.to_string())?;
-        let rgb8 = PngEncoding::default_for(settings.integrator).to_rgb8(&film);
+        Ok(Tile::new(film, &stats, settings.integrator))
+    }
+
+    /// Starts pixels `x0..x1` by `y0..y1` of the image `settings` describe rendered in passes,
+    /// no sample taken yet: for the path tracers only (`Settings::check_progressive`). Each
+    /// [`TilePasses::pass`] is given this same `Loaded`.
+    pub fn start_passes(
+        &self,
+        settings: &Settings,
+        x0: u32,
+        y0: u32,
+        x1: u32,
+        y1: u32,
+    ) -> Result<TilePasses, String> {
+        self.scene.as_ref().ok_or("the scene did not load")?;
+        let settings = RenderSettings {
+            pixel_bounds: Some(PixelBounds { x0, x1, y0, y1 }),
+            threads: None,
+            ..settings.0.clone()
+        };
+        let render = ProgressiveRender::new(&settings).map_err(|error| error.to_string())?;
+        Ok(TilePasses {
+            render,
+            integrator: settings.integrator,
+            scene: self.id,
+        })
+    }
+}
+
+impl Tile {
+    fn new(film: Film, stats: &RenderStats, integrator: IntegratorKind) -> Tile {
+        let rgb8 = PngEncoding::default_for(integrator).to_rgb8(&film);
         let (albedo, normal, depth) = match film.features {
             Some(features) => (
                 flatten(&features.albedo),
@@ -314,7 +368,7 @@ impl Loaded {
             ),
             None => Default::default(),
         };
-        Ok(Tile {
+        Tile {
             pixels: flatten(&film.pixels),
             rgb8,
             albedo,
@@ -322,7 +376,49 @@ impl Loaded {
             depth,
             rays: stats.rays as f64,
             nonfinite_samples: stats.nonfinite_samples as f64,
-        })
+        }
+    }
+}
+
+/// One rectangle of the image rendered in passes ([`Loaded::start_passes`]): it keeps each
+/// pixel's running sums between passes (about 100 bytes a pixel), not the scene, which each
+/// pass is given.
+#[wasm_bindgen]
+pub struct TilePasses {
+    render: ProgressiveRender,
+    integrator: IntegratorKind,
+    /// The `Loaded::id` of the scene the passes began with.
+    scene: u64,
+}
+
+#[wasm_bindgen]
+impl TilePasses {
+    /// Adds up to `samples` samples (at least one, not beyond the settings' samples per pixel)
+    /// to every pixel, and returns the rectangle's image so far, as `render_tile` does, with
+    /// the rays and dropped samples of this pass. Once the samples per pixel are all taken it
+    /// is `render_tile`'s image bit for bit.
+    pub fn pass(&mut self, loaded: &Loaded, samples: u32) -> Result<Tile, String> {
+        if loaded.id != self.scene {
+            return Err("the passes of a tile must all render the scene they began with".into());
+        }
+        let scene = loaded.scene.as_ref().ok_or("the scene did not load")?;
+        let stats = self
+            .render
+            .pass(scene, samples, &|_| true)
+            .map_err(|error| error.to_string())?;
+        Ok(Tile::new(self.render.film(), &stats, self.integrator))
+    }
+
+    /// Samples each pixel has taken so far.
+    #[wasm_bindgen(getter)]
+    pub fn samples_taken(&self) -> u32 {
+        self.render.samples_taken()
+    }
+
+    /// Whether every pixel has its samples per pixel: a further pass would add nothing.
+    #[wasm_bindgen(getter)]
+    pub fn finished(&self) -> bool {
+        self.render.is_finished()
     }
 }
 

@@ -1,6 +1,7 @@
 //! The page's API, natively: tiles rendered one by one and encoded here give the CLI's PNG and
 //! EXR byte for byte, a broken scene gives the CLI's located error text, and a Mitsuba scene
-//! loads from memory with the settings it asks for; glTF models load from their bytes.
+//! loads from memory with the settings it asks for; glTF models load from their bytes; a
+//! tile rendered in passes refines to `render_tile`'s pixels.
 
 use std::path::Path;
 
@@ -129,6 +130,90 @@ fn a_path_traced_png_gets_the_cli_display_transform() {
     glint_io::write_image_with(&file, &film, &options).unwrap();
     assert!(page == std::fs::read(&file).unwrap());
     assert_eq!(tile.rgb8, options.png.to_rgb8(&film));
+}
+
+#[test]
+fn a_tile_in_passes_refines_to_the_render_tile_bit_for_bit() {
+    let (text, files) = example_files();
+    let loaded = load(&text, "textured/textured.xml", &files);
+    // 8 samples over passes of 1, 1, 2, 4 (the page's doubling); a tile cut by the film's
+    // edge, off the origin, so that its pixels are placed as in the whole render.
+    let settings = Settings::new(70, 45, 8, "path", 5, None, true).unwrap();
+    let (x0, y0, x1, y1) = (32, 32, 64, 45);
+    let single = loaded.render_tile(&settings, x0, y0, x1, y1).unwrap();
+    let mut passes = loaded.start_passes(&settings, x0, y0, x1, y1).unwrap();
+    assert_eq!(passes.samples_taken(), 0);
+    let mut images = Vec::new();
+    let mut rays = 0.0;
+    for (samples, taken) in [(1, 1), (1, 2), (2, 4), (4, 8)] {
+        assert!(!passes.finished());
+        let tile = passes.pass(&loaded, samples).unwrap();
+        assert_eq!(passes.samples_taken(), taken);
+        assert_eq!(tile.pixels.len(), ((x1 - x0) * (y1 - y0) * 3) as usize);
+        rays += tile.rays;
+        images.push(tile);
+    }
+    assert!(passes.finished());
+    let last = images.last().unwrap();
+    let bits = |values: &[f32]| values.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&last.pixels), bits(&single.pixels));
+    assert_eq!(last.rgb8, single.rgb8);
+    assert_eq!(bits(&last.albedo), bits(&single.albedo));
+    assert_eq!(bits(&last.normal), bits(&single.normal));
+    assert_eq!(bits(&last.depth), bits(&single.depth));
+    // Each pass counts its own rays: together, the single render's.
+    assert_eq!(rays, single.rays);
+    // The first pass is a real image, and a noisier one: the passes refine it.
+    let first = &images[0];
+    assert!(first.pixels.iter().any(|&v| v > 0.0));
+    let differing = first
+        .pixels
+        .iter()
+        .zip(&last.pixels)
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        differing > first.pixels.len() / 4,
+        "{differing} values differ"
+    );
+    // A pass past the last adds nothing.
+    let again = passes.pass(&loaded, 4).unwrap();
+    assert_eq!(passes.samples_taken(), 8);
+    assert_eq!(bits(&again.pixels), bits(&single.pixels));
+}
+
+#[test]
+fn only_the_path_tracers_render_in_passes_and_on_their_own_scene() {
+    let (text, files) = example_files();
+    let loaded = load(&text, "textured/textured.xml", &files);
+    for integrator in ["course", "normals", "albedo", "depth"] {
+        let settings = Settings::new(8, 8, 4, integrator, 0, None, false).unwrap();
+        let error = loaded
+            .start_passes(&settings, 0, 0, 8, 8)
+            .err()
+            .unwrap_or_else(|| panic!("{integrator} started passes"));
+        assert!(error.contains("path tracers"), "{error}");
+        assert!(error.contains(integrator), "{error}");
+        let error = settings.check_progressive("a time budget").unwrap_err();
+        assert!(
+            error.starts_with("a time budget is for the path tracers"),
+            "{error}"
+        );
+    }
+    for integrator in ["path", "volpath"] {
+        let settings = Settings::new(8, 8, 4, integrator, 0, None, false).unwrap();
+        assert_eq!(settings.check_progressive("a time budget"), Ok(()));
+        let mut passes = loaded.start_passes(&settings, 0, 0, 8, 8).unwrap();
+        // Another load of the same text is another scene: its sums would not belong.
+        let other = load(&text, "textured/textured.xml", &files);
+        assert!(passes.pass(&other, 1).is_err());
+        assert_eq!(passes.samples_taken(), 0);
+        assert!(passes.pass(&loaded, 1).is_ok());
+    }
+    let settings = Settings::new(8, 8, 4, "path", 0, None, false).unwrap();
+    assert!(loaded.start_passes(&settings, 0, 0, 9, 8).is_err());
+    let broken = load("<scene>", "broken.xml", &Files::new());
+    assert!(broken.start_passes(&settings, 0, 0, 8, 8).is_err());
 }
 
 #[test]
