@@ -98,6 +98,8 @@ impl Job {
             if self.denoise {
                 check_denoise(Some(self.settings.integrator), false)?;
             }
+            // Checked for a path tracer before the load, in case the scene named one.
+            check_sampling(&self.settings, self.time_budget.is_some())?;
             return Ok(self.clone());
         }
         let settled = self.options.settle(&self.output, defaults)?;
@@ -334,15 +336,15 @@ impl Options {
             progressive_order: self.time_budget.is_some(),
             ..scene_settled
         };
-        settings.validate().map_err(|why| {
-            UsageError(match settings.adaptive {
-                Some(_) => why.replace("adaptive sampling", "--noise-threshold"),
-                None => why,
-            })
-        })?;
-        if self.time_budget.is_some() {
-            settings.check_progressive("--time").map_err(UsageError)?;
-        }
+        // Until the scene is loaded, an integrator nobody named may still be a path tracer.
+        let checked = match integrator_known {
+            true => settings.clone(),
+            false => RenderSettings {
+                integrator: IntegratorKind::Path,
+                ..settings.clone()
+            },
+        };
+        check_sampling(&checked, self.time_budget.is_some())?;
         if self.device == DeviceArg::Gpu
             && (self.time_budget.is_some() || settings.adaptive.is_some())
         {
@@ -404,6 +406,21 @@ pub fn png_encoding(
             TransferArg::Linear => Transfer::Linear,
         }),
     })
+}
+
+/// Why `settings` cannot be rendered, if they cannot, in the flags' words: adaptive sampling
+/// (`--noise-threshold`) and a time budget (`--time`) need a path tracer and no sample range.
+fn check_sampling(settings: &RenderSettings, time_budget: bool) -> Result<(), UsageError> {
+    settings.validate().map_err(|why| {
+        UsageError(match settings.adaptive {
+            Some(_) => why.replace("adaptive sampling", "--noise-threshold"),
+            None => why,
+        })
+    })?;
+    if time_budget {
+        settings.check_progressive("--time").map_err(UsageError)?;
+    }
+    Ok(())
 }
 
 /// `--denoise` is for the path tracers' whole images: the course's images are exact and the

@@ -366,3 +366,23 @@ fn an_adaptive_render_resumes_from_its_checkpoint() {
     };
     assert!(bits(&a) == bits(&b), "the resumed image differs");
 }
+
+/// A Mitsuba scene names its path tracer itself: `--noise-threshold` and `--time` work on it
+/// without `--integrator` (they are checked once the scene has said which integrator).
+#[test]
+fn a_scene_that_names_its_path_tracer_samples_adaptively() {
+    let scene =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes/mitsuba/cornell-rough.xml");
+    let dir = TempDir::new().unwrap();
+    let scene = scene.to_str().unwrap();
+    for extra in [&["--noise-threshold", "0.2"][..], &["--time", "0.5"][..]] {
+        let mut args = vec![
+            "render", scene, "-w", "24", "-h", "24", "-D", "spp=16", "-o", "out.exr",
+        ];
+        args.extend(extra);
+        let output = glint(dir.path(), &args);
+        assert!(output.status.success(), "{extra:?}: {}", stderr(&output));
+        let image = glint_io::read_exr(&dir.path().join("out.exr")).unwrap();
+        assert!(image.film.samples.is_some(), "{extra:?}");
+    }
+}
