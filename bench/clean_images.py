@@ -19,6 +19,7 @@ their time.
 """
 
 import argparse
+import json
 import re
 import statistics
 import subprocess
@@ -248,12 +249,27 @@ def main():
     parser.add_argument("--rounds", type=int, default=3)
     parser.add_argument("--scenes", default=",".join(SCENES))
     parser.add_argument("--plot", type=Path)
+    parser.add_argument(
+        "--reuse",
+        action="store_true",
+        help="take a scene's figures from OUT/SCENE/results.json when an earlier run left it",
+    )
     options = parser.parse_args()
     results = {}
     for name in options.scenes.split(","):
-        results[name] = campaign(
-            options.glint, name, SCENES[name], options.out, options.refs, options.rounds
-        )
+        saved = options.out / name / "results.json"
+        if options.reuse and saved.exists():
+            results[name] = json.loads(saved.read_text())
+        else:
+            results[name] = campaign(
+                options.glint,
+                name,
+                SCENES[name],
+                options.out,
+                options.refs,
+                options.rounds,
+            )
+            saved.write_text(json.dumps(results[name], indent=1))
         print(table(name, results[name]), flush=True)
     if options.plot:
         plot(results, options.plot)
