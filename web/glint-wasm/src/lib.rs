@@ -262,6 +262,17 @@ impl Settings {
     }
 }
 
+impl Settings {
+    /// These settings for pixels `x0..x1` by `y0..y1` alone, on the worker's one thread.
+    fn tile(&self, x0: u32, y0: u32, x1: u32, y1: u32) -> RenderSettings {
+        RenderSettings {
+            pixel_bounds: Some(PixelBounds { x0, x1, y0, y1 }),
+            threads: None,
+            ..self.0.clone()
+        }
+    }
+}
+
 fn integrator_named(name: &str) -> Result<IntegratorKind, String> {
     IntegratorKind::from_name(name).ok_or_else(|| {
         let names: Vec<&str> = IntegratorKind::ALL.iter().map(|kind| kind.name()).collect();
@@ -321,11 +332,7 @@ impl Loaded {
         y1: u32,
     ) -> Result<Tile, String> {
         let scene = self.scene.as_ref().ok_or("the scene did not load")?;
-        let settings = RenderSettings {
-            pixel_bounds: Some(PixelBounds { x0, x1, y0, y1 }),
-            threads: None,
-            ..settings.0.clone()
-        };
+        let settings = settings.tile(x0, y0, x1, y1);
         let (film, stats) =
             glint_render::render(scene, &settings, &|_| true).map_err(|error| error.to_string())?;
         Ok(Tile::new(film, &stats, settings.integrator))
@@ -343,11 +350,7 @@ impl Loaded {
         y1: u32,
     ) -> Result<TilePasses, String> {
         self.scene.as_ref().ok_or("the scene did not load")?;
-        let settings = RenderSettings {
-            pixel_bounds: Some(PixelBounds { x0, x1, y0, y1 }),
-            threads: None,
-            ..settings.0.clone()
-        };
+        let settings = settings.tile(x0, y0, x1, y1);
         let render = ProgressiveRender::new(&settings).map_err(|error| error.to_string())?;
         Ok(TilePasses {
             render,
