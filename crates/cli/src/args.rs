@@ -17,6 +17,7 @@
 //! `-h` is the image height, as in the course, so help is `-?` / `--help`.
 
 use std::path::PathBuf;
+use std::time::Duration;
 
 use clap::{ArgAction, Args, Parser, Subcommand, ValueEnum};
 use glint_render::{Color, IntegratorKind, SplitMethod};
@@ -269,16 +270,74 @@ impl LimitOptions {
     }
 }
 
-/// Half the machine's physical memory (Linux: /proc/meminfo), or 4 GiB where it is unknown.
+/// The memory this process may take, and what sets it: the least of the machine's memory
+/// (Linux: /proc/meminfo), its control group's limit (cgroup v2 `memory.max`, v1
+/// `memory.limit_in_bytes`) and its address-space and data-size limits (`ulimit -v`, `-d`);
+/// 8 GiB where none can be read.
+pub fn machine_memory() -> (u64, String) {
+    let bytes = glint_io::format_bytes;
+    let mut least: Option<(u64, String)> = None;
+    let mut consider = |limit: Option<u64>, name: &dyn Fn(u64) -> String| {
+        if let Some(limit) = limit {
+            if least.as_ref().is_none_or(|(bytes, _)| limit < *bytes) {
+                least = Some((limit, name(limit)));
+            }
+        }
+    };
+    consider(meminfo_total(), &|b| format!("the machine's {}", bytes(b)));
+    consider(cgroup_limit(), &|b| {
+        format!("the control group's {} limit", bytes(b))
+    });
+    for (row, what) in [
+        ("Max address space", "address-space limit (ulimit -v)"),
+        ("Max data size", "data-size limit (ulimit -d)"),
+    ] {
+        consider(process_limit(row), &|b| format!("the {} {what}", bytes(b)));
+    }
+    least.unwrap_or((8 << 30, "an assumed 8 GiB".to_owned()))
+}
+
+/// Half of `machine_memory`: room for what the estimate cannot see (the loader's parse trees
+/// while they live, the allocator's slack, other programs).
 pub fn default_max_memory() -> u64 {
-    let total = std::fs::read_to_string("/proc/meminfo")
-        .ok()
-        .and_then(|text| {
-            let line = text.lines().find(|line| line.starts_with("MemTotal:"))?;
-            let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
-            kib.checked_mul(1024)
-        });
-    total.map_or(4 << 30, |bytes| bytes / 2)
+    machine_memory().0 / 2
+}
+
+/// What sets the budget, for messages: the option, or the default's source.
+pub fn max_memory_source(given: Option<u64>) -> String {
+    match given {
+        Some(_) => "set by --max-memory".to_owned(),
+        None => format!("half of {}", machine_memory().1),
+    }
+}
+
+fn meminfo_total() -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let line = text.lines().find(|line| line.starts_with("MemTotal:"))?;
+    let kib: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    kib.checked_mul(1024)
+}
+
+/// The memory limit of this process's control group, where it has one.
+fn cgroup_limit() -> Option<u64> {
+    let membership = std::fs::read_to_string("/proc/self/cgroup").ok()?;
+    // cgroup v2: one line `0::/path`.
+    if let Some(path) = membership.lines().find_map(|line| line.strip_prefix("0::")) {
+        let file = format!("/sys/fs/cgroup{}/memory.max", path.trim_end_matches('/'));
+        if let Ok(text) = std::fs::read_to_string(file) {
+            return text.trim().parse().ok();
+        }
+    }
+    // cgroup v1; "no limit" reads as a huge number, which never wins.
+    let text = std::fs::read_to_string("/sys/fs/cgroup/memory/memory.limit_in_bytes").ok()?;
+    text.trim().parse().ok()
+}
+
+/// The soft limit of a row of /proc/self/limits given in bytes (`unlimited`: none).
+fn process_limit(row: &str) -> Option<u64> {
+    let text = std::fs::read_to_string("/proc/self/limits").ok()?;
+    let line = text.lines().find(|line| line.starts_with(row))?;
+    line[row.len()..].split_whitespace().next()?.parse().ok()
 }
 
 /// Parses a byte count: `1048576`, `512K`, `64M`, `4G`, `1T` (binary units; a trailing `B`
@@ -327,9 +386,10 @@ pub struct Options {
     pub height: Option<u32>,
 
     /// Rays per pixel, on an N x N jittered grid, N = floor(sqrt(RPP)) [default: the scene's
-    /// sample_count, else 1].
+    /// sample_count, else 1; at most 16777216].
     #[arg(short = 'r', long = "rpp", visible_alias = "spp", value_name = "RPP",
-          value_parser = clap::value_parser!(u32).range(1..))]
+          value_parser = clap::value_parser!(u32)
+              .range(1..=i64::from(glint_render::MAX_SAMPLES_PER_PIXEL)))]
     pub rpp: Option<u32>,
 
     /// Adaptive sampling (path tracers): stop sampling a pixel once the estimated relative
@@ -351,7 +411,7 @@ pub struct Options {
     #[arg(long = "time", value_name = "SECONDS", value_parser = parse_time_budget,
           conflicts_with_all = ["checkpoint", "resume", "sample_range"],
           help_heading = SAMPLING_HEADING)]
-    pub time_budget: Option<f64>,
+    pub time_budget: Option<Duration>,
 
     /// Maximum recursion depth: reflection/refraction for the course integrator, scattering
     /// events for the path tracer [default: 4 for the course; for path the scene's max_depth
@@ -447,18 +507,18 @@ pub struct Options {
     pub checkpoint: Option<PathBuf>,
 
     /// Seconds between checkpoints.
-    #[arg(long, value_name = "SECONDS", default_value_t = 60.0,
+    #[arg(long, value_name = "SECONDS", default_value = "60",
           value_parser = parse_seconds, help_heading = FARM)]
-    pub checkpoint_every: f64,
+    pub checkpoint_every: Duration,
 
     /// Continue the render checkpointed in FILE (same scene and options), checkpointing to it.
     #[arg(long, value_name = "FILE", conflicts_with = "checkpoint", help_heading = FARM)]
     pub resume: Option<PathBuf>,
 
     /// Seconds between progress lines when stderr is not a terminal (see README: progress).
-    #[arg(long, value_name = "SECONDS", default_value_t = 5.0,
+    #[arg(long, value_name = "SECONDS", default_value = "5",
           value_parser = parse_seconds, help_heading = FARM)]
-    pub progress_every: f64,
+    pub progress_every: Duration,
 
     /// Print help.
     #[arg(short = '?', long, action = ArgAction::Help)]
@@ -531,17 +591,30 @@ pub fn parse_noise_threshold(text: &str) -> Result<f32, String> {
     }
 }
 
-/// The longest `--time` budget: a year.
-pub const MAX_TIME_BUDGET: f64 = 365.0 * 24.0 * 3600.0;
+/// The longest duration any option takes (`--time`, `--checkpoint-every`,
+/// `--progress-every`): a year, far inside what `Duration` and the clocks hold.
+pub const MAX_SECONDS: f64 = 365.0 * 24.0 * 3600.0;
 
-/// Parses `--time`: seconds above 0, at most `MAX_TIME_BUDGET`.
-pub fn parse_time_budget(text: &str) -> Result<f64, String> {
-    match text.trim().parse::<f64>() {
-        Ok(value) if value > 0.0 && value <= MAX_TIME_BUDGET => Ok(value),
-        _ => Err(format!(
-            "expected a number of seconds above 0 and at most {MAX_TIME_BUDGET}, got '{text}'"
-        )),
+/// Parses a duration in seconds, the one parser of every duration option: a decimal number of
+/// seconds within 0..=`MAX_SECONDS` (above 0 unless `zero` is allowed).
+fn parse_duration(text: &str, zero: bool) -> Result<Duration, String> {
+    let low = if zero { "at least 0" } else { "above 0" };
+    let refuse = || {
+        format!(
+            "expected a number of seconds {low} and at most {MAX_SECONDS} (a year), got '{text}'"
+        )
+    };
+    let value: f64 = text.trim().parse().map_err(|_| refuse())?;
+    let in_range = value <= MAX_SECONDS && (value > 0.0 || (zero && value == 0.0));
+    if !in_range {
+        return Err(refuse());
     }
+    Duration::try_from_secs_f64(value).map_err(|_| refuse())
+}
+
+/// Parses `--time`: a duration above 0.
+pub fn parse_time_budget(text: &str) -> Result<Duration, String> {
+    parse_duration(text, false)
 }
 
 /// Parses `--exposure`: a finite number of stops, within ±64 (2^64 overflows nothing in f32,
@@ -561,12 +634,9 @@ pub fn parse_exposure(text: &str) -> Result<f32, String> {
 
 const FARM: &str = "Render farms (see README: render farms)";
 
-/// Parses a duration in seconds: a finite number >= 0.
-pub fn parse_seconds(text: &str) -> Result<f64, String> {
-    match text.trim().parse::<f64>() {
-        Ok(value) if value.is_finite() && value >= 0.0 => Ok(value),
-        _ => Err(format!("expected a number of seconds >= 0, got '{text}'")),
-    }
+/// Parses an interval (`--checkpoint-every`, `--progress-every`): a duration of at least 0.
+pub fn parse_seconds(text: &str) -> Result<Duration, String> {
+    parse_duration(text, true)
 }
 
 /// `--integrator` / `--shader` values.

@@ -69,6 +69,8 @@ pub struct Job {
     pub environment: Option<(PathBuf, f32)>,
     /// The memory estimate's budget, in bytes.
     pub max_memory: u64,
+    /// What set it, for messages ("half of the machine's 23 GiB").
+    pub max_memory_source: String,
     /// `--checkpoint` / `--resume`.
     pub checkpoint: Option<Checkpointing>,
     /// `--denoise`: the image is denoised by OIDN before it is written.
@@ -202,13 +204,16 @@ impl Options {
         }
         .map(|(file, resume)| Checkpointing {
             file,
-            every: Duration::from_secs_f64(self.checkpoint_every),
+            every: self.checkpoint_every,
             resume,
         });
         if let Some(checkpoint) = &checkpoint {
-            if checkpoint.file == output {
+            // Compared as files, not as text: `./out.exr` or a link to it would otherwise
+            // pass, and the checkpoint, removed after the write, would take the image along.
+            if crate::paths::same_file(&checkpoint.file, &output) {
                 return Err(UsageError(format!(
-                    "the checkpoint file and the output are both '{}'",
+                    "the checkpoint '{}' and the output '{}' are the same file",
+                    checkpoint.file.display(),
                     output.display()
                 )));
             }
@@ -240,6 +245,7 @@ impl Options {
                 .map(|file| (file, self.limits.env_strength)),
             limits,
             max_memory,
+            max_memory_source: crate::args::max_memory_source(self.limits.max_memory),
             scene,
             output,
             settings,
@@ -261,8 +267,8 @@ impl Options {
             notes,
             checkpoint,
             denoise: self.denoise,
-            progress_every: Duration::from_secs_f64(self.progress_every),
-            time_budget: self.time_budget.map(Duration::from_secs_f64),
+            progress_every: self.progress_every,
+            time_budget: self.time_budget,
             options,
         })
     }
@@ -372,7 +378,7 @@ impl Options {
 }
 
 /// Samples per pixel of a time budget without `-r`: more than any budget takes.
-pub const UNBOUNDED_SAMPLES: u32 = 1 << 24;
+pub const UNBOUNDED_SAMPLES: u32 = glint_render::MAX_SAMPLES_PER_PIXEL;
 
 /// `--min-spp` when not given: enough samples that a pixel whose light arrives along rare
 /// paths (a caustic, a small light seen through glass) has likely met some before its error

@@ -20,6 +20,7 @@ mod job;
 mod memory;
 mod merge;
 mod passes;
+mod paths;
 mod preview;
 mod progress;
 mod report;

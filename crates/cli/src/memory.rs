@@ -6,15 +6,21 @@ use glint_render::{Background, SceneParts};
 use crate::failure::Failure;
 
 /// Bytes per pixel of a render: the pipeline's per-pixel values (40), the film (12), the
-/// 8-bit copy and its encoding (6), and with feature layers their film copies (28); adaptive
-/// sampling's counts (8); and for a render in passes (`progressive`, `--time`) the running
-/// sums each pixel keeps between passes, twice during a pass (256).
-pub fn film_bytes(settings: &glint_render::RenderSettings, progressive: bool) -> u64 {
+/// 8-bit copy and its encoding (6), and with feature layers their film copies (28); an EXR's
+/// channels as the writer lays them out and encodes them (40); adaptive sampling's counts (8);
+/// and for a render in passes (adaptive sampling, `--time`) the running sums each pixel keeps
+/// between passes, twice during a pass (256). Peak resident memory measured on 3000 x 3000
+/// renders (bench/results/2026-11-29-hostile.md): 22 bytes a pixel to PNG, 111-118 to EXR,
+/// 234 with `--time`, 274 adaptive to EXR; the estimate is above each.
+pub fn film_bytes(settings: &glint_render::RenderSettings, time_budget: bool, exr: bool) -> u64 {
     let mut per_pixel = if settings.features { 86 } else { 58 };
+    if exr {
+        per_pixel += 40;
+    }
     if settings.adaptive.is_some() {
         per_pixel += 8;
     }
-    if progressive {
+    if time_budget || settings.adaptive.is_some() {
         per_pixel += 256;
     }
     u64::from(settings.width) * u64::from(settings.height) * per_pixel
@@ -60,18 +66,24 @@ pub fn shape_count(parts: &SceneParts) -> u64 {
     shapes + light_triangles + parts.instances.len() as u64
 }
 
-/// Refuses a render whose estimated memory is over the budget.
-pub fn check(film: u64, textures: u64, shapes: u64, budget: u64) -> Result<(), Failure> {
+/// Refuses a render whose estimated memory is over the budget; returns the estimate.
+pub fn check(
+    film: u64,
+    textures: u64,
+    shapes: u64,
+    budget: u64,
+    source: &str,
+) -> Result<u64, Failure> {
     let structures = shapes.saturating_mul(BYTES_PER_SHAPE);
     let total = film.saturating_add(textures).saturating_add(structures);
     if total <= budget {
-        return Ok(());
+        return Ok(total);
     }
     let bytes = glint_io::format_bytes;
     Err(Failure::Memory(format!(
         "the render would need about {} (image {}, textures {}, shapes and their acceleration \
-         structures {}), more than the limit of {}; render a smaller image, or raise the limit \
-         with --max-memory",
+         structures {}), more than the limit of {} ({source}); render a smaller image, or \
+         raise the limit with --max-memory",
         bytes(total),
         bytes(film),
         bytes(textures),
@@ -91,12 +103,12 @@ mod tests {
             height: 65_535,
             ..glint_render::RenderSettings::default()
         };
-        let film = film_bytes(&huge, false);
+        let film = film_bytes(&huge, false, false);
         assert!(film > 200 << 30, "{film}");
-        let refused = check(film, 0, 0, 8 << 30).unwrap_err();
+        let refused = check(film, 0, 0, 8 << 30, "test").unwrap_err();
         assert_eq!(refused.exit_code(), 2);
         assert!(refused.to_string().contains("--max-memory"), "{refused}");
-        assert!(check(1 << 20, 1 << 20, 1000, 8 << 30).is_ok());
-        assert!(check(0, 0, u64::MAX, 8 << 30).is_err());
+        assert!(check(1 << 20, 1 << 20, 1000, 8 << 30, "test").is_ok());
+        assert!(check(0, 0, u64::MAX, 8 << 30, "test").is_err());
     }
 }

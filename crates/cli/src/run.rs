@@ -44,9 +44,11 @@ pub fn run(
     // Everything that can be known before the render is checked before it: the output can
     // be written, and the film fits in the memory budget.
     check_output(&job.output)?;
+    check_checkpoint(job)?;
     remove_stale_partials(&job.output, err);
-    let film_bytes = memory::film_bytes(&job.settings, job.time_budget.is_some());
-    memory::check(film_bytes, 0, 0, job.max_memory)?;
+    let film_bytes =
+        memory::film_bytes(&job.settings, job.time_budget.is_some(), output_is_exr(job));
+    memory::check(film_bytes, 0, 0, job.max_memory, &job.max_memory_source)?;
     let loaded = load(job, &pool, film_bytes, err)?;
     // A scene may set its film, samples, integrator and depth (Mitsuba's do); flags win.
     let settled = job
@@ -62,12 +64,13 @@ pub fn run(
     let job = &settled;
     // After the scene has settled the integrator, which --denoise needs to be a path tracer.
     let denoiser = crate::denoise::open_for(job)?;
-    let film_bytes = memory::film_bytes(&job.settings, job.time_budget.is_some());
-    check_memory(job, film_bytes, &loaded.parts)?;
+    let film_bytes =
+        memory::film_bytes(&job.settings, job.time_budget.is_some(), output_is_exr(job));
+    let estimate = check_memory(job, film_bytes, &loaded.parts)?;
     if job.device == DeviceArg::Gpu {
         return crate::gpu::run(job, &loaded.parts, interrupt, err, progress_bar);
     }
-    let built = build(job, &pool, loaded);
+    let built = build(job, &pool, loaded, estimate);
     if job.verbose {
         print_settings(job, &built, err);
     }
@@ -109,6 +112,8 @@ struct Built {
     load_time: Duration,
     hash_time: Duration,
     build_time: Duration,
+    /// The memory estimate the render was checked against (`memory::check`), in bytes.
+    estimate: u64,
 }
 
 impl Built {
@@ -159,7 +164,7 @@ fn thread_pool(threads: usize) -> Result<rayon::ThreadPool, Failure> {
 
 /// Removes the temporary files that killed runs left beside the output, and says so.
 fn remove_stale_partials(output: &Path, err: &mut dyn Write) {
-    let removed = glint_io::remove_stale_partials(output_directory(output));
+    let removed = glint_io::remove_stale_partials(crate::paths::folder_of(output));
     if removed > 0 {
         let _ = writeln!(
             err,
@@ -222,17 +227,18 @@ fn load(
 
 /// Refuses a scene whose film, textures and acceleration structures would not fit in the
 /// memory budget.
-fn check_memory(job: &Job, film_bytes: u64, parts: &SceneParts) -> Result<(), Failure> {
+fn check_memory(job: &Job, film_bytes: u64, parts: &SceneParts) -> Result<u64, Failure> {
     memory::check(
         film_bytes,
         memory::texture_bytes(parts),
         memory::shape_count(parts),
         job.max_memory,
+        &job.max_memory_source,
     )
 }
 
 /// Hashes the scene for the image's metadata and builds its acceleration structures.
-fn build(job: &Job, pool: &rayon::ThreadPool, loaded: Loaded) -> Built {
+fn build(job: &Job, pool: &rayon::ThreadPool, loaded: Loaded, estimate: u64) -> Built {
     let hash_start = Instant::now();
     let hash = glint_io::scene_hash(&loaded.parts);
     let hash_time = hash_start.elapsed();
@@ -245,6 +251,7 @@ fn build(job: &Job, pool: &rayon::ThreadPool, loaded: Loaded) -> Built {
         load_time: loaded.time,
         hash_time,
         build_time: build_start.elapsed(),
+        estimate,
     }
 }
 
@@ -504,13 +511,14 @@ fn print_stats(
         .row("render", seconds(summary.render_time))
         .row("write", seconds(write_time));
     rays_section(&mut report, &job.settings, &summary.stats);
-    report.section("memory").row(
-        "peak resident",
-        peak_rss().map_or_else(
-            || "unknown".to_string(),
-            |bytes| format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0)),
-        ),
-    );
+    let mib = |bytes: u64| format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0));
+    report
+        .section("memory")
+        .row("estimated", mib(built.estimate))
+        .row(
+            "peak resident",
+            peak_rss().map_or_else(|| "unknown".to_string(), mib),
+        );
     let _ = write!(err, "{}", report.render());
     let _ = write!(
         err,
@@ -519,52 +527,35 @@ fn print_stats(
     );
 }
 
-/// The folder the output goes into.
-fn output_directory(output: &Path) -> &Path {
-    match output.parent() {
-        Some(parent) if !parent.as_os_str().is_empty() => parent,
-        _ => Path::new("."),
-    }
+fn output_is_exr(job: &Job) -> bool {
+    glint_io::output_format(&job.output).is_ok_and(|f| f == glint_io::OutputFormat::Exr)
 }
 
-/// The output's extension is known, its folder exists, and a file can be created in it (an
-/// unnamed one, on Linux: nothing appears in the folder, even if the process dies here).
+/// The output's extension is known and a file can be created where it names
+/// (`paths::check_writable`).
 fn check_output(output: &Path) -> Result<(), Failure> {
     glint_io::output_format(output)
         .map_err(|error| Failure::Usage(UsageError(error.to_string())))?;
-    let directory = output_directory(output);
-    let refuse = |why: String| {
+    crate::paths::check_writable(output).map_err(|why| {
         Failure::Usage(UsageError(format!(
             "cannot write {}: {why}; nothing was rendered",
             output.display()
         )))
+    })
+}
+
+/// The checkpoint file can be written (to resume from, it must also exist: `resume` reads it
+/// before rendering).
+fn check_checkpoint(job: &Job) -> Result<(), Failure> {
+    let Some(checkpoint) = &job.checkpoint else {
+        return Ok(());
     };
-    match std::fs::metadata(directory) {
-        Ok(metadata) if metadata.is_dir() => {}
-        Ok(_) => return Err(refuse(format!("{} is not a folder", directory.display()))),
-        Err(error) if error.kind() == std::io::ErrorKind::NotFound => {
-            return Err(refuse(format!(
-                "the folder {} does not exist",
-                directory.display()
-            )))
-        }
-        Err(error) => {
-            return Err(refuse(format!(
-                "the folder {} cannot be used ({error})",
-                directory.display()
-            )))
-        }
-    }
-    if output.is_dir() {
-        return Err(refuse("it is a folder".to_owned()));
-    }
-    tempfile::tempfile_in(directory).map_err(|error| {
-        refuse(format!(
-            "the folder {} is not writable ({error})",
-            directory.display()
-        ))
-    })?;
-    Ok(())
+    crate::paths::check_writable(&checkpoint.file).map_err(|why| {
+        Failure::Usage(UsageError(format!(
+            "cannot write the checkpoint {}: {why}; nothing was rendered",
+            checkpoint.file.display()
+        )))
+    })
 }
 
 /// Tiles of `TILE_SIZE` the render of `bounds` runs.

@@ -78,6 +78,12 @@ pub mod testing;
 #[cfg(test)]
 mod tests;
 
+/// The most samples (rays) per pixel a render may take: 2^24, where an f32 sample count stops
+/// being exact and far past any reference image (Mitsuba's own limit on `sample_count`).
+/// Front ends refuse more, so that a typo such as `-r 1e9` cannot start a render that never
+/// ends.
+pub const MAX_SAMPLES_PER_PIXEL: u32 = 1 << 24;
+
 // The scene a loader builds, in plain data.
 pub use accel::build::{BuildPhases, SplitMethod};
 pub use camera::{Camera, Projection, ThinLens};

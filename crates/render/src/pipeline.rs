@@ -299,6 +299,13 @@ impl RenderSettings {
                 self.width, self.height
             ));
         }
+        if !(1..=crate::MAX_SAMPLES_PER_PIXEL).contains(&self.samples_per_pixel) {
+            return Err(format!(
+                "the samples per pixel must be between 1 and {}, not {}",
+                crate::MAX_SAMPLES_PER_PIXEL,
+                self.samples_per_pixel
+            ));
+        }
         if let Some(bounds) = self.pixel_bounds {
             if !bounds.fits(self.width, self.height) || bounds.is_empty() {
                 return Err(format!(

@@ -705,7 +705,7 @@ impl<'a> Builder<'a> {
             );
         }
         let count = props.integer(self.files, "sample_count", 4)?;
-        if !(1..=1 << 24).contains(&count) {
+        if !(1..=i64::from(glint_render::MAX_SAMPLES_PER_PIXEL)).contains(&count) {
             let p = props.get("sample_count").expect("a bad count was given");
             return Err(self.error(
                 p.file,
