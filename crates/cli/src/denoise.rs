@@ -130,12 +130,20 @@ pub fn write_render(
 pub fn run(args: &DenoiseArgs, err: &mut dyn Write) -> Result<(), Failure> {
     let usage = |message: String| Failure::Usage(UsageError(message));
     glint_io::output_format(&args.output).map_err(|error| usage(error.to_string()))?;
-    if args.output == args.input {
+    if crate::paths::same_file(&args.output, &args.input) {
         return Err(usage(format!(
-            "the input and the output are both '{}'; the noisy image would be lost",
-            args.input.display()
+            "the input '{}' and the output '{}' are the same file; the noisy image would be \
+             lost",
+            args.input.display(),
+            args.output.display()
         )));
     }
+    crate::paths::check_writable(&args.output).map_err(|why| {
+        usage(format!(
+            "cannot write {}: {why}; nothing was denoised",
+            args.output.display()
+        ))
+    })?;
     let input = glint_io::read_exr(&args.input).map_err(|error| usage(error.to_string()))?;
     let film = input.film;
     if film.sums.is_some() {

@@ -26,12 +26,10 @@ fn resolved(path: &Path) -> Option<PathBuf> {
     let absolute = std::path::absolute(path).ok()?;
     let components: Vec<Component> = absolute.components().collect();
     // The longest prefix that exists, with its links resolved.
-    let (mut out, rest) = (0..=components.len())
-        .rev()
-        .find_map(|n| {
-            let prefix: PathBuf = components[..n].iter().collect();
-            Some((prefix.canonicalize().ok()?, &components[n..]))
-        })?;
+    let (mut out, rest) = (0..=components.len()).rev().find_map(|n| {
+        let prefix: PathBuf = components[..n].iter().collect();
+        Some((prefix.canonicalize().ok()?, &components[n..]))
+    })?;
     for component in rest {
         match component {
             Component::CurDir => {}

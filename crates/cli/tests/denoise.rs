@@ -364,7 +364,10 @@ fn glint_denoise_refuses_bad_input_by_name() {
         (&["text.exr", "-o", "out.exr"][..], "text.exr"),
         (&["part.exr", "-o", "out.exr"][..], "glint merge"),
         (&["part.exr", "-o", "out.jpg"][..], "out.jpg"),
-        (&["part.exr", "-o", "part.exr"][..], "both"),
+        (&["part.exr", "-o", "part.exr"][..], "the same file"),
+        (&["part.exr", "-o", "./part.exr"][..], "the same file"),
+        (&["part.exr", "-o", "out.exr/"][..], "names a folder"),
+        (&["part.exr", "-o", "missing/out.exr"][..], "does not exist"),
     ];
     for (args, named) in refused {
         let mut all = vec!["denoise"];
