@@ -23,7 +23,9 @@ pub fn film_bytes(settings: &glint_render::RenderSettings, time_budget: bool, ex
     if time_budget || settings.adaptive.is_some() {
         per_pixel += 256;
     }
-    u64::from(settings.width) * u64::from(settings.height) * per_pixel
+    // A tile or crop holds and writes its own pixels only.
+    let bounds = settings.bounds();
+    u64::from(bounds.width()) * u64::from(bounds.height()) * per_pixel
 }
 
 /// Bytes per shape of the scene and its acceleration structures: the shape (up to 40 bytes),
@@ -110,5 +112,15 @@ mod tests {
         assert!(refused.to_string().contains("--max-memory"), "{refused}");
         assert!(check(1 << 20, 1 << 20, 1000, 8 << 30, "test").is_ok());
         assert!(check(0, 0, u64::MAX, 8 << 30, "test").is_err());
+        let tile = glint_render::RenderSettings {
+            pixel_bounds: Some(glint_render::PixelBounds {
+                x0: 8,
+                x1: 24,
+                y0: 0,
+                y1: 16,
+            }),
+            ..huge
+        };
+        assert_eq!(film_bytes(&tile, false, false), 16 * 16 * 58);
     }
 }
