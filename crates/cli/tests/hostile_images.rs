@@ -383,6 +383,65 @@ fn class_3_parts_of_a_huge_image_are_refused_from_their_headers() {
     assert_eq!(dir.names(), before);
 }
 
+/// A PNG whose header declares `width` x `height` pixels, with one pixel of data.
+fn png_declaring(width: u32, height: u32) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    image::RgbImage::new(1, 1)
+        .write_to(
+            &mut std::io::Cursor::new(&mut bytes),
+            image::ImageFormat::Png,
+        )
+        .unwrap();
+    // Signature (8), IHDR length (4), "IHDR" (4), width (4), height (4), ..., CRC at 29.
+    assert_eq!(&bytes[12..16], b"IHDR");
+    bytes[16..20].copy_from_slice(&width.to_be_bytes());
+    bytes[20..24].copy_from_slice(&height.to_be_bytes());
+    let crc = crc32(&bytes[12..29]);
+    bytes[29..33].copy_from_slice(&crc.to_be_bytes());
+    bytes
+}
+
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &byte in bytes {
+        crc ^= u32::from(byte);
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 {
+                (crc >> 1) ^ 0xedb8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// Issue 55, class 4: `glint diff` had no size or memory limit (two 9000 x 9000 PNGs took
+/// 8.4 GB). It refuses from the headers, naming the file and its size.
+#[test]
+fn class_4_diff_refuses_images_past_its_memory_limit() {
+    let dir = Dir::new();
+    for name in ["a.png", "b.png"] {
+        let output = dir.run(&["render", "scene.xml", "-w", "64", "-h", "64", "-o", name]);
+        assert!(output.status.success(), "{}", stderr(&output));
+    }
+    // 64 x 64 pixels take 320 KiB to compare, and the file.
+    let output = dir.run(&["diff", "a.png", "b.png", "--max-memory", "100K"]);
+    assert_refused(&output, &["a.png", "64 x 64 pixels", "--max-memory"]);
+    let output = dir.run(&["diff", "a.png", "b.png", "--max-memory", "500K"]);
+    assert_refused(&output, &["b.png", "64 x 64 pixels"]);
+    let output = dir.run(&["diff", "a.png", "b.png", "--max-memory", "2M"]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+
+    // At the default limit (half of `ulimit -v` here), headers declaring 9000 x 9000.
+    std::fs::write(dir.path("big-a.png"), png_declaring(9000, 9000)).unwrap();
+    std::fs::write(dir.path("big-b.png"), png_declaring(9000, 9000)).unwrap();
+    let before = dir.names();
+    let output = dir.run_capped(&["diff", "big-a.png", "big-b.png"]);
+    assert_refused(&output, &["big-a.png", "9000 x 9000 pixels"]);
+    assert_eq!(dir.names(), before);
+}
+
 /// Whether process `pid` catches SIGTERM (bit 15 of SigCgt in /proc/PID/status).
 fn catches_sigterm(pid: u32) -> bool {
     let Ok(status) = std::fs::read_to_string(format!("/proc/{pid}/status")) else {
