@@ -481,8 +481,10 @@ fn write_heatmap(path: &Path, error_map: &nv_flip::FlipImageFloat) -> Result<(),
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
+    // Named as glint_io names its temporary files (`.glint-PID-RANDOM.partial`), so that a
+    // later run removes it if this one is killed before the rename.
     let mut temporary = tempfile::Builder::new()
-        .prefix(".glint-")
+        .prefix(&format!(".glint-{}-", std::process::id()))
         .suffix(".partial")
         .tempfile_in(directory)
         .map_err(|error| error.to_string())?;
