@@ -224,12 +224,14 @@ def cases(glint, work):
             '<shape type="instance" id="m"/>\n'))
 
     def textures(w):
-        write(os.path.join(w, "t8k.png"), blank_png(8192))
+        png = blank_png(8192)
+        for i in range(3):
+            write(os.path.join(w, "t8k%d.png" % i), png)
         body = "".join(
-            '<texture name="t%d" type="image"><sourcefile>t8k.png</sourcefile></texture>'
+            '<texture name="t%d" type="image"><sourcefile>t8k%d.png</sourcefile></texture>'
             '<shader name="s%d" type="Lambertian"><diffuse tex="t%d">1 1 1</diffuse></shader>\n'
             '<shape type="sphere"><shader ref="s%d"/><center>%d 0 -5</center><radius>0.5'
-            "</radius></shape>\n" % (i, i, i, i, i - 1) for i in range(3))
+            "</radius></shape>\n" % (i, i, i, i, i, i - 1) for i in range(3))
         write(os.path.join(w, "tex.xml"), scene(body))
 
     def identical(w):

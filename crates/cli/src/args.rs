@@ -131,6 +131,12 @@ pub struct MergeArgs {
     /// and/or --sample-range.
     #[arg(value_name = "PART", required = true, num_args = 1..)]
     pub parts: Vec<PathBuf>,
+
+    /// Memory the merge may plan for: the image and its largest part, checked from the parts'
+    /// headers before any pixel is read (bytes; K, M, G suffixes) [default: half the memory
+    /// this process may use].
+    #[arg(long, value_name = "SIZE", value_parser = parse_size)]
+    pub max_memory: Option<u64>,
 }
 
 /// `glint denoise IN.exr -o OUT [--no-prefilter]`
@@ -752,6 +758,15 @@ pub fn parse_aspect(text: &str) -> Result<f32, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_memory_this_process_may_use_is_read_and_named() {
+        let (bytes, source) = machine_memory();
+        assert!(bytes > 0);
+        assert!(!source.is_empty());
+        assert_eq!(default_max_memory(), bytes / 2);
+        assert!(max_memory_source(None).starts_with("half of "));
+    }
     use clap::CommandFactory;
 
     #[test]

@@ -50,7 +50,9 @@ pub struct Resumed {
 
 /// Reads `file` to continue a render whose metadata would be `expected` (its identity keys
 /// and sample range must agree) over `bounds`. `Ok(None)` when the file does not exist yet (a
-/// run killed before its first checkpoint).
+/// run killed before its first checkpoint). Its header is checked first (the limits, the
+/// metadata, the rows and the layers, which bound it by this run's own pixels) and only then
+/// its pixels read, each of which must be finite; a refused checkpoint is left as it is.
 pub fn load(
     file: &Path,
     settings: &RenderSettings,
@@ -59,11 +61,12 @@ pub fn load(
     if !file.exists() {
         return Ok(None);
     }
-    let part = glint_io::read_exr(file).map_err(|e| UsageError(e.to_string()))?;
+    let limits = glint_io::ImageLimits::with_memory(crate::args::default_max_memory());
+    let header = glint_io::read_exr_header(file, &limits).map_err(|e| UsageError(e.to_string()))?;
     let name = file.display();
     for key in farm::IDENTITY_KEYS.iter().chain([&key::SAMPLE_RANGE]) {
         let (theirs, ours) = (
-            farm::lookup(&part.metadata, key),
+            farm::lookup(&header.metadata, key),
             farm::lookup(expected, key),
         );
         if theirs != ours {
@@ -75,31 +78,49 @@ pub fn load(
         }
     }
     let bounds = settings.bounds();
-    let film = part.film;
-    if film.origin != (bounds.x0, bounds.y0)
-        || film.width != bounds.width()
-        || film.height > bounds.height()
+    if header.full_size != (settings.width, settings.height)
+        || header.origin != (bounds.x0, bounds.y0)
+        || header.width != bounds.width()
+        || header.height > bounds.height()
     {
         return Err(UsageError(format!(
-            "cannot resume {name}: it holds pixels x {}..{}, y {}..{}, which are not the top \
-             rows of this run's pixels x {}..{}, y {}..{}",
-            film.origin.0,
-            film.origin.0 + film.width,
-            film.origin.1,
-            film.origin.1 + film.height,
+            "cannot resume {name}: it holds pixels x {}..{}, y {}..{} of a {}x{} image, which \
+             are not the top rows of this run's pixels x {}..{}, y {}..{} of {}x{}",
+            header.origin.0,
+            header.origin.0 + header.width,
+            header.origin.1,
+            header.origin.1 + header.height,
+            header.full_size.0,
+            header.full_size.1,
             bounds.x0,
             bounds.x1,
             bounds.y0,
-            bounds.y1
+            bounds.y1,
+            settings.width,
+            settings.height
         )));
     }
-    if film.features.is_some() != settings.features
-        || film.sums.is_some() != settings.sample_range.is_some()
-        || film.samples.is_some() != settings.adaptive.is_some()
+    if header.has_channel(glint_io::DEPTH_CHANNEL) != settings.features
+        || header.has_channel("count") != settings.sample_range.is_some()
+        || header.has_channel(glint_io::SAMPLES_CHANNEL) != settings.adaptive.is_some()
     {
         return Err(UsageError(format!(
             "cannot resume {name}: its layers (features, sample sums, samples) differ from this run's \
              (the output format decides them)"
+        )));
+    }
+    // No more than the header said: the file cannot grow into more than this run's rows.
+    let limits = glint_io::ImageLimits::with_memory(header.bytes);
+    let part = glint_io::read_exr_with(file, &limits).map_err(|e| UsageError(e.to_string()))?;
+    let film = part.film;
+    let same = film.origin == header.origin
+        && (film.width, film.height) == (header.width, header.height)
+        && film.features.is_some() == settings.features
+        && film.sums.is_some() == settings.sample_range.is_some()
+        && film.samples.is_some() == settings.adaptive.is_some();
+    if !same {
+        return Err(UsageError(format!(
+            "cannot resume {name}: it changed while it was being read"
         )));
     }
     let number = |key: &str| farm::lookup(&part.metadata, key).and_then(|v| v.parse::<f64>().ok());

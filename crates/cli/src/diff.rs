@@ -21,7 +21,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 use clap::{Args, ValueEnum};
-use glint_io::{DisplayTransform, Transfer, TRANSFER_KEYWORD};
+use glint_io::{DisplayTransform, ImageFile, ImageLimits, RgbPixels, Transfer, TRANSFER_KEYWORD};
 use glint_render::Color;
 
 /// `glint diff` arguments.
@@ -56,6 +56,12 @@ pub struct DiffArgs {
     #[arg(long, value_name = "HOW", value_enum, default_value_t = PngTransferArg::Auto)]
     pub png_transfer: PngTransferArg,
 
+    /// Memory the comparison may take: both images as read, decoded and compared by FLIP,
+    /// estimated from their headers before either is decoded (bytes; K, M, G suffixes)
+    /// [default: half the machine's memory].
+    #[arg(long, value_name = "SIZE", value_parser = crate::args::parse_size)]
+    pub max_memory: Option<u64>,
+
     /// Print help (`glint` turns off `-h`, which is the image height for renders).
     #[arg(short = '?', long, action = clap::ArgAction::Help)]
     pub help: Option<bool>,
@@ -67,7 +73,7 @@ Examples:
   glint diff reference.png mine.png --threshold mae=1.5,over=2 --heatmap flip.png
 
 Exit status: 0 within every threshold, 1 past one (or the heat map cannot be written), 2 bad
-input (unreadable, different sizes).";
+input (unreadable, different sizes, larger than --max-memory allows).";
 
 /// `--png-transfer` values.
 #[derive(ValueEnum, Clone, Copy, Debug, PartialEq, Eq)]
@@ -192,55 +198,64 @@ pub struct DiffImage {
     pub description: String,
 }
 
-/// Reads `path` (PNG, EXR, Radiance HDR, or anything else the `image` crate decodes).
-pub fn read_image(path: &Path, png_transfer: PngTransferArg) -> Result<DiffImage, BadInput> {
+/// Memory one pixel of a compared image takes, decoding and FLIP included: measured 55 to 58
+/// bytes for 8-bit PNGs (peak RSS of 1000 x 1000 and 2000 x 2000 pairs, half each), and a
+/// float image's decoder holds RGBA and RGB f32 copies besides (up to 24 more).
+pub const BYTES_PER_PIXEL: u64 = 80;
+
+/// Opens `path` (PNG, EXR, Radiance HDR, or anything else the `image` crate decodes) and
+/// checks its header against `limits` before anything is decoded.
+pub fn open_image(path: &Path, limits: &ImageLimits) -> Result<ImageFile, BadInput> {
+    glint_io::open_image(path, limits, BYTES_PER_PIXEL).map_err(|error| BadInput(error.to_string()))
+}
+
+/// Decodes an image whose header `open_image` checked, both ways the report needs.
+pub fn decode_image(
+    path: &Path,
+    file: ImageFile,
+    png_transfer: PngTransferArg,
+) -> Result<DiffImage, BadInput> {
     let fail = |why: String| BadInput(format!("cannot read {}: {why}", path.display()));
-    let reader = image::ImageReader::open(path)
-        .map_err(|error| fail(error.to_string()))?
-        .with_guessed_format()
-        .map_err(|error| fail(error.to_string()))?;
-    let format = reader.format();
-    let decoded = reader.decode().map_err(|error| fail(error.to_string()))?;
-    let (width, height) = (decoded.width(), decoded.height());
-    let format_name = format.map_or("image", |format| format.extensions_str()[0]);
-    if matches!(
-        decoded,
-        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-    ) {
-        let linear = decoded.to_rgb32f().into_raw();
-        if let Some(index) = linear.iter().position(|v| !v.is_finite()) {
-            let pixel = (index / 3) as u32;
-            return Err(fail(format!(
-                "pixel ({}, {}) from the top-left is not finite",
-                pixel % width,
-                pixel / width
-            )));
+    let format_name = file.format_name();
+    let tagged = (png_transfer == PngTransferArg::Auto && file.is_png())
+        .then(|| png_tagged_transfer(file.bytes()))
+        .flatten();
+    let decoded = file.decode().map_err(|error| BadInput(error.to_string()))?;
+    let (width, height) = (decoded.width, decoded.height);
+    let levels = match decoded.pixels {
+        RgbPixels::Float(linear) => {
+            if let Some(index) = linear.iter().position(|v| !v.is_finite()) {
+                let pixel = (index / 3) as u32;
+                return Err(fail(format!(
+                    "pixel ({}, {}) from the top-left is not finite",
+                    pixel % width,
+                    pixel / width
+                )));
+            }
+            let colors: Vec<Color> = linear
+                .chunks_exact(3)
+                .map(|c| Color::new(c[0], c[1], c[2]))
+                .collect();
+            let levels = DisplayTransform::default().to_rgb8(&colors);
+            return Ok(DiffImage {
+                width,
+                height,
+                levels,
+                linear,
+                description: format!(
+                    "{} {width}x{height}, linear float (8-bit: clamp, sRGB)",
+                    format_name.to_uppercase()
+                ),
+            });
         }
-        let colors: Vec<Color> = linear
-            .chunks_exact(3)
-            .map(|c| Color::new(c[0], c[1], c[2]))
-            .collect();
-        let levels = DisplayTransform::default().to_rgb8(&colors);
-        return Ok(DiffImage {
-            width,
-            height,
-            levels,
-            linear,
-            description: format!(
-                "{} {width}x{height}, linear float (8-bit: clamp, sRGB)",
-                format_name.to_uppercase()
-            ),
-        });
-    }
-    let levels = decoded.to_rgb8().into_raw();
+        RgbPixels::Levels(levels) => levels,
+    };
     let (transfer, why) = match png_transfer {
         PngTransferArg::Srgb => (Transfer::Srgb, "--png-transfer"),
         PngTransferArg::Linear => (Transfer::Linear, "--png-transfer"),
-        PngTransferArg::Auto if format == Some(image::ImageFormat::Png) => {
-            png_tagged_transfer(path)
-                .unwrap_or((Transfer::Linear, "untagged: the course's convention"))
+        PngTransferArg::Auto => {
+            tagged.unwrap_or((Transfer::Linear, "untagged: the course's convention"))
         }
-        PngTransferArg::Auto => (Transfer::Linear, "untagged: the course's convention"),
     };
     let table: Vec<f32> = (0..=255u8)
         .map(|level| transfer.decode(f32::from(level) / 255.0))
@@ -264,9 +279,8 @@ pub fn read_image(path: &Path, png_transfer: PngTransferArg) -> Result<DiffImage
 
 /// The transfer function a PNG's chunks name: Glint's own tEXt, else an sRGB chunk, else a
 /// gAMA chunk of 1/2.2 (sRGB) or 1.0 (linear). `None` when it names none.
-fn png_tagged_transfer(path: &Path) -> Option<(Transfer, &'static str)> {
-    let file = std::fs::File::open(path).ok()?;
-    let reader = png::Decoder::new(std::io::BufReader::new(file))
+fn png_tagged_transfer(bytes: &[u8]) -> Option<(Transfer, &'static str)> {
+    let reader = png::Decoder::new(std::io::Cursor::new(bytes))
         .read_info()
         .ok()?;
     let info = reader.info();
@@ -467,8 +481,10 @@ fn write_heatmap(path: &Path, error_map: &nv_flip::FlipImageFloat) -> Result<(),
         Some(parent) if !parent.as_os_str().is_empty() => parent,
         _ => Path::new("."),
     };
+    // Named as glint_io names its temporary files (`.glint-PID-RANDOM.partial`), so that a
+    // later run removes it if this one is killed before the rename.
     let mut temporary = tempfile::Builder::new()
-        .prefix(".glint-")
+        .prefix(&format!(".glint-{}-", std::process::id()))
         .suffix(".partial")
         .tempfile_in(directory)
         .map_err(|error| error.to_string())?;
@@ -500,11 +516,23 @@ pub fn run(args: &DiffArgs, out: &mut dyn Write, err: &mut dyn Write) -> u8 {
             return 2;
         }
     }
-    let compared = read_image(&args.reference, args.png_transfer).and_then(|a| {
-        let b = read_image(&args.test, args.png_transfer)?;
-        let (report, error_map) = compare(&a, &b, args.levels)?;
-        Ok((a, b, report, error_map))
-    });
+    // Both headers are checked before either image is decoded: B gets what A leaves.
+    let budget = args
+        .max_memory
+        .unwrap_or_else(crate::args::default_max_memory);
+    let compared = open_image(&args.reference, &ImageLimits::with_memory(budget))
+        .and_then(|a| {
+            let left = budget.saturating_sub(a.bytes_charged);
+            let b = open_image(&args.test, &ImageLimits::with_memory(left))
+                .map_err(|why| BadInput(format!("{why} (what is left of the limit after A)")))?;
+            Ok((a, b))
+        })
+        .and_then(|(a, b)| {
+            let a = decode_image(&args.reference, a, args.png_transfer)?;
+            let b = decode_image(&args.test, b, args.png_transfer)?;
+            let (report, error_map) = compare(&a, &b, args.levels)?;
+            Ok((a, b, report, error_map))
+        });
     let (a, b, report, error_map) = match compared {
         Ok(compared) => compared,
         Err(BadInput(why)) => {

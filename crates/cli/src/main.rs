@@ -73,7 +73,8 @@ fn main() -> ExitCode {
         let Some(crate::args::Command::Merge(args)) = cli.command.take() else {
             unreachable!("matched just above");
         };
-        return match merge::run(&args, &mut std::io::stderr()) {
+        handle_signals();
+        return match merge::run(&args, &INTERRUPT, &mut std::io::stderr()) {
             Ok(()) => ExitCode::SUCCESS,
             Err(failure) => fail(&failure),
         };
@@ -90,18 +91,7 @@ fn main() -> ExitCode {
         Err(error) => return fail(&Failure::Usage(error)),
     };
 
-    // Without a handler Ctrl-C would still kill the process without writing anything (the
-    // image is written atomically), only less politely; so a failure here is only a note.
-    // With ctrlc's `termination` feature SIGTERM (and SIGHUP) take the same path as Ctrl-C.
-    if let Err(error) = ctrlc::set_handler(|| match INTERRUPT.on_signal() {
-        SignalAction::ExitNow => {
-            eprintln!("\nerror: {}", Failure::Interrupted);
-            std::process::exit(EXIT_INTERRUPTED.into());
-        }
-        SignalAction::Cancel | SignalAction::Ignore => {}
-    }) {
-        eprintln!("note: cannot handle Ctrl-C: {error}");
-    }
+    handle_signals();
 
     // Not locked: the progress bar draws from the render threads.
     let progress_bar = std::io::stderr().is_terminal();
@@ -134,6 +124,22 @@ fn main() -> ExitCode {
     match outcome {
         Ok(_) => ExitCode::SUCCESS,
         Err(failure) => fail(&failure),
+    }
+}
+
+/// Ctrl-C and SIGTERM through `INTERRUPT`, for a render and for `glint merge`. Without a
+/// handler Ctrl-C would still kill the process, but a merge or render killed while writing
+/// would leave its temporary file; a failure to install it is only a note. With ctrlc's
+/// `termination` feature SIGTERM (and SIGHUP) take the same path as Ctrl-C.
+fn handle_signals() {
+    if let Err(error) = ctrlc::set_handler(|| match INTERRUPT.on_signal() {
+        SignalAction::ExitNow => {
+            eprintln!("\nerror: {}", Failure::Interrupted);
+            std::process::exit(EXIT_INTERRUPTED.into());
+        }
+        SignalAction::Cancel | SignalAction::Ignore => {}
+    }) {
+        eprintln!("note: cannot handle Ctrl-C: {error}");
     }
 }
 

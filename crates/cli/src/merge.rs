@@ -7,34 +7,52 @@
 //! samples per pixel, depth, aspect). Otherwise the merge is refused with exit status 2 and
 //! nothing is written.
 //!
+//! Everything that can be known from the parts' headers is checked before a pixel is read:
+//! each header against the image limits (windows inside each other, sizes), the identity
+//! keys, the coverage (worked out on the rectangles the parts' edges cut the image into, so a
+//! huge image with a tiny part costs nothing), and the memory the merge will take against the
+//! budget (`--max-memory`). Then the parts are read one at a time, each folded into the image
+//! and dropped. A part holding a NaN or an infinity is refused (`glint_io::read_exr_with`).
+//!
 //! A pixel covered by one part with all its samples is copied: tiles merge to the single
 //! render bit for bit. A pixel split over sample ranges is the sum of the parts' sums, added
-//! in the order of their range starts, over the sum of their sample counts: deterministic,
-//! but not always the same `f32` as the single render, whose one running sum adds the same
-//! samples in another association (see README: render farms, for the measured difference).
+//! in f64 in the order of their range starts, over the sum of their sample counts. In f64
+//! the sum of finite f32 sums cannot overflow, and the mean of finite values is a finite
+//! f32, so two parts of 2e38 each merge to their mean instead of an infinity; the value is
+//! deterministic, and differs from the single render's one running f32 sum by that sum's own
+//! rounding at most (see README: render farms).
 
 use std::io::Write;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
+use glint_io::{ExrHeader, ImageLimits, DEPTH_CHANNEL, SAMPLES_CHANNEL};
 use glint_render::{Color, Features, Film};
 
 use crate::args::MergeArgs;
 use crate::failure::Failure;
 use crate::farm::{self, key};
+use crate::interrupt::{Interrupt, Phase};
 use crate::job::UsageError;
 
-/// One part, read and checked.
+/// One part, its header read and checked.
 struct Part {
     path: PathBuf,
-    film: Film,
-    metadata: Vec<(String, String)>,
+    header: ExrHeader,
     samples: Range<u32>,
 }
 
 impl Part {
     fn name(&self) -> String {
         self.path.display().to_string()
+    }
+
+    fn columns(&self) -> Range<u32> {
+        self.header.origin.0..self.header.origin.0 + self.header.width
+    }
+
+    fn rows(&self) -> Range<u32> {
+        self.header.origin.1..self.header.origin.1 + self.header.height
     }
 }
 
@@ -57,11 +75,12 @@ fn described(key: &str) -> &'static str {
     }
 }
 
-fn read_part(path: &Path) -> Result<Part, Failure> {
+fn read_part(path: &Path, limits: &ImageLimits) -> Result<Part, Failure> {
     let name = path.display();
-    let file = glint_io::read_exr(path).map_err(|error| refuse(error.to_string()))?;
+    let header =
+        glint_io::read_exr_header(path, limits).map_err(|error| refuse(error.to_string()))?;
     let value = |key: &str| {
-        farm::lookup(&file.metadata, key).ok_or_else(|| {
+        farm::lookup(&header.metadata, key).ok_or_else(|| {
             refuse(format!(
                 "{name} is not a part of a Glint render: it has no {key} metadata"
             ))
@@ -70,7 +89,7 @@ fn read_part(path: &Path) -> Result<Part, Failure> {
     for key in farm::IDENTITY_KEYS {
         value(key)?;
     }
-    let size = format!("{}x{}", file.film.full_size.0, file.film.full_size.1);
+    let size = format!("{}x{}", header.full_size.0, header.full_size.1);
     if value(key::IMAGE_SIZE)? != size {
         return Err(refuse(format!(
             "{name}: its display window is {size} but its metadata says {}",
@@ -91,7 +110,7 @@ fn read_part(path: &Path) -> Result<Part, Failure> {
             samples.start, samples.end
         )));
     }
-    if samples != (0..spp) && file.film.sums.is_none() {
+    if samples != (0..spp) && !header.has_channel("count") {
         return Err(refuse(format!(
             "{name} holds samples {}..{} of {spp} but no sample sums (channels sum.R/G/B, count)",
             samples.start, samples.end
@@ -99,73 +118,53 @@ fn read_part(path: &Path) -> Result<Part, Failure> {
     }
     Ok(Part {
         path: path.to_path_buf(),
-        film: file.film,
-        metadata: file.metadata,
+        header,
         samples,
     })
 }
 
-/// Merges `parts` into one whole image with its metadata; refuses parts that do not fit.
-fn merge(parts: &[Part]) -> Result<(Film, Vec<(String, String)>), Failure> {
-    let first = &parts[0];
-    for part in &parts[1..] {
-        for key in farm::IDENTITY_KEYS {
-            let (a, b) = (
-                farm::lookup(&first.metadata, key).unwrap_or_default(),
-                farm::lookup(&part.metadata, key).unwrap_or_default(),
-            );
-            if a != b {
-                return Err(refuse(format!(
-                    "{} and {} are parts of different renders: their {} differ ({key}: {a} vs {b})",
-                    first.name(),
-                    part.name(),
-                    described(key)
-                )));
-            }
-        }
-    }
-    let (width, height) = first.film.full_size;
-    let spp = first.samples.end.max(
-        farm::lookup(&first.metadata, key::SAMPLES_PER_PIXEL)
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(0),
-    );
+/// Refuses parts that do not cover every pixel with samples 0..`spp` exactly once, from
+/// their rectangles alone: the parts' edges cut the image into cells that each part covers
+/// whole or not at all, so checking one pixel a cell checks them all, and the memory is the
+/// parts', whatever the image's size. The first problem in reading order is reported.
+fn check_coverage(
+    parts: &[Part],
+    order: &[usize],
+    size: (u32, u32),
+    spp: u32,
+) -> Result<(), Failure> {
+    let (width, height) = size;
     let full = 0..spp;
-    let pixel_count = width as usize * height as usize;
-
-    // Parts in a fixed order: by sample range start, then by position, then by name, so that
-    // sums are added in the same order whatever order the parts were given in.
-    let mut order: Vec<usize> = (0..parts.len()).collect();
-    order.sort_by(|&a, &b| {
-        let key = |p: &Part| {
-            (
-                p.samples.start,
-                p.film.origin.1,
-                p.film.origin.0,
-                p.path.clone(),
-            )
-        };
-        key(&parts[a]).cmp(&key(&parts[b]))
-    });
-
-    // The next sample each pixel expects and the part that gave it the last ones.
-    let mut next = vec![0u32; pixel_count];
-    let mut owner = vec![usize::MAX; pixel_count];
-    let mut pixels = vec![Color::ZERO; pixel_count];
-    let mut sums = vec![Color::ZERO; pixel_count];
-    let mut counts = vec![0u32; pixel_count];
-    let mut copied = vec![false; pixel_count];
-    for &index in &order {
-        let part = &parts[index];
-        let film = &part.film;
-        let range = &part.samples;
-        for row in 0..film.height {
-            for column in 0..film.width {
-                let (x, y) = (film.origin.0 + column, film.origin.1 + row);
-                let p = (y * width + x) as usize;
-                let local = (row * film.width + column) as usize;
-                if next[p] > range.start {
-                    let other = &parts[owner[p]];
+    let mut xs = vec![0, width];
+    let mut ys = vec![0, height];
+    for part in parts {
+        xs.extend([part.columns().start, part.columns().end]);
+        ys.extend([part.rows().start, part.rows().end]);
+    }
+    for edges in [&mut xs, &mut ys] {
+        edges.sort_unstable();
+        edges.dedup();
+    }
+    let mut missing = 0u64;
+    // The first pixel short of samples: where, how many it has, and from which part.
+    let mut first_short: Option<(u32, u32, u32, Option<usize>)> = None;
+    for band in ys.windows(2) {
+        let y = band[0];
+        let across: Vec<usize> = order
+            .iter()
+            .copied()
+            .filter(|&index| parts[index].rows().contains(&y))
+            .collect();
+        for cell in xs.windows(2) {
+            let x = cell[0];
+            let (mut next, mut owner) = (0u32, None::<usize>);
+            for &index in across
+                .iter()
+                .filter(|&&index| parts[index].columns().contains(&x))
+            {
+                let (part, range) = (&parts[index], &parts[index].samples);
+                if next > range.start {
+                    let other = &parts[owner.expect("a part gave the samples before")];
                     return Err(refuse(if other.samples == full && *range == full {
                         format!(
                             "tiles overlap: {} and {} both cover pixel ({x}, {y})",
@@ -177,7 +176,7 @@ fn merge(parts: &[Part]) -> Result<(Film, Vec<(String, String)>), Failure> {
                             "a sample range is counted twice: samples {}..{} of pixel ({x}, {y}) \
                              are in {} (samples {}..{}) and in {} (samples {}..{})",
                             range.start,
-                            next[p].min(range.end),
+                            next.min(range.end),
                             other.name(),
                             other.samples.start,
                             other.samples.end,
@@ -187,110 +186,215 @@ fn merge(parts: &[Part]) -> Result<(Film, Vec<(String, String)>), Failure> {
                         )
                     }));
                 }
-                if next[p] < range.start {
+                if next < range.start {
                     return Err(refuse(format!(
-                        "gap in the samples: pixel ({x}, {y}) has samples 0..{} but the next \
-                         part covering it, {}, starts at sample {}: samples {}..{} are in no part",
-                        next[p],
+                        "gap in the samples: pixel ({x}, {y}) has samples 0..{next} but the next \
+                         part covering it, {}, starts at sample {}: samples {next}..{} are in no \
+                         part",
                         part.name(),
                         range.start,
-                        next[p],
                         range.start
                     )));
                 }
-                next[p] = range.end;
-                owner[p] = index;
-                if *range == full {
-                    pixels[p] = film.pixels[local];
-                    copied[p] = true;
+                next = range.end;
+                owner = Some(index);
+            }
+            if next < spp {
+                if next == 0 {
+                    missing += u64::from(cell[1] - x) * u64::from(band[1] - y);
+                }
+                first_short.get_or_insert((x, y, next, owner));
+            }
+        }
+    }
+    let Some((x, y, next, owner)) = first_short else {
+        return Ok(());
+    };
+    Err(refuse(match owner {
+        None => format!(
+            "gap: {missing} pixel{} of the {width}x{height} image {} in no part, the first \
+             ({x}, {y})",
+            if missing == 1 { "" } else { "s" },
+            if missing == 1 { "is" } else { "are" },
+        ),
+        Some(owner) => format!(
+            "gap in the samples: pixel ({x}, {y}) has samples 0..{next} (the last from {}) but \
+             samples {next}..{spp} are in no part",
+            parts[owner].name(),
+        ),
+    }))
+}
+
+/// Bytes a pixel of the merged image takes: its colour, the EXR's copy of it and the encoded
+/// file (12 each); with sample ranges the f64 sums and the u64 count (32); with feature layers
+/// their seven values thrice (84); with the samples layer its count thrice (12).
+fn merge_bytes_per_pixel(partial: bool, features: bool, samples: bool) -> u64 {
+    36 + if partial { 32 } else { 0 } + if features { 84 } else { 0 } + if samples { 12 } else { 0 }
+}
+
+/// Merges `parts` into one whole image with its metadata within `budget` bytes; refuses parts
+/// that do not fit, before reading a pixel when their headers tell.
+fn merge(parts: &[Part], budget: u64) -> Result<(Film, Vec<(String, String)>), Failure> {
+    let first = &parts[0];
+    for part in &parts[1..] {
+        for key in farm::IDENTITY_KEYS {
+            let (a, b) = (
+                farm::lookup(&first.header.metadata, key).unwrap_or_default(),
+                farm::lookup(&part.header.metadata, key).unwrap_or_default(),
+            );
+            if a != b {
+                return Err(refuse(format!(
+                    "{} and {} are parts of different renders: their {} differ ({key}: {a} vs {b})",
+                    first.name(),
+                    part.name(),
+                    described(key)
+                )));
+            }
+        }
+    }
+    let (width, height) = first.header.full_size;
+    let spp = first.samples.end.max(
+        farm::lookup(&first.header.metadata, key::SAMPLES_PER_PIXEL)
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(0),
+    );
+    let full = 0..spp;
+
+    // Parts in a fixed order: by sample range start, then by position, then by name, so that
+    // sums are added in the same order whatever order the parts were given in.
+    let mut order: Vec<usize> = (0..parts.len()).collect();
+    order.sort_by(|&a, &b| {
+        let key = |p: &Part| {
+            (
+                p.samples.start,
+                p.header.origin.1,
+                p.header.origin.0,
+                p.path.clone(),
+            )
+        };
+        key(&parts[a]).cmp(&key(&parts[b]))
+    });
+    check_coverage(parts, &order, (width, height), spp)?;
+
+    // Feature layers survive when every pixel comes whole from a part that has them; so does
+    // adaptive sampling's count of samples.
+    let partial = parts.iter().any(|part| part.samples != full);
+    let whole_with = |channel: &str| {
+        parts
+            .iter()
+            .all(|part| part.samples == full && part.header.has_channel(channel))
+    };
+    let (features, samples) = (whole_with(DEPTH_CHANNEL), whole_with(SAMPLES_CHANNEL));
+    let pixel_count = u64::from(width) * u64::from(height);
+    let image_bytes = pixel_count.saturating_mul(merge_bytes_per_pixel(partial, features, samples));
+    let largest_part = parts
+        .iter()
+        .map(|part| part.header.bytes)
+        .max()
+        .unwrap_or(0);
+    let needed = image_bytes.saturating_add(largest_part);
+    if needed > budget {
+        let bytes = glint_io::format_bytes;
+        return Err(Failure::Memory(format!(
+            "merging {} part{} into the {width}x{height} image would take about {} (the image \
+             {}, its largest part {}), more than the limit of {} (--max-memory; by default \
+             half of the least of the machine's memory, its control group's and ulimit -v)",
+            parts.len(),
+            if parts.len() == 1 { "" } else { "s" },
+            bytes(needed),
+            bytes(image_bytes),
+            bytes(largest_part),
+            bytes(budget)
+        )));
+    }
+
+    let pixel_count = pixel_count as usize;
+    let stride = width as usize;
+    let mut pixels = vec![Color::ZERO; pixel_count];
+    let (mut sums, mut counts) = if partial {
+        (vec![[0f64; 3]; pixel_count], vec![0u64; pixel_count])
+    } else {
+        (Vec::new(), Vec::new())
+    };
+    let mut layers = features.then(|| Features {
+        albedo: vec![Color::ZERO; pixel_count],
+        normal: vec![Color::ZERO; pixel_count],
+        depth: vec![0.0; pixel_count],
+    });
+    let mut taken = samples.then(|| vec![0u32; pixel_count]);
+    let limits = ImageLimits::with_memory(budget - image_bytes);
+    for &index in &order {
+        let part = &parts[index];
+        let film = glint_io::read_exr_with(&part.path, &limits)
+            .map_err(|error| refuse(error.to_string()))?
+            .film;
+        let header = &part.header;
+        let same = film.origin == header.origin
+            && (film.width, film.height) == (header.width, header.height)
+            && film.full_size == header.full_size
+            && (part.samples == full || film.sums.is_some())
+            && (!features || film.features.is_some())
+            && (!samples || film.samples.is_some());
+        if !same {
+            return Err(refuse(format!(
+                "{} changed while it was being merged",
+                part.name()
+            )));
+        }
+        let whole = part.samples == full;
+        for row in 0..film.height as usize {
+            let start = (film.origin.1 as usize + row) * stride + film.origin.0 as usize;
+            let local = row * film.width as usize;
+            for column in 0..film.width as usize {
+                let (p, l) = (start + column, local + column);
+                if whole {
+                    pixels[p] = film.pixels[l];
                 } else if let Some(part_sums) = &film.sums {
-                    sums[p] += part_sums.radiance[local];
-                    counts[p] += part_sums.counts[local];
-                }
-            }
-        }
-    }
-    if let Some(p) = next.iter().position(|&n| n < spp) {
-        let (x, y) = (p as u32 % width, p as u32 / width);
-        let missing = next.iter().filter(|&&n| n == 0).count();
-        return Err(refuse(if next[p] == 0 {
-            format!(
-                "gap: {missing} pixel{} of the {width}x{height} image {} in no part, the first \
-                 ({x}, {y})",
-                if missing == 1 { "" } else { "s" },
-                if missing == 1 { "is" } else { "are" },
-            )
-        } else {
-            format!(
-                "gap in the samples: pixel ({x}, {y}) has samples 0..{} (the last from {}) but \
-                 samples {}..{spp} are in no part",
-                next[p],
-                parts[owner[p]].name(),
-                next[p]
-            )
-        }));
-    }
-    for p in 0..pixel_count {
-        // As the pipeline averages: black where every sample was dropped.
-        if !copied[p] && counts[p] > 0 {
-            pixels[p] = sums[p] / counts[p] as f32;
-        }
-    }
-
-    // Feature layers survive when every pixel comes whole from a part that has them.
-    let features = parts
-        .iter()
-        .all(|part| part.samples == full && part.film.features.is_some())
-        .then(|| {
-            let mut features = Features {
-                albedo: vec![Color::ZERO; pixel_count],
-                normal: vec![Color::ZERO; pixel_count],
-                depth: vec![0.0; pixel_count],
-            };
-            for part in parts {
-                let (film, layers) = (&part.film, part.film.features.as_ref().expect("checked"));
-                for row in 0..film.height {
-                    for column in 0..film.width {
-                        let p = ((film.origin.1 + row) * width + film.origin.0 + column) as usize;
-                        let local = (row * film.width + column) as usize;
-                        features.albedo[p] = layers.albedo[local];
-                        features.normal[p] = layers.normal[local];
-                        features.depth[p] = layers.depth[local];
+                    let value = part_sums.radiance[l];
+                    for (sum, v) in sums[p].iter_mut().zip([value.x, value.y, value.z]) {
+                        *sum += f64::from(v);
                     }
+                    counts[p] += u64::from(part_sums.counts[l]);
+                }
+                if let (Some(ours), Some(theirs)) = (&mut layers, &film.features) {
+                    ours.albedo[p] = theirs.albedo[l];
+                    ours.normal[p] = theirs.normal[l];
+                    ours.depth[p] = theirs.depth[l];
+                }
+                if let (Some(ours), Some(theirs)) = (&mut taken, &film.samples) {
+                    ours[p] = theirs[l];
                 }
             }
-            features
-        });
-
-    // So does adaptive sampling's count of samples.
-    let samples = parts
-        .iter()
-        .all(|part| part.samples == full && part.film.samples.is_some())
-        .then(|| {
-            let mut samples = vec![0; pixel_count];
-            for part in parts {
-                let (film, taken) = (&part.film, part.film.samples.as_ref().expect("checked"));
-                for row in 0..film.height {
-                    let start = ((film.origin.1 + row) * width + film.origin.0) as usize;
-                    let local = (row * film.width) as usize;
-                    samples[start..start + film.width as usize]
-                        .copy_from_slice(&taken[local..local + film.width as usize]);
-                }
-            }
-            samples
-        });
+        }
+    }
+    // Sample-range pixels; a pixel copied whole has no count. As the pipeline averages:
+    // black where every sample was dropped.
+    for ((pixel, sum), &count) in pixels.iter_mut().zip(&sums).zip(&counts) {
+        if count > 0 {
+            let n = count as f64;
+            *pixel = Color::new(
+                (sum[0] / n) as f32,
+                (sum[1] / n) as f32,
+                (sum[2] / n) as f32,
+            );
+        }
+    }
 
     let mut metadata: Vec<(String, String)> = farm::IDENTITY_KEYS
         .iter()
         .map(|key| {
-            let value = farm::lookup(&first.metadata, key).unwrap_or_default();
+            let value = farm::lookup(&first.header.metadata, key).unwrap_or_default();
             (key.to_string(), value.to_string())
         })
         .collect();
     let total = |key: &str| -> f64 {
         parts
             .iter()
-            .filter_map(|part| farm::lookup(&part.metadata, key)?.parse::<f64>().ok())
+            .filter_map(|part| {
+                farm::lookup(&part.header.metadata, key)?
+                    .parse::<f64>()
+                    .ok()
+            })
             .sum()
     };
     metadata.push((key::SAMPLE_RANGE.to_string(), format!("0..{spp}")));
@@ -300,39 +404,80 @@ fn merge(parts: &[Part]) -> Result<(Film, Vec<(String, String)>), Failure> {
     ));
     let rays: u64 = parts
         .iter()
-        .filter_map(|part| farm::lookup(&part.metadata, key::RAYS)?.parse::<u64>().ok())
-        .sum();
+        .filter_map(|part| {
+            farm::lookup(&part.header.metadata, key::RAYS)?
+                .parse::<u64>()
+                .ok()
+        })
+        .fold(0u64, u64::saturating_add);
     metadata.push((key::RAYS.to_string(), rays.to_string()));
     metadata.push(("glint.merged_parts".to_string(), parts.len().to_string()));
 
     let film = Film {
         pixels,
-        features,
-        samples,
+        features: layers,
+        samples: taken,
         ..Film::new(width, height)
     };
     Ok((film, metadata))
 }
 
-/// `glint merge`: reads, checks and merges the parts, writes the image.
-pub fn run(args: &MergeArgs, err: &mut dyn Write) -> Result<(), Failure> {
+/// `glint merge`: reads, checks and merges the parts, writes the image. Until the write
+/// nothing is on disk, so a signal (`interrupt`, in its loading phase) exits at once; during
+/// the write it waits for the atomic write to finish, as a render's does, so no temporary
+/// file is left. Temporary files of earlier merges killed outright are removed first.
+pub fn run(args: &MergeArgs, interrupt: &Interrupt, err: &mut dyn Write) -> Result<(), Failure> {
+    interrupt.set_phase(Phase::Loading);
     glint_io::output_format(&args.output).map_err(|_| {
         refuse(format!(
             "cannot write '{}': the output must end in .png or .exr",
             args.output.display()
         ))
     })?;
+    crate::paths::check_writable(&args.output).map_err(|why| {
+        refuse(format!(
+            "cannot write {}: {why}; nothing was merged",
+            args.output.display()
+        ))
+    })?;
+    // Compared as files: `-o ./p0.exr p0.exr` would replace a part with the merge.
+    if let Some(part) = args
+        .parts
+        .iter()
+        .find(|part| crate::paths::same_file(part, &args.output))
+    {
+        return Err(refuse(format!(
+            "the output '{}' is the part '{}': the part would be lost",
+            args.output.display(),
+            part.display()
+        )));
+    }
+    let removed = glint_io::remove_stale_partials(crate::paths::folder_of(&args.output));
+    if removed > 0 {
+        let _ = writeln!(
+            err,
+            "note: removed {removed} temporary file{} left by an earlier run that was killed",
+            if removed == 1 { "" } else { "s" }
+        );
+    }
+    let budget = args
+        .max_memory
+        .unwrap_or_else(crate::args::default_max_memory);
+    let limits = ImageLimits::with_memory(budget);
     let mut parts = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
-        if parts.iter().any(|part: &Part| part.path == *path) {
+        if parts
+            .iter()
+            .any(|part: &Part| crate::paths::same_file(&part.path, path))
+        {
             return Err(refuse(format!(
                 "{} is given twice: its pixels would be counted twice",
                 path.display()
             )));
         }
-        parts.push(read_part(path)?);
+        parts.push(read_part(path, &limits)?);
     }
-    let (film, metadata) = merge(&parts)?;
+    let (film, metadata) = merge(&parts, budget)?;
     // A PNG gets its integrator's default encoding, as `glint render` would have written it.
     let integrator = metadata
         .iter()
@@ -342,6 +487,7 @@ pub fn run(args: &MergeArgs, err: &mut dyn Write) -> Result<(), Failure> {
     let options = glint_io::WriteOptions {
         png: glint_io::PngEncoding::default_for(integrator),
     };
+    interrupt.set_phase(Phase::Writing);
     glint_io::write_image_with_metadata(&args.output, &film, &options, &metadata)
         .map_err(Failure::Write)?;
     let _ = writeln!(
@@ -354,4 +500,113 @@ pub fn run(args: &MergeArgs, err: &mut dyn Write) -> Result<(), Failure> {
         args.output.display()
     );
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A part that exists only as its header (nothing reads its pixels in these tests).
+    fn part(name: &str, rect: (u32, u32, u32, u32), size: u32, samples: Range<u32>) -> Part {
+        let (x, y, width, height) = rect;
+        Part {
+            path: PathBuf::from(name),
+            header: ExrHeader {
+                full_size: (size, size),
+                origin: (x, y),
+                width,
+                height,
+                channels: ["R", "G", "B", "sum.R", "sum.G", "sum.B", "count"]
+                    .map(String::from)
+                    .to_vec(),
+                metadata: vec![(key::SAMPLES_PER_PIXEL.to_string(), "2".to_string())],
+                bytes: u64::from(width) * u64::from(height) * 56,
+            },
+            samples,
+        }
+    }
+
+    fn refusal(parts: &[Part], budget: u64) -> String {
+        match merge(parts, budget) {
+            Err(failure) => {
+                assert_eq!(failure.exit_code(), 2, "{failure}");
+                failure.to_string()
+            }
+            Ok(_) => panic!("merged"),
+        }
+    }
+
+    #[test]
+    fn coverage_is_checked_on_rectangles_whatever_the_image_size() {
+        let huge = u32::from(u16::MAX);
+        // 8 x 8 pixels of a 65535 x 65535 image: refused without a buffer of its size.
+        let parts = [
+            part("a", (0, 0, 8, 8), huge, 0..1),
+            part("b", (0, 0, 8, 8), huge, 1..2),
+        ];
+        let message = refusal(&parts, 1 << 30);
+        assert!(
+            message.contains(
+                "gap: 4294836161 pixels of the 65535x65535 image are in no part, the first (8, 0)"
+            ),
+            "{message}"
+        );
+        // Tiles that overlap at (4, 0), and sample ranges counted twice.
+        let parts = [
+            part("a", (0, 0, 6, 8), 8, 0..2),
+            part("b", (4, 0, 4, 8), 8, 0..2),
+        ];
+        let message = refusal(&parts, 1 << 30);
+        assert!(
+            message.contains("tiles overlap: a and b both cover pixel (4, 0)"),
+            "{message}"
+        );
+        let parts = [
+            part("a", (0, 0, 8, 8), 8, 0..2),
+            part("b", (0, 4, 8, 4), 8, 1..2),
+        ];
+        let message = refusal(&parts, 1 << 30);
+        assert!(
+            message.contains("counted twice: samples 1..2 of pixel (0, 4)"),
+            "{message}"
+        );
+        // A missing sample range at the end of some pixels, and in the middle of others.
+        let parts = [
+            part("a", (0, 0, 8, 8), 8, 0..1),
+            part("b", (0, 0, 8, 5), 8, 1..2),
+        ];
+        let message = refusal(&parts, 1 << 30);
+        assert!(
+            message.contains("pixel (0, 5) has samples 0..1 (the last from a) but samples 1..2"),
+            "{message}"
+        );
+        let parts = [
+            part("a", (0, 0, 8, 8), 8, 1..2),
+            part("b", (0, 0, 8, 2), 8, 0..1),
+        ];
+        let message = refusal(&parts, 1 << 30);
+        assert!(
+            message.contains("gap in the samples: pixel (0, 2) has samples 0..0"),
+            "{message}"
+        );
+    }
+
+    #[test]
+    fn a_merge_past_the_budget_is_refused_before_reading_a_part() {
+        // Two sample ranges of a whole 16384 x 16384 image: 2^28 pixels at 68 bytes and a
+        // 14 GiB part, over 1 GiB. The parts' files do not exist: nothing was read.
+        let parts = [
+            part("s0", (0, 0, 16384, 16384), 16384, 0..1),
+            part("s1", (0, 0, 16384, 16384), 16384, 1..2),
+        ];
+        let message = refusal(&parts, 1 << 30);
+        assert!(
+            message.contains("merging 2 parts into the 16384x16384 image would take about"),
+            "{message}"
+        );
+        assert!(
+            message.contains("more than the limit of 1 GiB"),
+            "{message}"
+        );
+    }
 }

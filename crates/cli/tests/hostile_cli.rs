@@ -365,3 +365,58 @@ fn the_memory_estimate_covers_what_a_render_holds() {
         );
     }
 }
+
+/// `glint merge` compared its output and parts as text too: a part named twice under two
+/// spellings was counted twice, and `-o ./p0.exr p0.exr` replaced a part with the merge.
+#[test]
+fn merge_compares_its_parts_and_output_as_files() {
+    let dir = folder();
+    for i in 0..2 {
+        let range = format!("{i}/2");
+        let name = format!("p{i}.exr");
+        let output = glint(
+            dir.path(),
+            &[
+                "render",
+                "scene.xml",
+                "-w",
+                "8",
+                "-h",
+                "8",
+                "--integrator",
+                "path",
+                "-r",
+                "4",
+                "--sample-range",
+                &range,
+                "-o",
+                &name,
+            ],
+        );
+        assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+    }
+    let before = std::fs::read(dir.path().join("p0.exr")).unwrap();
+    let cases: [(&[&str], &str); 3] = [
+        (
+            &["-o", "out.exr", "p0.exr", "./p0.exr", "p1.exr"],
+            "given twice",
+        ),
+        (
+            &["-o", "./p0.exr", "p0.exr", "p1.exr"],
+            "the part would be lost",
+        ),
+        (&["-o", "out.exr/", "p0.exr", "p1.exr"], "names a folder"),
+    ];
+    for (args, expected) in cases {
+        let mut all = vec!["merge"];
+        all.extend_from_slice(args);
+        let output = glint(dir.path(), &all);
+        let text = stderr(&output);
+        assert_eq!(output.status.code(), Some(2), "{args:?}: {text}");
+        assert!(text.contains(expected), "{args:?}: {text}");
+    }
+    assert_eq!(std::fs::read(dir.path().join("p0.exr")).unwrap(), before);
+    assert_eq!(files(dir.path()), ["p0.exr", "p1.exr", "scene.xml", "sub"]);
+    let output = glint(dir.path(), &["merge", "-o", "out.exr", "p0.exr", "p1.exr"]);
+    assert_eq!(output.status.code(), Some(0), "{}", stderr(&output));
+}

@@ -1,5 +1,7 @@
-//! The rendered film out: written atomically as PNG or EXR (or encoded in memory), and an EXR
-//! that Glint wrote read back, as `glint merge` does with farm parts.
+//! The rendered film out: written atomically as PNG or EXR (or encoded in memory); and images
+//! in, every one through the same gate (`check_size`) from its header before it is decoded:
+//! an EXR that Glint wrote read back (farm parts, checkpoints), and any image `glint diff`
+//! compares. Textures go through the same gate in `texture_io`.
 
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -8,6 +10,7 @@ use std::path::{Path, PathBuf};
 use glint_render::{Film, Vec3};
 
 use crate::display::{PngEncoding, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD};
+use crate::limits::{format_bytes, Limits};
 
 /// Why an image could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -455,12 +458,242 @@ fn encode_exr(
     Ok(())
 }
 
-/// Why an EXR could not be read back.
+/// Why an image could not be read: the file, and what is wrong with it.
 #[derive(Debug, thiserror::Error)]
 #[error("cannot read {}: {message}", path.display())]
 pub struct ImageReadError {
     pub path: PathBuf,
     pub message: String,
+}
+
+/// The largest side of an image Glint renders (`--width`, `--height`), and so of a part,
+/// checkpoint or image it reads back by default.
+pub const MAX_IMAGE_SIDE: u32 = 65_535;
+
+/// What reading one image may take, checked from its header before a pixel is decoded: every
+/// EXR, PNG or HDR that Glint reads (textures, farm parts, checkpoints, `glint diff`'s images)
+/// passes the same gate, `check_size`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageLimits {
+    /// Largest width or height, in pixels, of the image and of an EXR's display window.
+    pub max_side: u32,
+    /// Memory the read may take, in bytes: the file, the decoder's buffers and the result.
+    pub max_bytes: u64,
+}
+
+impl Default for ImageLimits {
+    /// The largest image Glint renders, and the library's default memory for images
+    /// (`Limits::default().max_texture_bytes`); front ends pass their own memory budget.
+    fn default() -> Self {
+        ImageLimits {
+            max_side: MAX_IMAGE_SIDE,
+            max_bytes: Limits::default().max_texture_bytes,
+        }
+    }
+}
+
+impl ImageLimits {
+    /// The default side limit with `max_bytes` of memory.
+    pub fn with_memory(max_bytes: u64) -> ImageLimits {
+        ImageLimits {
+            max_bytes,
+            ..ImageLimits::default()
+        }
+    }
+}
+
+/// Why an image is too large to read, known from its header.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Oversize {
+    /// A side is over `max_side`.
+    Side,
+    /// Reading it would take `bytes`, more than was available.
+    Memory { bytes: u64 },
+}
+
+/// The one gate before decoding any image: `width` x `height` pixels of `bytes_per_pixel`
+/// each, plus `fixed` bytes (the file held in memory), against a side limit and the memory
+/// still `available`. Returns the bytes the read will take. Computed in u128, so no header can
+/// overflow it.
+pub(crate) fn check_size(
+    width: u64,
+    height: u64,
+    bytes_per_pixel: u64,
+    fixed: u64,
+    max_side: u32,
+    available: u64,
+) -> Result<u64, Oversize> {
+    if width > u64::from(max_side) || height > u64::from(max_side) {
+        return Err(Oversize::Side);
+    }
+    let bytes =
+        u128::from(width) * u128::from(height) * u128::from(bytes_per_pixel) + u128::from(fixed);
+    let bytes = u64::try_from(bytes).unwrap_or(u64::MAX);
+    if bytes > available {
+        return Err(Oversize::Memory { bytes });
+    }
+    Ok(bytes)
+}
+
+/// The `image` crate's reader over bytes held in memory, its format told by their content.
+pub(crate) fn image_reader(
+    bytes: &[u8],
+) -> std::io::Result<image::ImageReader<std::io::Cursor<&[u8]>>> {
+    image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format()
+}
+
+/// The `image` crate's own limits for a decode whose header passed `check_size`: its
+/// decoders then refuse to allocate past what was charged, whatever the rest of the file says.
+pub(crate) fn decoder_limits(max_side: u32, max_bytes: u64) -> image::Limits {
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(max_side);
+    limits.max_image_height = Some(max_side);
+    limits.max_alloc = Some(max_bytes);
+    limits
+}
+
+/// The message for an image refused by `check_size`.
+fn oversize_message(oversize: Oversize, width: u64, height: u64, limits: &ImageLimits) -> String {
+    match oversize {
+        Oversize::Side => format!(
+            "the image is {width} x {height} pixels, larger than the limit of {} pixels a side",
+            limits.max_side
+        ),
+        Oversize::Memory { bytes } => format!(
+            "the image is {width} x {height} pixels and reading it would take {}, more than \
+             the limit of {} (--max-memory raises it)",
+            format_bytes(bytes),
+            format_bytes(limits.max_bytes)
+        ),
+    }
+}
+
+/// The file at `path` in memory, read only when it is no larger than `limits.max_bytes`.
+fn read_bounded(path: &Path, limits: &ImageLimits) -> Result<Vec<u8>, ImageReadError> {
+    crate::assets::read_file_at_most(path, limits.max_bytes).map_err(|error| ImageReadError {
+        path: path.to_path_buf(),
+        message: match crate::assets::TooLarge::of(&error) {
+            Some(_) => format!(
+                "the file is larger than the limit of {} (--max-memory raises it)",
+                format_bytes(limits.max_bytes)
+            ),
+            None => error.to_string(),
+        },
+    })
+}
+
+/// A PNG, EXR, HDR (or any image the `image` crate reads) held in memory, whose header
+/// passed the limits: what is left is `decode`. `glint diff` reads its images so.
+#[derive(Debug)]
+pub struct ImageFile {
+    path: PathBuf,
+    bytes: Vec<u8>,
+    /// Width and height from the header.
+    pub width: u32,
+    pub height: u32,
+    /// The bytes the read was charged: the file and `bytes_per_pixel` a pixel.
+    pub bytes_charged: u64,
+    format: Option<image::ImageFormat>,
+    limits: image::Limits,
+}
+
+/// Pixels of a decoded image, RGB (alpha dropped), rows from the top.
+#[derive(Clone, Debug, PartialEq)]
+pub enum RgbPixels {
+    /// 8-bit levels as stored, three a pixel.
+    Levels(Vec<u8>),
+    /// Floating point values as stored (EXR, HDR), three a pixel.
+    Float(Vec<f32>),
+}
+
+/// An image decoded by `ImageFile::decode`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RgbImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: RgbPixels,
+}
+
+/// Reads the image file at `path` and checks the size its header declares before anything
+/// is decoded: each side at most `limits.max_side`, and the file plus `bytes_per_pixel` a
+/// pixel (what the caller will make of it, the decode included) at most `limits.max_bytes`.
+pub fn open_image(
+    path: &Path,
+    limits: &ImageLimits,
+    bytes_per_pixel: u64,
+) -> Result<ImageFile, ImageReadError> {
+    let error = |message: String| ImageReadError {
+        path: path.to_path_buf(),
+        message,
+    };
+    let bytes = read_bounded(path, limits)?;
+    let reader = image_reader(&bytes).map_err(|e| error(e.to_string()))?;
+    let format = reader.format();
+    let (width, height) = reader.into_dimensions().map_err(|e| error(e.to_string()))?;
+    let (w, h) = (u64::from(width), u64::from(height));
+    let file = bytes.len() as u64;
+    let charged = check_size(
+        w,
+        h,
+        bytes_per_pixel,
+        file,
+        limits.max_side,
+        limits.max_bytes,
+    )
+    .map_err(|oversize| error(oversize_message(oversize, w, h, limits)))?;
+    Ok(ImageFile {
+        path: path.to_path_buf(),
+        bytes,
+        width,
+        height,
+        bytes_charged: charged,
+        format,
+        limits: decoder_limits(limits.max_side, limits.max_bytes),
+    })
+}
+
+impl ImageFile {
+    /// The format's usual extension ("png", "exr", "hdr"), or "image" when unknown.
+    pub fn format_name(&self) -> &'static str {
+        self.format
+            .and_then(|format| format.extensions_str().first().copied())
+            .unwrap_or("image")
+    }
+
+    /// Whether the file is a PNG.
+    pub fn is_png(&self) -> bool {
+        self.format == Some(image::ImageFormat::Png)
+    }
+
+    /// The file's bytes (to read a PNG's chunks).
+    pub fn bytes(&self) -> &[u8] {
+        &self.bytes
+    }
+
+    /// Decodes the image under the limits its header was checked against.
+    pub fn decode(self) -> Result<RgbImage, ImageReadError> {
+        let error = |message: String| ImageReadError {
+            path: self.path.clone(),
+            message,
+        };
+        let mut reader = image_reader(&self.bytes).map_err(|e| error(e.to_string()))?;
+        reader.limits(self.limits);
+        let decoded = reader.decode().map_err(|e| error(e.to_string()))?;
+        let (width, height) = (decoded.width(), decoded.height());
+        let pixels = if matches!(
+            decoded,
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+        ) {
+            RgbPixels::Float(decoded.into_rgb32f().into_raw())
+        } else {
+            RgbPixels::Levels(decoded.into_rgb8().into_raw())
+        };
+        Ok(RgbImage {
+            width,
+            height,
+            pixels,
+        })
+    }
 }
 
 /// An EXR read back: the film (with its window, feature layers and sample sums, as
@@ -471,74 +704,250 @@ pub struct ExrFile {
     pub metadata: Vec<(String, String)>,
 }
 
-/// Reads an EXR that `write_image_with_metadata` wrote (a farm part, a crop, a whole image):
-/// the first layer's channels R, G, B, and when present the feature layers (`ALBEDO_LAYER`,
-/// `NORMAL_LAYER`, `DEPTH_CHANNEL`), `sum.R/G/B` and `count`. The display window must start at (0, 0).
-pub fn read_exr(path: &Path) -> Result<ExrFile, ImageReadError> {
+/// What an EXR's header says, checked against the limits: enough to plan with (a merge's
+/// coverage, a checkpoint's rows) before a pixel is decoded.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ExrHeader {
+    /// The display window's size: the whole image.
+    pub full_size: (u32, u32),
+    /// The data window: its corner in the whole image, and its size.
+    pub origin: (u32, u32),
+    pub width: u32,
+    pub height: u32,
+    /// The channels' names.
+    pub channels: Vec<String>,
+    /// String attributes, sorted by key.
+    pub metadata: Vec<(String, String)>,
+    /// The memory reading the pixels takes (`read_exr_with`), the file included.
+    pub bytes: u64,
+}
+
+impl ExrHeader {
+    /// Whether the file has the channel `name`.
+    pub fn has_channel(&self, name: &str) -> bool {
+        self.channels.iter().any(|channel| channel == name)
+    }
+}
+
+/// Reads and checks the header of the EXR at `path`, not its pixels: the display window
+/// starts at (0, 0), the data window lies inside it, neither is wider or taller than
+/// `limits.max_side`, no channel is subsampled, and reading the pixels would take at most
+/// `limits.max_bytes`. The file must be a regular file (a part, a checkpoint).
+pub fn read_exr_header(path: &Path, limits: &ImageLimits) -> Result<ExrHeader, ImageReadError> {
     let error = |message: String| ImageReadError {
         path: path.to_path_buf(),
         message,
     };
-    let image =
-        exr::prelude::read_first_flat_layer_from_file(path).map_err(|e| error(e.to_string()))?;
-    let display = image.attributes.display_window;
+    let metadata = std::fs::metadata(path).map_err(|e| error(e.to_string()))?;
+    if !metadata.is_file() {
+        return Err(error("it is not a regular file".into()));
+    }
+    let file = File::open(path).map_err(|e| error(e.to_string()))?;
+    let meta =
+        exr::meta::MetaData::read_from_unbuffered(file, false).map_err(|e| error(e.to_string()))?;
+    exr_header(&meta, metadata.len(), limits).map_err(error)
+}
+
+/// `read_exr_header`'s checks on a parsed header, the file being `file_bytes` long.
+fn exr_header(
+    meta: &exr::meta::MetaData,
+    file_bytes: u64,
+    limits: &ImageLimits,
+) -> Result<ExrHeader, String> {
+    let header = meta.headers.first().ok_or("it has no header")?;
+    if header.deep {
+        return Err("it holds deep data".into());
+    }
+    let display = header.shared_attributes.display_window;
     if display.position.0 != 0 || display.position.1 != 0 {
-        return Err(error(format!(
+        return Err(format!(
             "the display window starts at ({}, {}), not (0, 0)",
             display.position.0, display.position.1
-        )));
+        ));
     }
-    let layer = &image.layer_data;
+    let (full_w, full_h) = (display.size.0 as u64, display.size.1 as u64);
+    if full_w > u64::from(limits.max_side) || full_h > u64::from(limits.max_side) {
+        return Err(format!(
+            "its display window is {full_w} x {full_h} pixels, larger than the limit of {} \
+             pixels a side",
+            limits.max_side
+        ));
+    }
     let (x, y) = (
-        layer.attributes.layer_position.0,
-        layer.attributes.layer_position.1,
+        header.own_attributes.layer_position.0,
+        header.own_attributes.layer_position.1,
     );
-    let (width, height) = (layer.size.0, layer.size.1);
-    let origin = (
-        u32::try_from(x).map_err(|_| error(format!("the data window starts at x = {x}")))?,
-        u32::try_from(y).map_err(|_| error(format!("the data window starts at y = {y}")))?,
-    );
-    let size = |n: usize| u32::try_from(n).map_err(|_| error(format!("{n} pixels is too large")));
-    let mut film = Film {
-        origin,
-        full_size: (size(display.size.0)?, size(display.size.1)?),
-        ..Film::new(size(width)?, size(height)?)
-    };
-    let channel = |name: &str| {
-        layer
-            .channel_data
+    let (width, height) = (header.layer_size.0 as u64, header.layer_size.1 as u64);
+    let inside = x >= 0
+        && y >= 0
+        && width > 0
+        && height > 0
+        && x as u64 + width <= full_w
+        && y as u64 + height <= full_h;
+    if !inside {
+        return Err(format!(
+            "its data window (x {x}..{}, y {y}..{}) does not lie inside its {full_w} x {full_h} \
+             display window",
+            i64::from(x) + width as i64,
+            i64::from(y) + height as i64
+        ));
+    }
+    let mut per_pixel = 0;
+    for channel in &header.channels.list {
+        if channel.sampling.0 != 1 || channel.sampling.1 != 1 {
+            return Err(format!("channel {} is subsampled", channel.name));
+        }
+        // As stored, and as the film holds it (four bytes a value).
+        per_pixel += channel.sample_type.bytes_per_sample() as u64 + 4;
+    }
+    let bytes = check_size(
+        width,
+        height,
+        per_pixel,
+        file_bytes,
+        limits.max_side,
+        limits.max_bytes,
+    )
+    .map_err(|oversize| match oversize {
+        Oversize::Side => format!(
+            "its data window is {width} x {height} pixels, larger than the limit of {} pixels \
+             a side",
+            limits.max_side
+        ),
+        Oversize::Memory { bytes } => format!(
+            "its data window is {width} x {height} pixels and reading it would take {}, more \
+             than the limit of {} (--max-memory raises it)",
+            format_bytes(bytes),
+            format_bytes(limits.max_bytes)
+        ),
+    })?;
+    let mut metadata: Vec<(String, String)> = header
+        .shared_attributes
+        .other
+        .iter()
+        .chain(&header.own_attributes.other)
+        .filter_map(|(key, value)| match value {
+            exr::prelude::AttributeValue::Text(text) => Some((key.to_string(), text.to_string())),
+            _ => None,
+        })
+        .collect();
+    metadata.sort();
+    // Every value was checked against `max_side` (at most 65535 by default, and u32 always).
+    let side = |n: u64| u32::try_from(n).map_err(|_| format!("{n} pixels is too large"));
+    Ok(ExrHeader {
+        full_size: (side(full_w)?, side(full_h)?),
+        origin: (side(x as u64)?, side(y as u64)?),
+        width: side(width)?,
+        height: side(height)?,
+        channels: header
+            .channels
             .list
             .iter()
-            .find(|channel| channel.name.eq(name))
-            .map(|channel| &channel.sample_data)
+            .map(|channel| channel.name.to_string())
+            .collect(),
+        metadata,
+        bytes,
+    })
+}
+
+/// `read_exr_with` under `ImageLimits::default()`.
+pub fn read_exr(path: &Path) -> Result<ExrFile, ImageReadError> {
+    read_exr_with(path, &ImageLimits::default())
+}
+
+/// Reads an EXR that `write_image_with_metadata` wrote (a farm part, a crop, a whole image):
+/// the first layer's channels R, G, B, and when present the feature layers (`ALBEDO_LAYER`,
+/// `NORMAL_LAYER`, `DEPTH_CHANNEL`), `sum.R/G/B` and `count`. The header is checked as
+/// `read_exr_header` checks it before any pixel is decoded, and every value read must be
+/// finite: Glint never writes a NaN or an infinity, so one is a damaged or foreign file,
+/// refused with the first such pixel.
+pub fn read_exr_with(path: &Path, limits: &ImageLimits) -> Result<ExrFile, ImageReadError> {
+    let error = |message: String| ImageReadError {
+        path: path.to_path_buf(),
+        message,
     };
-    let floats = |name: &str| -> Result<Option<Vec<f32>>, ImageReadError> {
-        match channel(name) {
+    let metadata = std::fs::metadata(path).map_err(|e| error(e.to_string()))?;
+    if !metadata.is_file() {
+        return Err(error("it is not a regular file".into()));
+    }
+    let bytes = read_bounded(path, limits)?;
+    let meta = exr::meta::MetaData::read_from_buffered(bytes.as_slice(), false)
+        .map_err(|e| error(e.to_string()))?;
+    let header = exr_header(&meta, bytes.len() as u64, limits).map_err(error)?;
+    use exr::prelude::traits::*;
+    let image = exr::prelude::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .from_buffered(std::io::Cursor::new(bytes.as_slice()))
+        .map_err(|e| error(e.to_string()))?;
+    drop(bytes);
+    let layer = image.layer_data;
+    let size = (layer.size.0 as u64, layer.size.1 as u64);
+    if size != (u64::from(header.width), u64::from(header.height)) {
+        return Err(error("its layer is not the size its header says".into()));
+    }
+    let pixel_count = header.width as usize * header.height as usize;
+    let mut channels: Vec<(String, exr::prelude::FlatSamples)> = layer
+        .channel_data
+        .list
+        .into_iter()
+        .map(|channel| (channel.name.to_string(), channel.sample_data))
+        .collect();
+    let mut take = |name: &str| {
+        channels
+            .iter()
+            .position(|(channel, _)| channel == name)
+            .map(|index| channels.swap_remove(index).1)
+    };
+    let mut floats = |name: &str| -> Result<Option<Vec<f32>>, ImageReadError> {
+        match take(name) {
             None => Ok(None),
-            Some(exr::prelude::FlatSamples::F32(values)) => Ok(Some(values.clone())),
+            Some(exr::prelude::FlatSamples::F32(values)) if values.len() == pixel_count => {
+                Ok(Some(values))
+            }
+            Some(exr::prelude::FlatSamples::F32(_)) => Err(error(format!(
+                "channel {name} has the wrong number of values"
+            ))),
             Some(_) => Err(error(format!("channel {name} is not 32-bit float"))),
         }
     };
-    let colors = |prefix: &str, suffixes: [&str; 3]| -> Result<Option<Vec<Vec3>>, ImageReadError> {
-        let [r, g, b] = suffixes.map(|c| floats(&format!("{prefix}{c}")));
-        match (r?, g?, b?) {
-            (Some(r), Some(g), Some(b)) => Ok(Some(
-                r.iter()
-                    .zip(&g)
-                    .zip(&b)
-                    .map(|((&r, &g), &b)| Vec3::new(r, g, b))
-                    .collect(),
-            )),
-            (None, None, None) => Ok(None),
-            _ => Err(error(format!("the channels {prefix}* are incomplete"))),
-        }
-    };
-    film.pixels = colors("", ["R", "G", "B"])?
+    let mut colors =
+        |prefix: &str, suffixes: [&str; 3]| -> Result<Option<Vec<Vec3>>, ImageReadError> {
+            let [r, g, b] = suffixes.map(|c| floats(&format!("{prefix}{c}")));
+            match (r?, g?, b?) {
+                (Some(r), Some(g), Some(b)) => Ok(Some(
+                    r.iter()
+                        .zip(&g)
+                        .zip(&b)
+                        .map(|((&r, &g), &b)| Vec3::new(r, g, b))
+                        .collect(),
+                )),
+                (None, None, None) => Ok(None),
+                _ => Err(error(format!("the channels {prefix}* are incomplete"))),
+            }
+        };
+    let pixels = colors("", ["R", "G", "B"])?
         .ok_or_else(|| error("there are no R, G, B channels".into()))?;
     let albedo = colors(ALBEDO_LAYER, ["R", "G", "B"])?;
     let normal = colors(NORMAL_LAYER, ["X", "Y", "Z"])?;
+    let sums = colors("sum.", ["R", "G", "B"])?;
     let depth = floats(DEPTH_CHANNEL)?;
-    film.features = match (albedo, normal, depth) {
+    let mut unsigned = |name: &str| match take(name) {
+        None => Ok(None),
+        Some(exr::prelude::FlatSamples::U32(values)) if values.len() == pixel_count => {
+            Ok(Some(values))
+        }
+        Some(exr::prelude::FlatSamples::U32(_)) => Err(error(format!(
+            "channel {name} has the wrong number of values"
+        ))),
+        Some(_) => Err(error(format!("channel {name} is not 32-bit unsigned"))),
+    };
+    let counts = unsigned("count")?;
+    let samples = unsigned(SAMPLES_CHANNEL)?;
+    let features = match (albedo, normal, depth) {
         (Some(albedo), Some(normal), Some(depth)) => Some(glint_render::Features {
             albedo,
             normal,
@@ -547,14 +956,7 @@ pub fn read_exr(path: &Path) -> Result<ExrFile, ImageReadError> {
         (None, None, None) => None,
         _ => return Err(error("the feature layers are incomplete".into())),
     };
-    let unsigned = |name: &str| match channel(name) {
-        None => Ok(None),
-        Some(exr::prelude::FlatSamples::U32(values)) => Ok(Some(values.clone())),
-        Some(_) => Err(error(format!("channel {name} is not 32-bit unsigned"))),
-    };
-    let counts = unsigned("count")?;
-    film.samples = unsigned(SAMPLES_CHANNEL)?;
-    film.sums = match (colors("sum.", ["R", "G", "B"])?, counts) {
+    let sums = match (sums, counts) {
         (Some(radiance), Some(counts)) => Some(glint_render::SampleSums { radiance, counts }),
         (None, None) => None,
         _ => {
@@ -563,18 +965,45 @@ pub fn read_exr(path: &Path) -> Result<ExrFile, ImageReadError> {
             ))
         }
     };
-    let mut metadata: Vec<(String, String)> = image
-        .attributes
-        .other
-        .iter()
-        .chain(&layer.attributes.other)
-        .filter_map(|(key, value)| match value {
-            exr::prelude::AttributeValue::Text(text) => Some((key.to_string(), text.to_string())),
-            _ => None,
-        })
-        .collect();
-    metadata.sort();
-    Ok(ExrFile { film, metadata })
+    let film = Film {
+        pixels,
+        origin: header.origin,
+        full_size: header.full_size,
+        features,
+        sums,
+        samples,
+        ..Film::new(header.width, header.height)
+    };
+    if let Some((layer, index)) = first_nonfinite(&film) {
+        let (column, row) = (index as u32 % film.width, index as u32 / film.width);
+        return Err(error(format!(
+            "pixel ({}, {}) of the image is not finite in its {layer}: Glint never writes NaN \
+             or infinity, so the file is damaged or not Glint's",
+            film.origin.0 + column,
+            film.origin.1 + row
+        )));
+    }
+    Ok(ExrFile {
+        film,
+        metadata: header.metadata,
+    })
+}
+
+/// The first value of `film` that is not finite: the layer it is in and the pixel's index.
+fn first_nonfinite(film: &Film) -> Option<(&'static str, usize)> {
+    let colors = |values: &[Vec3]| values.iter().position(|value| !value.is_finite());
+    let first = |layer: &'static str, index: Option<usize>| index.map(|index| (layer, index));
+    let mut found = vec![first("beauty (R, G, B)", colors(&film.pixels))];
+    if let Some(features) = &film.features {
+        found.push(first("albedo layer", colors(&features.albedo)));
+        found.push(first("normal layer", colors(&features.normal)));
+        let depth = features.depth.iter().position(|depth| !depth.is_finite());
+        found.push(first("depth layer", depth));
+    }
+    if let Some(sums) = &film.sums {
+        found.push(first("sample sums (sum.R/G/B)", colors(&sums.radiance)));
+    }
+    found.into_iter().flatten().min_by_key(|(_, index)| *index)
 }
 
 /// Temporary files are created private (0600); the output should get the permissions of the file
@@ -694,6 +1123,124 @@ mod tests {
         };
         let refused = write_image_with_layers(&path, &film, &options, &[], &[short]);
         assert!(matches!(refused, Err(ImageWriteError::InvalidFilm { .. })));
+    }
+
+    #[test]
+    fn exr_headers_are_checked_against_the_limits_before_decoding() {
+        let film = Film {
+            pixels: vec![Color::new(0.5, 1.0, 2.0); 12],
+            origin: (2, 1),
+            full_size: (10, 5),
+            ..Film::new(4, 3)
+        };
+        let directory = tempfile::tempdir().unwrap();
+        let path = directory.path().join("part.exr");
+        let metadata = [("glint.seed".to_string(), "7".to_string())];
+        write_image_with_metadata(&path, &film, &WriteOptions::default(), &metadata).unwrap();
+        let header = read_exr_header(&path, &ImageLimits::default()).unwrap();
+        assert_eq!(
+            (header.full_size, header.origin, header.width, header.height),
+            ((10, 5), (2, 1), 4, 3)
+        );
+        assert!(header.has_channel("G") && !header.has_channel("count"));
+        assert_eq!(header.metadata, metadata);
+        let file_bytes = std::fs::metadata(&path).unwrap().len();
+        // Three f32 channels: 4 bytes stored and 4 held a value.
+        assert_eq!(header.bytes, file_bytes + 12 * 24);
+        assert_eq!(
+            read_exr_with(&path, &ImageLimits::default()).unwrap().film,
+            film
+        );
+
+        let refused = |limits: ImageLimits| {
+            let header = read_exr_header(&path, &limits).unwrap_err().to_string();
+            let file = read_exr_with(&path, &limits).unwrap_err().to_string();
+            assert!(header.contains("part.exr"), "{header}");
+            (header, file)
+        };
+        let (header, file) = refused(ImageLimits {
+            max_side: 9,
+            max_bytes: u64::MAX,
+        });
+        assert!(header.contains("display window is 10 x 5 pixels, larger than the limit of 9"));
+        assert_eq!(header, file);
+        let (header, file) = refused(ImageLimits::with_memory(file_bytes + 12 * 24 - 1));
+        assert!(header.contains("data window is 4 x 3 pixels and reading it would take"));
+        assert_eq!(header, file);
+
+        let mut bad = film.clone();
+        bad.pixels[6].y = f32::NAN;
+        write_image_with_metadata(&path, &bad, &WriteOptions::default(), &[]).unwrap();
+        let error = read_exr(&path).unwrap_err().to_string();
+        // Local pixel 6 is (2, 1) of the data window, (4, 2) of the image.
+        assert!(
+            error.contains("pixel (4, 2) of the image is not finite in its beauty"),
+            "{error}"
+        );
+
+        let directory_error = read_exr_header(directory.path(), &ImageLimits::default());
+        assert!(directory_error
+            .unwrap_err()
+            .message
+            .contains("not a regular file"));
+    }
+
+    #[test]
+    fn image_headers_are_checked_before_decoding() {
+        let directory = tempfile::tempdir().unwrap();
+        let path = directory.path().join("image.png");
+        write_image(&path, &Film::new(6, 4)).unwrap();
+        let file_bytes = std::fs::metadata(&path).unwrap().len();
+        let file = open_image(&path, &ImageLimits::default(), 10).unwrap();
+        assert_eq!(
+            (file.width, file.height, file.bytes_charged),
+            (6, 4, file_bytes + 240)
+        );
+        assert!(file.is_png() && file.format_name() == "png");
+        let decoded = file.decode().unwrap();
+        assert_eq!(decoded.pixels, RgbPixels::Levels(vec![0; 72]));
+        let error = open_image(&path, &ImageLimits::with_memory(file_bytes + 239), 10)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            error.contains("image.png: the image is 6 x 4 pixels and reading it would take"),
+            "{error}"
+        );
+        let limits = ImageLimits {
+            max_side: 5,
+            ..ImageLimits::default()
+        };
+        let error = open_image(&path, &limits, 10).unwrap_err().to_string();
+        assert!(
+            error.contains("larger than the limit of 5 pixels a side"),
+            "{error}"
+        );
+        assert_eq!(
+            check_size(
+                u64::MAX,
+                u64::MAX,
+                u64::MAX,
+                u64::MAX,
+                u32::MAX,
+                u64::MAX - 1
+            ),
+            Err(Oversize::Side)
+        );
+        assert_eq!(
+            check_size(1 << 32, 1 << 32, 1 << 32, 1, u32::MAX, u64::MAX - 1),
+            Err(Oversize::Side)
+        );
+        assert_eq!(
+            check_size(
+                u64::from(u32::MAX),
+                u64::from(u32::MAX),
+                1 << 40,
+                1,
+                u32::MAX,
+                u64::MAX - 1
+            ),
+            Err(Oversize::Memory { bytes: u64::MAX })
+        );
     }
 
     #[test]

@@ -76,10 +76,11 @@ pub use display::{
 };
 pub use gltf::ModelOptions;
 pub use image_io::{
-    encode_image, output_format, read_exr, remove_stale_partials, write_image, write_image_with,
-    write_image_with_layers, write_image_with_metadata, EncodeError, ExrFile, ExtraLayer,
-    ImageReadError, ImageWriteError, OutputFormat, WriteOptions, ALBEDO_LAYER, DEPTH_CHANNEL,
-    NOISY_LAYER, NORMAL_LAYER,
+    encode_image, open_image, output_format, read_exr, read_exr_header, read_exr_with,
+    remove_stale_partials, write_image, write_image_with, write_image_with_layers,
+    write_image_with_metadata, EncodeError, ExrFile, ExrHeader, ExtraLayer, ImageFile, ImageLimits,
+    ImageReadError, ImageWriteError, OutputFormat, RgbImage, RgbPixels, WriteOptions, ALBEDO_LAYER,
+    DEPTH_CHANNEL, MAX_IMAGE_SIDE, NOISY_LAYER, NORMAL_LAYER, SAMPLES_CHANNEL,
 };
 pub use limits::{format_bytes, Limits, BYTES_PER_TEXEL};
 pub use mesh::Mesh;

@@ -8,6 +8,7 @@ use glint_render::{Color, CubeMap, Image};
 use rayon::prelude::*;
 
 use crate::assets::{AssetError, Assets, TooLarge};
+use crate::image_io::{check_size, decoder_limits, image_reader, Oversize};
 use crate::limits::{format_bytes, Limits, BYTES_PER_TEXEL};
 
 /// The texture memory a load may still take, charged image by image before each decode.
@@ -72,13 +73,12 @@ pub(crate) struct Checked {
 }
 
 fn reader(bytes: &[u8]) -> Result<image::ImageReader<std::io::Cursor<&[u8]>>, AssetError> {
-    image::ImageReader::new(std::io::Cursor::new(bytes))
-        .with_guessed_format()
-        .map_err(|error| AssetError::Failed(error.to_string()))
+    image_reader(bytes).map_err(|error| AssetError::Failed(error.to_string()))
 }
 
 /// An image file held in memory (a glTF model's embedded image), its header checked against
-/// the limits and its memory charged to `budget`.
+/// the limits (through `check_size`, the gate every image read passes) and its memory charged
+/// to `budget`.
 pub(crate) fn check_image(
     bytes: Vec<u8>,
     budget: &mut TextureBudget,
@@ -87,28 +87,27 @@ pub(crate) fn check_image(
         .into_dimensions()
         .map_err(|error| AssetError::Failed(error.to_string()))?;
     let side = budget.limits.max_texture_side;
-    if width > side || height > side {
-        return Err(AssetError::Refused(format!(
-            "the image is {width} x {height} pixels, larger than the limit of {side} pixels a \
-             side (--max-texture-size raises it)"
-        )));
-    }
-    let cost = u64::from(width) * u64::from(height) * BYTES_PER_TEXEL;
     let remaining = budget.limits.max_texture_bytes.saturating_sub(budget.used);
-    if cost > remaining {
-        return Err(AssetError::Refused(format!(
-            "the image is {width} x {height} pixels and would take {} with the textures \
-             before it, more than the limit of {} (--max-memory raises it)",
-            format_bytes(budget.used + cost),
-            format_bytes(budget.limits.max_texture_bytes)
-        )));
-    }
-    let mut limits = image::Limits::default();
-    limits.max_image_width = Some(side);
-    limits.max_image_height = Some(side);
-    limits.max_alloc = Some(remaining);
+    let (w, h) = (u64::from(width), u64::from(height));
+    let cost = check_size(w, h, BYTES_PER_TEXEL, 0, side, remaining).map_err(|oversize| {
+        AssetError::Refused(match oversize {
+            Oversize::Side => format!(
+                "the image is {width} x {height} pixels, larger than the limit of {side} pixels \
+                 a side (--max-texture-size raises it)"
+            ),
+            Oversize::Memory { bytes } => format!(
+                "the image is {width} x {height} pixels and would take {} with the textures \
+                 before it, more than the limit of {} (--max-memory raises it)",
+                format_bytes(budget.used.saturating_add(bytes)),
+                format_bytes(budget.limits.max_texture_bytes)
+            ),
+        })
+    })?;
     budget.used += cost;
-    Ok(Checked { bytes, limits })
+    Ok(Checked {
+        bytes,
+        limits: decoder_limits(side, remaining),
+    })
 }
 
 impl Checked {
