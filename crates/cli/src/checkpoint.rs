@@ -232,7 +232,9 @@ pub fn render(
             threads: None,
             ..settings.clone()
         };
-        match pool.install(|| glint_render::render(scene, &band_settings, progress)) {
+        let stop = || interrupt.requested();
+        let render = || glint_render::render_interruptible(scene, &band_settings, progress, &stop);
+        match pool.install(render) {
             Ok((band_film, band_stats)) if !interrupt.requested() => {
                 append(&mut film, band_film);
                 stats.rays += band_stats.rays;

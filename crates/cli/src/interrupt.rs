@@ -9,7 +9,8 @@ use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 pub enum Phase {
     /// Reading and building the scene: nothing to clean up, so Ctrl-C exits at once.
     Loading = 0,
-    /// Rendering: Ctrl-C cancels at the end of the current tiles; a second one exits at once
+    /// Rendering: Ctrl-C cancels within a fraction of a second (the renderer asks inside
+    /// pixels); a second one exits at once
     /// (rendering writes nothing, so that is safe too).
     Rendering = 1,
     /// Writing the image: Ctrl-C is noted but the (atomic) write completes, so that no

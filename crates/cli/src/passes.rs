@@ -66,7 +66,8 @@ pub fn render(
     loop {
         let pass_start = Instant::now();
         let before = render.samples_taken();
-        match pool.install(|| render.pass(scene, samples, progress)) {
+        let stop = || interrupt.requested();
+        match pool.install(|| render.pass_interruptible(scene, samples, progress, &stop)) {
             Ok(_) => {}
             Err(RenderError::Cancelled) => return Err(interrupted(written)),
             Err(error) => return Err(invalid(error)),

@@ -309,8 +309,8 @@ fn resume(
 }
 
 /// Renders the scene on the pool, in checkpointed bands with `--checkpoint` or `--resume`,
-/// showing the progress and handing each tile to the preview. Ctrl-C stops it at the end of
-/// the current tiles.
+/// showing the progress and handing each tile to the preview. Ctrl-C stops it within a
+/// fraction of a second, inside the pixels being sampled.
 fn render(
     job: &Job,
     pool: &rayon::ThreadPool,
@@ -405,7 +405,11 @@ fn render(
         )
         .map(|banded| (banded.film, banded.stats, banded.render_seconds)),
         (None, None) => {
-            match pool.install(|| glint_render::render(&built.scene, settings, &progress)) {
+            // Asked inside pixels too, so that a render of costly pixels stops at once.
+            let stop = || interrupt.requested();
+            let render =
+                || glint_render::render_interruptible(&built.scene, settings, &progress, &stop);
+            match pool.install(render) {
                 Ok((film, stats)) => Ok((film, stats, render_start.elapsed().as_secs_f64())),
                 Err(RenderError::Invalid(why)) => Err(Failure::Usage(UsageError(why))),
                 Err(RenderError::Cancelled) => Err(Failure::Interrupted),

@@ -58,6 +58,7 @@ fn single_ray_frame(scene: &Scene, settings: &RenderSettings) -> (Vec<Color>, u6
                     pixel_key: pixel_index ^ settings.seed.rotate_left(32),
                     max_depth: settings.max_depth(),
                     rays: 1,
+                    ray_budget: glint_render::bench::RAY_BUDGET,
                 };
                 let c = shade_camera_ray(scene, &ray, &mut ctx);
                 rays += ctx.rays;

@@ -112,7 +112,7 @@ pub use texture::{
 // Rendering it.
 pub use film::{Features, Film, SampleSums};
 pub use pipeline::{
-    measure_traversal, render, AdaptiveSampling, IntegratorKind, PixelBounds, Progress,
-    ProgressiveRender, RenderError, RenderSettings, RenderStats, RequestedSettings, TraversalStats,
-    TILE_SIZE,
+    measure_traversal, render, render_interruptible, AdaptiveSampling, IntegratorKind, PixelBounds,
+    Progress, ProgressiveRender, RenderError, RenderSettings, RenderStats, RequestedSettings,
+    TraversalStats, TILE_SIZE,
 };

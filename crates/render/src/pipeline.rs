@@ -14,6 +14,7 @@ use std::ops::Range;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 use rayon::prelude::*;
+use web_time::{Duration, Instant};
 
 use crate::accel::PACKET;
 use crate::film::{Features, Film, SampleSums};
@@ -483,10 +484,28 @@ pub const TILE_SIZE: u32 = 16;
 
 /// Renders `scene` as `settings` say. `progress` is called from the worker threads after each
 /// tile; returning `false` cancels the render. The film covers `settings.bounds()`.
+///
+/// The progress callback hears only between tiles, so a tile of costly pixels (a huge sample
+/// count, a scene that is slow to trace) cannot be cancelled through it before it ends;
+/// [`render_interruptible`] can.
 pub fn render(
     scene: &Scene,
     settings: &RenderSettings,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
+) -> Result<(Film, RenderStats), RenderError> {
+    render_interruptible(scene, settings, progress, &|| false)
+}
+
+/// `render`, cancelled also when `stop` returns `true`: `stop` is asked inside pixels, every
+/// few samples (about every `CHECK_EVERY` of a worker's time, however costly a sample is),
+/// so that a front end's signal (Ctrl-C, a closed page) stops the render within a fraction
+/// of a second. A cancelled render returns `RenderError::Cancelled` and no pixel: a pixel is
+/// never handed over partly sampled. `stop` must be cheap (an atomic load).
+pub fn render_interruptible(
+    scene: &Scene,
+    settings: &RenderSettings,
+    progress: &(dyn Fn(&Progress) -> bool + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<(Film, RenderStats), RenderError> {
     settings.validate().map_err(RenderError::Invalid)?;
     if let Some(adaptive) = settings.adaptive {
@@ -494,7 +513,12 @@ pub fn render(
         let mut passes = ProgressiveRender::new(settings)?;
         while !passes.is_finished() {
             let taken = passes.samples_taken();
-            passes.pass(scene, adaptive.check_after(taken) - taken, progress)?;
+            passes.pass_interruptible(
+                scene,
+                adaptive.check_after(taken) - taken,
+                progress,
+                stop,
+            )?;
         }
         return Ok((passes.film(), passes.stats()));
     }
@@ -507,9 +531,9 @@ pub fn render(
                 .map_err(|error| {
                     RenderError::Invalid(format!("cannot start {threads} threads: {error}"))
                 })?;
-            pool.install(|| render_on_current_pool(scene, settings, progress))
+            pool.install(|| render_on_current_pool(scene, settings, progress, stop))
         }
-        None => render_on_current_pool(scene, settings, progress),
+        None => render_on_current_pool(scene, settings, progress, stop),
     }
 }
 
@@ -518,40 +542,31 @@ fn render_on_current_pool(
     scene: &Scene,
     settings: &RenderSettings,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<(Film, RenderStats), RenderError> {
+    let depth = settings.max_depth();
     match settings.integrator {
         IntegratorKind::Course => {
-            render_with(scene, settings, &CourseIntegrator::new(scene), progress)
+            let integrator = CourseIntegrator::new(scene);
+            render_with(scene, settings, &integrator, progress, stop)
         }
-        IntegratorKind::Path => render_with(
-            scene,
-            settings,
-            &PathIntegrator::new(scene, PathSettings::for_scene(scene, settings.max_depth())),
-            progress,
-        ),
+        IntegratorKind::Path => {
+            let integrator = PathIntegrator::new(scene, PathSettings::for_scene(scene, depth));
+            render_with(scene, settings, &integrator, progress, stop)
+        }
         IntegratorKind::VolPath => {
-            let integrator =
-                VolPathIntegrator::new(scene, PathSettings::for_scene(scene, settings.max_depth()));
-            render_with(scene, settings, &integrator, progress)
+            let integrator = VolPathIntegrator::new(scene, PathSettings::for_scene(scene, depth));
+            render_with(scene, settings, &integrator, progress, stop)
         }
-        IntegratorKind::Normals => render_with(
-            scene,
-            settings,
-            &DebugIntegrator::new(scene, DebugView::Normals),
-            progress,
-        ),
-        IntegratorKind::Albedo => render_with(
-            scene,
-            settings,
-            &DebugIntegrator::new(scene, DebugView::Albedo),
-            progress,
-        ),
-        IntegratorKind::Depth => render_with(
-            scene,
-            settings,
-            &DebugIntegrator::new(scene, DebugView::Depth),
-            progress,
-        ),
+        IntegratorKind::Normals | IntegratorKind::Albedo | IntegratorKind::Depth => {
+            let view = match settings.integrator {
+                IntegratorKind::Normals => DebugView::Normals,
+                IntegratorKind::Albedo => DebugView::Albedo,
+                _ => DebugView::Depth,
+            };
+            let integrator = DebugIntegrator::new(scene, view);
+            render_with(scene, settings, &integrator, progress, stop)
+        }
     }
 }
 
@@ -685,9 +700,93 @@ impl PixelSums {
     }
 }
 
+/// What stops a render: a progress callback that returned `false` (`cancelled`, shared by
+/// the tiles) or the front end's `stop`.
+#[derive(Clone, Copy)]
+struct Stop<'a> {
+    cancelled: &'a AtomicBool,
+    external: &'a (dyn Fn() -> bool + Sync),
+}
+
+impl Stop<'_> {
+    /// Whether the render is to stop, noted for the other tiles.
+    fn requested(&self) -> bool {
+        if self.cancelled.load(Ordering::Relaxed) {
+            return true;
+        }
+        let stop = (self.external)();
+        if stop {
+            self.cancelled.store(true, Ordering::Relaxed);
+        }
+        stop
+    }
+}
+
+/// How long a worker samples between two looks at the stop signal: short enough that a
+/// render stops within a fraction of a second of being told, long enough that the clock read
+/// and the signal's load cost nothing beside the samples.
+const CHECK_EVERY: Duration = Duration::from_millis(20);
+
+/// Samples per pixel of a run taken between two looks at the stop signal, kept by a tile
+/// from run to run: one at first, then doubled while a chunk takes less than `CHECK_EVERY`
+/// and halved while it takes more than four times that. A sample's cost ranges over orders
+/// of magnitude (a debug view's one ray; thousands of rays in a million overlapping
+/// triangles), so the chunk is sized by the clock rather than by a count. The samples and
+/// their order do not depend on the chunks (each is keyed by its index), so neither does
+/// the image; a tile's later runs take all their samples in one chunk at ordinary sample
+/// counts, as before.
+#[derive(Clone, Copy, Debug)]
+struct Pace {
+    chunk: u32,
+}
+
+impl Pace {
+    fn new() -> Pace {
+        Pace { chunk: 1 }
+    }
+
+    /// Sizes the next chunk from the last one's time.
+    fn update(&mut self, took: Duration) {
+        if took < CHECK_EVERY {
+            self.chunk = self.chunk.saturating_mul(2);
+        } else if took > 4 * CHECK_EVERY {
+            self.chunk = (self.chunk / 2).max(1);
+        }
+    }
+}
+
+/// `Integrator::run_samples` over `samples` in chunks (`Pace`), looking at `stop` before
+/// each chunk after the first; `false` if it stopped before `samples.end`.
+#[allow(clippy::too_many_arguments)] // The pieces of `sample_run`; a struct would only rename them.
+#[inline]
+fn run_paced<I: Integrator>(
+    integrator: &I,
+    scene: &Scene,
+    pixels: &[PixelContext],
+    samples: Range<u32>,
+    rays: &mut u64,
+    stop: &Stop,
+    pace: &mut Pace,
+    sink: &mut impl FnMut(usize, Sample),
+) -> bool {
+    let mut start = samples.start;
+    while start < samples.end {
+        if start > samples.start && stop.requested() {
+            return false;
+        }
+        let end = start.saturating_add(pace.chunk).min(samples.end);
+        let begun = Instant::now();
+        integrator.run_samples(scene, pixels, start..end, rays, sink);
+        pace.update(begun.elapsed());
+        start = end;
+    }
+    true
+}
+
 /// Takes the samples of a run of `pixels` from where each stands (`PixelSums::next`) up to
 /// `end`, in one call. With `adaptive`, pixels that have converged take none, and the others
-/// also add up their samples' squares.
+/// also add up their samples' squares. `false` if `stop` stopped it, the sums then partial.
+#[allow(clippy::too_many_arguments)] // One caller per render kind; a struct would only rename them.
 #[inline]
 fn sample_run<I: Integrator>(
     integrator: &I,
@@ -696,23 +795,39 @@ fn sample_run<I: Integrator>(
     sums: &mut [PixelSums],
     end: u32,
     adaptive: bool,
-    rays: &mut u64,
-) {
+    counters: &mut TileState,
+    stop: &Stop,
+) -> bool {
+    let TileState { counters, pace } = counters;
+    let rays = &mut counters.rays;
+    if stop.requested() {
+        return false;
+    }
     if !adaptive {
         // The pixels of a run start together, at the range's start.
         let start = sums.first().map_or(end, |s| s.next);
         if start < end {
-            integrator.run_samples(scene, pixels, start..end, rays, &mut |i, sample| {
-                sums[i].add(sample)
-            });
+            let sink = &mut |i: usize, sample| sums[i].add(sample);
+            if !run_paced(
+                integrator,
+                scene,
+                pixels,
+                start..end,
+                rays,
+                stop,
+                pace,
+                sink,
+            ) {
+                return false;
+            }
             for pixel in sums.iter_mut() {
                 pixel.next = end;
             }
         }
-        return;
+        return true;
     }
     let Some(&first) = pixels.first() else {
-        return;
+        return true;
     };
     let mut active = [0usize; RUN];
     let mut contexts = [first; RUN];
@@ -721,7 +836,7 @@ fn sample_run<I: Integrator>(
         // behind them has converged.
         let waiting = |p: &PixelSums| !p.converged && p.next < end;
         let Some(start) = sums.iter().filter(|p| waiting(p)).map(|p| p.next).min() else {
-            return;
+            return true;
         };
         let mut count = 0;
         for (i, pixel) in sums.iter().enumerate() {
@@ -731,22 +846,37 @@ fn sample_run<I: Integrator>(
                 count += 1;
             }
         }
-        integrator.run_samples(
+        let sink = &mut |j: usize, sample: Sample| {
+            let pixel = &mut sums[active[j]];
+            let radiance = sample.radiance;
+            pixel.add(sample);
+            pixel.add_squares(radiance);
+        };
+        let contexts = &contexts[..count];
+        if !run_paced(
+            integrator,
             scene,
-            &contexts[..count],
+            contexts,
             start..end,
             rays,
-            &mut |j, sample| {
-                let pixel = &mut sums[active[j]];
-                let radiance = sample.radiance;
-                pixel.add(sample);
-                pixel.add_squares(radiance);
-            },
-        );
+            stop,
+            pace,
+            sink,
+        ) {
+            return false;
+        }
         for &i in &active[..count] {
             sums[i].next = end;
         }
     }
+}
+
+/// What a tile keeps while its pixels render: its counters, and how many samples it takes
+/// between looks at the stop signal.
+#[derive(Clone, Copy, Debug)]
+struct TileState {
+    counters: TileCounters,
+    pace: Pace,
 }
 
 /// Pixels of a row the tile loop hands over at once (`Integrator::run_samples`), so that an
@@ -759,22 +889,37 @@ fn render_with<I: Integrator>(
     settings: &RenderSettings,
     integrator: &I,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
 ) -> Result<(Film, RenderStats), RenderError> {
     // The tiles keep what the film takes: the beauty alone (12 bytes a pixel) unless the
     // features, a sample range's sums or adaptive sampling's counts are asked for (all of
     // `PixelValue`, 60 bytes): the tiles of a 1024x1024 frame were 56 MB of fresh pages to
     // fault in and gather from.
     if !settings.features && settings.sample_range.is_none() && settings.adaptive.is_none() {
-        let (values, stats) =
-            render_values(scene, settings, integrator, progress, |v| v.beauty, |c| *c)?;
+        let (values, stats) = render_values(
+            scene,
+            settings,
+            integrator,
+            progress,
+            stop,
+            |v| v.beauty,
+            |c| *c,
+        )?;
         let film = Film {
             pixels: values.gather(|c| *c),
             ..empty_film(settings)
         };
         return Ok((film, stats));
     }
-    let (values, stats) =
-        render_values(scene, settings, integrator, progress, |v| v, |v| v.beauty)?;
+    let (values, stats) = render_values(
+        scene,
+        settings,
+        integrator,
+        progress,
+        stop,
+        |v| v,
+        |v| v.beauty,
+    )?;
     let samples = settings.adaptive.is_some();
     Ok((film_of(&values, settings, samples, |v| *v), stats))
 }
@@ -828,6 +973,7 @@ fn render_values<I: Integrator, P: Copy + Default + Send>(
     settings: &RenderSettings,
     integrator: &I,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
     keep: impl Fn(PixelValue) -> P + Sync,
     beauty: impl Fn(&P) -> Color + Sync,
 ) -> Result<(TilePixels<P>, RenderStats), RenderError> {
@@ -837,28 +983,34 @@ fn render_values<I: Integrator, P: Copy + Default + Send>(
         settings.bounds(),
         settings.width,
         progress,
+        stop,
         beauty,
-        |_tile, xs, y, counters, out| {
+        |_tile, xs, y, state, out, stop| {
             let mut pixels = [context(xs.start, y); RUN];
             let count = xs.len();
             for (pixel, x) in pixels.iter_mut().zip(xs) {
                 pixel.x = x;
             }
             let mut sums = [PixelSums::starting_at(samples.start); RUN];
-            sample_run(
+            let (pixels, sums) = (&pixels[..count], &mut sums[..count]);
+            if !sample_run(
                 integrator,
                 scene,
-                &pixels[..count],
-                &mut sums[..count],
+                pixels,
+                sums,
                 samples.end,
                 false,
-                &mut counters.rays,
-            );
-            for (pixel, sums) in pixels[..count].iter().zip(sums) {
+                state,
+                stop,
+            ) {
+                return false;
+            }
+            for (pixel, sums) in pixels.iter().zip(sums.iter()) {
                 let (value, dropped) = sums.finish(settings.features);
-                counters.dropped_samples(pixel.index(), dropped);
+                state.counters.dropped_samples(pixel.index(), dropped);
                 out.push(keep(value));
             }
+            true
         },
     )
 }
@@ -985,6 +1137,19 @@ impl ProgressiveRender {
         samples: u32,
         progress: &(dyn Fn(&Progress) -> bool + Sync),
     ) -> Result<RenderStats, RenderError> {
+        self.pass_interruptible(scene, samples, progress, &|| false)
+    }
+
+    /// `pass`, cancelled also when `stop` returns `true`, which is asked inside pixels every
+    /// few samples as `render_interruptible` asks it. Cancelled, it leaves the render as it
+    /// was: the pass's partly sampled pixels are dropped.
+    pub fn pass_interruptible(
+        &mut self,
+        scene: &Scene,
+        samples: u32,
+        progress: &(dyn Fn(&Progress) -> bool + Sync),
+        stop: &(dyn Fn() -> bool + Sync),
+    ) -> Result<RenderStats, RenderError> {
         let end = self
             .taken
             .saturating_add(samples.max(1))
@@ -996,12 +1161,14 @@ impl ProgressiveRender {
                 &PathIntegrator::new(scene, PathSettings::for_scene(scene, depth)),
                 end,
                 progress,
+                stop,
             ),
             IntegratorKind::VolPath => self.run_pass(
                 scene,
                 &VolPathIntegrator::new(scene, PathSettings::for_scene(scene, depth)),
                 end,
                 progress,
+                stop,
             ),
             other => Err(RenderError::Invalid(format!(
                 "the {} integrator cannot render progressively",
@@ -1042,6 +1209,7 @@ impl ProgressiveRender {
         integrator: &I,
         end: u32,
         progress: &(dyn Fn(&Progress) -> bool + Sync),
+        stop: &(dyn Fn() -> bool + Sync),
     ) -> Result<(TilePixels<PixelSums>, RenderStats), RenderError> {
         let settings = &self.settings;
         let context = pixel_context(settings);
@@ -1050,8 +1218,9 @@ impl ProgressiveRender {
             settings.bounds(),
             settings.width,
             progress,
+            stop,
             PixelSums::mean,
-            |tile, xs, y, counters, out| {
+            |tile, xs, y, state, out, stop| {
                 let count = xs.len();
                 let mut pixels = [context(xs.start, y); RUN];
                 for (pixel, x) in pixels.iter_mut().zip(xs) {
@@ -1061,19 +1230,17 @@ impl ProgressiveRender {
                 let offset = out.len();
                 sums[..count].copy_from_slice(&before[tile][offset..offset + count]);
                 let dropped = sums.map(|p| p.dropped);
-                sample_run(
-                    integrator,
-                    scene,
-                    &pixels[..count],
-                    &mut sums[..count],
-                    end,
-                    settings.adaptive.is_some(),
-                    &mut counters.rays,
-                );
+                let adaptive = settings.adaptive.is_some();
+                let (run, run_sums) = (&pixels[..count], &mut sums[..count]);
+                if !sample_run(integrator, scene, run, run_sums, end, adaptive, state, stop) {
+                    return false;
+                }
                 for i in 0..count {
-                    counters.dropped_samples(pixels[i].index(), sums[i].dropped - dropped[i]);
+                    let newly = sums[i].dropped - dropped[i];
+                    state.counters.dropped_samples(pixels[i].index(), newly);
                 }
                 out.extend_from_slice(&sums[..count]);
+                true
             },
         )
     }
@@ -1153,24 +1320,31 @@ impl<P: Default + Sync> TilePixels<P> {
     }
 }
 
-/// The tile scheduler: `run(tile, xs, y, counters, out)` computes the pixels xs of row y (at most
-/// `RUN` of them, x and y from the top-left of the whole image `width` wide) and pushes them
-/// to `out` in order; tiles of `bounds` run on the current rayon pool, each pixel is computed
-/// by exactly one task and kept in its tile's buffer, so neither thread count nor
-/// scheduling can change the image. Returns the pixels of `bounds` by tile
-/// ([`TilePixels::gather`] lays them out row-major).
+/// The tile scheduler: `run(tile, xs, y, state, out, stop)` computes the pixels xs of row y
+/// (at most `RUN` of them, x and y from the top-left of the whole image `width` wide) and
+/// pushes them to `out` in order, or returns `false` when `stop` stopped it; tiles of `bounds`
+/// run on the current rayon pool, each pixel is computed by exactly one task and kept in its
+/// tile's buffer, so neither thread count nor scheduling can change the image. Returns the
+/// pixels of `bounds` by tile ([`TilePixels::gather`] lays them out row-major), or
+/// `RenderError::Cancelled` when a progress report returned `false` or `stop` returned
+/// `true` before the last tile was done.
 fn render_tiles<P: Copy + Default + Send>(
     bounds: PixelBounds,
     width: u32,
     progress: &(dyn Fn(&Progress) -> bool + Sync),
+    stop: &(dyn Fn() -> bool + Sync),
     beauty: impl Fn(&P) -> Color + Sync,
-    run: impl Fn(usize, Range<u32>, u32, &mut TileCounters, &mut Vec<P>) + Sync,
+    run: impl Fn(usize, Range<u32>, u32, &mut TileState, &mut Vec<P>, &Stop) -> bool + Sync,
 ) -> Result<(TilePixels<P>, RenderStats), RenderError> {
     let tiles_x = bounds.width().div_ceil(TILE_SIZE);
     let tiles_y = bounds.height().div_ceil(TILE_SIZE);
     let tile_count = (tiles_x * tiles_y) as usize;
     let done = AtomicUsize::new(0);
     let cancelled = AtomicBool::new(false);
+    let stop = Stop {
+        cancelled: &cancelled,
+        external: stop,
+    };
     let tile_bounds = |tile: usize| {
         let x0 = bounds.x0 + (tile as u32 % tiles_x) * TILE_SIZE;
         let y0 = bounds.y0 + (tile as u32 / tiles_x) * TILE_SIZE;
@@ -1191,23 +1365,26 @@ fn render_tiles<P: Copy + Default + Send>(
         .into_par_iter()
         .with_max_len(1)
         .map(|tile| {
-            let mut counters = TileCounters::default();
-            if cancelled.load(Ordering::Relaxed) {
-                return (Vec::new(), counters);
+            let mut state = TileState {
+                counters: TileCounters::default(),
+                pace: Pace::new(),
+            };
+            if stop.requested() {
+                return (Vec::new(), state.counters);
             }
             let area = tile_bounds(tile);
             let mut out = Vec::with_capacity((area.width() * area.height()) as usize);
             for y in area.y0..area.y1 {
                 for x in (area.x0..area.x1).step_by(RUN) {
-                    run(
-                        tile,
-                        x..(x + RUN as u32).min(area.x1),
-                        y,
-                        &mut counters,
-                        &mut out,
-                    );
+                    let xs = x..(x + RUN as u32).min(area.x1);
+                    if !run(tile, xs, y, &mut state, &mut out, &stop) {
+                        // Partly sampled pixels are never handed over.
+                        cancelled.store(true, Ordering::Relaxed);
+                        return (Vec::new(), state.counters);
+                    }
                 }
             }
+            let counters = state.counters;
             let finished = done.fetch_add(1, Ordering::Relaxed) + 1;
             let pixels: Vec<Color> = out.iter().map(&beauty).collect();
             let report = Progress {
@@ -1336,12 +1513,14 @@ mod tests {
                     bounds,
                     64,
                     &|_: &Progress| true,
+                    &|| false,
                     |_: &(u32, u32)| Color::ZERO,
-                    |_, xs, y, counters, out| {
+                    |_, xs, y, state, out, _| {
                         for x in xs {
-                            counters.rays += 1;
+                            state.counters.rays += 1;
                             out.push((x, y));
                         }
+                        true
                     },
                 )
             })
@@ -1383,8 +1562,9 @@ mod tests {
                 bounds,
                 bounds.width(),
                 &|_: &Progress| true,
+                &|| false,
                 |_: &()| Color::ZERO,
-                |_, xs, y, _, out| {
+                |_, xs, y, _, out, _| {
                     let first_tile = xs.start < TILE_SIZE && y < TILE_SIZE;
                     if first_tile && xs.start == 0 && y == 0 {
                         let start = std::time::Instant::now();
@@ -1401,6 +1581,7 @@ mod tests {
                         rest_done.fetch_add(xs.len(), Ordering::SeqCst);
                     }
                     out.extend(xs.map(|_| ()));
+                    true
                 },
             )
         })

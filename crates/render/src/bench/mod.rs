@@ -16,7 +16,7 @@ pub use crate::scene::SurfaceNeeds;
 
 // The integrators' per-sample pieces and their samplers, for the tests that hold packet frames
 // to single rays.
-pub use crate::integrator::course::{shade_camera_ray, SampleContext};
+pub use crate::integrator::course::{shade_camera_ray, SampleContext, RAY_BUDGET};
 pub use crate::integrator::path::{PathIntegrator, PathSettings};
 pub use crate::integrator::FirstHit;
 pub use crate::light::sampler::LightSampler;

@@ -9,6 +9,7 @@ mod chi2_sampling;
 mod composite_bsdfs;
 mod depth_of_field;
 mod gltf_bsdf;
+mod hostile_render;
 mod lecture_math;
 mod media_known_answers;
 mod mitsuba_emitters;
