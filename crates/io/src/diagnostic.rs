@@ -41,6 +41,9 @@ pub struct Diagnostic {
 pub struct SourceLine {
     text: Arc<str>,
     range: Range<usize>,
+    /// The column's byte offset in the line, where the loader knew it: an excerpt of a line
+    /// of megabytes is then cut without counting its characters up to the column.
+    caret: Option<usize>,
 }
 
 impl SourceLine {
@@ -49,6 +52,7 @@ impl SourceLine {
         SourceLine {
             text: Arc::from(line),
             range: 0..line.len(),
+            caret: None,
         }
     }
 
@@ -108,9 +112,19 @@ impl Diagnostic {
     /// `None` when the source line is unknown. A long line is cut to an excerpt around the
     /// column.
     pub fn source_excerpt(&self) -> Option<String> {
-        let source_line = self.source_line()?;
-        let (shown, caret_offset) =
-            excerpt_around(source_line, self.column.saturating_sub(1) as usize);
+        let source = self.source.as_ref()?;
+        let source_line = source.as_str();
+        let column_index = self.column.saturating_sub(1) as usize;
+        let caret = source
+            .caret
+            .filter(|&caret| source_line.is_char_boundary(caret))
+            .unwrap_or_else(|| {
+                source_line
+                    .char_indices()
+                    .nth(column_index)
+                    .map_or(source_line.len(), |(at, _)| at)
+            });
+        let (shown, caret_offset) = excerpt_around(source_line, caret);
         // Reuse the line's own tabs in front of the caret so it lines up however wide the
         // terminal draws a tab.
         let caret_indent: String = shown
@@ -126,24 +140,49 @@ impl Diagnostic {
 /// single line of 89,000 characters).
 const SHOWN_LINE_LIMIT: usize = 120;
 
-/// The part of `line` to display and the caret's character offset in it.
-fn excerpt_around(line: &str, column_index: usize) -> (String, usize) {
-    let length = line.chars().count();
-    if length <= SHOWN_LINE_LIMIT {
-        return (line.to_owned(), column_index);
+/// The part of `line` to display and the caret's character offset in it, for the caret at
+/// byte `caret`. Only the characters shown are walked, so a warning on a line of megabytes
+/// costs no more than one on a short line (thousands of them on one line were quadratic).
+fn excerpt_around(line: &str, caret: usize) -> (String, usize) {
+    let caret = caret.min(line.len());
+    // At most four bytes a character: a line this short has few enough to count.
+    if line.len() <= 4 * SHOWN_LINE_LIMIT && line.chars().count() <= SHOWN_LINE_LIMIT {
+        return (line.to_owned(), line[..caret].chars().count());
     }
-    let start = column_index
-        .saturating_sub(SHOWN_LINE_LIMIT / 2)
-        .min(length - SHOWN_LINE_LIMIT);
-    let end = start + SHOWN_LINE_LIMIT;
+    // Half the excerpt before the caret, then the rest after it; where the line ends first,
+    // the excerpt starts earlier, so that it always shows SHOWN_LINE_LIMIT characters.
+    let mut before = line[..caret]
+        .char_indices()
+        .rev()
+        .take(SHOWN_LINE_LIMIT / 2);
+    let mut start = caret;
+    let mut taken_before = 0;
+    for (at, _) in before.by_ref() {
+        start = at;
+        taken_before += 1;
+    }
+    let after: Vec<usize> = line[start..]
+        .char_indices()
+        .map(|(at, _)| start + at)
+        .take(SHOWN_LINE_LIMIT + 1)
+        .collect();
+    let mut end = after.get(SHOWN_LINE_LIMIT).copied().unwrap_or(line.len());
+    let shortfall = SHOWN_LINE_LIMIT.saturating_sub(after.len().min(SHOWN_LINE_LIMIT));
+    if shortfall > 0 {
+        for (at, _) in line[..start].char_indices().rev().take(shortfall) {
+            start = at;
+            taken_before += 1;
+        }
+        end = line.len();
+    }
     let mut shown = String::new();
-    let mut caret_offset = column_index - start;
+    let mut caret_offset = taken_before;
     if start > 0 {
         shown.push_str("...");
         caret_offset += 3;
     }
-    shown.extend(line.chars().skip(start).take(SHOWN_LINE_LIMIT));
-    if end < length {
+    shown.push_str(&line[start..end]);
+    if end < line.len() {
         shown.push_str("...");
     }
     (shown, caret_offset)
@@ -262,6 +301,32 @@ impl<'text> LineIndex<'text> {
         }
     }
 
+    /// The byte offset, in the line at `range`, of 1-based character `column`: found from the
+    /// counted blocks in O(log n + CHARS_EVERY), not by walking the line.
+    fn offset_in_line(&self, range: &Range<usize>, column: u32) -> Option<usize> {
+        let wanted = (column as usize).checked_sub(1)?;
+        if self.chars_before.is_empty() {
+            return Some(wanted.min(range.end - range.start));
+        }
+        let target = self.chars_before(range.start) + wanted;
+        // The last block start at or before the target character, then a walk within it.
+        let block = self
+            .chars_before
+            .partition_point(|&before| before <= target);
+        let mut block_start = (block.saturating_sub(1) * CHARS_EVERY).max(range.start);
+        while !self.text.is_char_boundary(block_start) {
+            block_start -= 1;
+        }
+        let mut count = self.chars_before(block_start);
+        for (at, _) in self.text[block_start..range.end].char_indices() {
+            if count == target {
+                return Some(block_start + at - range.start);
+            }
+            count += 1;
+        }
+        Some(range.end - range.start)
+    }
+
     /// The text of 1-based `line`, without its line break.
     #[cfg(test)]
     pub fn line_text(&self, line: u32) -> Option<&'text str> {
@@ -321,6 +386,7 @@ impl<'text> Diagnostics<'text> {
                 .shared_text
                 .get_or_init(|| Arc::from(self.lines.text))
                 .clone(),
+            caret: self.lines.offset_in_line(&range, span.column),
             range,
         });
         Diagnostic {
@@ -616,6 +682,33 @@ mod tests {
             diagnostic.to_string(),
             "scene.xml:3:5: warning: something\n\tab cd\n\t   ^"
         );
+    }
+
+    /// The excerpt cut at the byte offset the loader knows is the one cut by walking to the
+    /// column, on long lines of mixed-width characters, at every column.
+    #[test]
+    fn excerpts_from_the_loader_agree_with_walking() {
+        let mut random = crate::testing::xorshift(0x0bad_5eed_1234_4321);
+        let pieces = ["a", "é", "€", "𝄞", "\t", "xyz"];
+        let line: String = (0..400)
+            .map(|_| pieces[(random() % pieces.len() as u64) as usize])
+            .collect();
+        let text = format!("first\n{line}\nlast");
+        let diagnostics = Diagnostics::new(Path::new("s.xml"), &text);
+        for column in 1..=line.chars().count() as u32 + 1 {
+            let span = Span { line: 2, column };
+            let from_loader = diagnostics.diagnostic(Severity::Error, span, "m".into());
+            assert!(from_loader.source.as_ref().unwrap().caret.is_some());
+            let walked = Diagnostic {
+                source: Some(SourceLine::new(&line)),
+                ..from_loader.clone()
+            };
+            assert_eq!(
+                from_loader.source_excerpt(),
+                walked.source_excerpt(),
+                "{column}"
+            );
+        }
     }
 
     #[test]

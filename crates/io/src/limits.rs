@@ -102,6 +102,7 @@ impl MemoryBudget {
     }
 
     /// No budget (for scans whose other findings are wanted alone).
+    #[cfg(test)]
     pub fn unlimited() -> MemoryBudget {
         MemoryBudget {
             limit: u64::MAX,
