@@ -317,14 +317,14 @@ impl<'text> LineIndex<'text> {
         while !self.text.is_char_boundary(block_start) {
             block_start -= 1;
         }
-        let mut count = self.chars_before(block_start);
-        for (at, _) in self.text[block_start..range.end].char_indices() {
-            if count == target {
-                return Some(block_start + at - range.start);
-            }
-            count += 1;
-        }
-        Some(range.end - range.start)
+        let skip = target - self.chars_before(block_start);
+        Some(
+            self.text[block_start..range.end]
+                .char_indices()
+                .nth(skip)
+                .map_or(range.end, |(at, _)| block_start + at)
+                - range.start,
+        )
     }
 
     /// The text of 1-based `line`, without its line break.

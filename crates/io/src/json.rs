@@ -107,10 +107,8 @@ fn check_nesting(
                 }
                 index += 1;
             }
-            b':' | b',' => {
-                if !memory.charge(JSON_BYTES_PER_VALUE) {
-                    return Err(over_budget(memory, index));
-                }
+            b':' | b',' if !memory.charge(JSON_BYTES_PER_VALUE) => {
+                return Err(over_budget(memory, index));
             }
             b'{' | b'[' => {
                 if !memory.charge(JSON_BYTES_PER_VALUE) {
