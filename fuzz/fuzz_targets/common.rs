@@ -11,6 +11,7 @@ pub fn limits() -> Limits {
         max_triangles: 1 << 20,
         max_texture_side: 1024,
         max_texture_bytes: 64 << 20,
+        max_memory: 256 << 20,
     }
 }
 

@@ -271,6 +271,7 @@ impl LimitOptions {
             max_triangles: self.max_triangles,
             max_texture_side: self.max_texture_size,
             max_texture_bytes: max_memory,
+            max_memory,
         };
         (limits, max_memory)
     }

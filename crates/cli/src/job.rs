@@ -704,6 +704,7 @@ mod tests {
                 max_triangles: 7,
                 max_texture_side: 100,
                 max_texture_bytes: 1 << 30,
+                max_memory: 1 << 30,
             }
         );
         let defaults = job(&["-i", "s.xml"]).unwrap();

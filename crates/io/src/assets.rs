@@ -90,24 +90,20 @@ impl Assets for FileSystem {
     fn exists(&self, path: &Path) -> bool {
         path.is_file()
     }
-    /// Refuses a regular file by its size before reading it; reads anything else (a pipe, a
-    /// device such as /dev/zero) only up to one byte past the limit.
+    /// Refuses a regular file by its size before reading it, and a FIFO, socket, block device
+    /// or folder before opening it; reads a character device (/dev/zero) only up to one byte
+    /// past the limit.
     fn read_at_most(&self, path: &Path, limit: u64) -> io::Result<Vec<u8>> {
         read_file_at_most(path, limit)
     }
 }
 
 /// The file at `path`, refused with [`TooLarge`] when over `limit` bytes, without ever holding
-/// more than `limit + 1` bytes.
+/// more than `limit + 1` bytes. It is opened by [`open_input`], so a FIFO, a socket, a block
+/// device or a folder is refused before anything waits on it.
 pub fn read_file_at_most(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
-    let file = std::fs::File::open(path)?;
+    let file = open_input(path)?;
     let metadata = file.metadata()?;
-    if metadata.is_dir() {
-        return Err(io::Error::new(
-            io::ErrorKind::InvalidInput,
-            "it is a directory",
-        ));
-    }
     if metadata.is_file() && metadata.len() > limit {
         return Err(TooLarge { limit }.into());
     }
@@ -117,6 +113,92 @@ pub fn read_file_at_most(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
         0
     };
     read_sized(&file, expected, limit)
+}
+
+/// A path that names something other than a file to read: a FIFO, a socket, a block device or
+/// a folder. `NotAFile::of(&error)` finds it in an `io::Error`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NotAFile {
+    /// What the path names, for messages: "a FIFO (named pipe)", "a socket", "a directory".
+    pub what: &'static str,
+}
+
+impl NotAFile {
+    /// The refusal `error` reports, when it is a `NotAFile`.
+    pub fn of(error: &io::Error) -> Option<NotAFile> {
+        error.get_ref()?.downcast_ref::<NotAFile>().copied()
+    }
+
+    /// The refusal of what `metadata` describes, if it is not a file to read. Character
+    /// devices are read, as before, only up to the size limit and without waiting: a link to
+    /// /dev/zero is cut off at the limit, and one to a terminal ends at once.
+    fn check(metadata: &std::fs::Metadata) -> Result<(), NotAFile> {
+        let file_type = metadata.file_type();
+        if file_type.is_file() {
+            return Ok(());
+        }
+        if file_type.is_dir() {
+            return Err(NotAFile {
+                what: "a directory",
+            });
+        }
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::FileTypeExt;
+            if file_type.is_fifo() {
+                return Err(NotAFile {
+                    what: "a FIFO (named pipe)",
+                });
+            }
+            if file_type.is_socket() {
+                return Err(NotAFile { what: "a socket" });
+            }
+            if file_type.is_block_device() {
+                return Err(NotAFile {
+                    what: "a block device",
+                });
+            }
+        }
+        Ok(())
+    }
+}
+
+impl fmt::Display for NotAFile {
+    fn fmt(&self, formatter: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            formatter,
+            "it is {}, not a regular file; only files are read",
+            self.what
+        )
+    }
+}
+
+impl std::error::Error for NotAFile {}
+
+impl From<NotAFile> for io::Error {
+    fn from(not_a_file: NotAFile) -> io::Error {
+        io::Error::new(io::ErrorKind::InvalidInput, not_a_file)
+    }
+}
+
+/// Opens an input file (a scene, a mesh, a texture, an include, a buffer) for reading, the one
+/// way every load opens one. `open` on a FIFO waits for a writer, forever if none comes, so
+/// what the path names (links followed) is looked at first and refused unless it is a file
+/// (or a character device, see `NotAFile::check`); the open itself does not wait (O_NONBLOCK),
+/// and what was opened is looked at again, in case the path changed in between. Reads of a
+/// regular file ignore O_NONBLOCK; a character device with nothing to read fails at once.
+pub fn open_input(path: &Path) -> io::Result<std::fs::File> {
+    NotAFile::check(&std::fs::metadata(path)?)?;
+    let mut options = std::fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::OpenOptionsExt;
+        options.custom_flags(libc::O_NONBLOCK);
+    }
+    let file = options.open(path)?;
+    NotAFile::check(&file.metadata()?)?;
+    Ok(file)
 }
 
 /// `file` from its start, whose size was `expected` bytes when looked at (0 where it has
@@ -343,6 +425,41 @@ mod tests {
                 Some(TooLarge { limit: whole - 1 }),
                 "size {expected}"
             );
+        }
+    }
+
+    /// Issue 55: a mesh that was a FIFO blocked in `open` for ever. A FIFO, a socket and a
+    /// folder, named directly or through a link, are refused at once and say what they are.
+    #[cfg(unix)]
+    #[test]
+    fn inputs_that_are_not_files_are_refused_without_waiting() {
+        let directory = tempfile::tempdir().unwrap();
+        let fifo = directory.path().join("pipe.obj");
+        let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+        assert!(made.is_ok_and(|status| status.success()), "mkfifo failed");
+        let socket = directory.path().join("socket.obj");
+        let _listener = std::os::unix::net::UnixListener::bind(&socket).unwrap();
+        let link = directory.path().join("link.obj");
+        std::os::unix::fs::symlink(&fifo, &link).unwrap();
+        let cases = [
+            (fifo, "a FIFO (named pipe)"),
+            (link, "a FIFO (named pipe)"),
+            (socket, "a socket"),
+            (directory.path().to_path_buf(), "a directory"),
+        ];
+        for (path, what) in cases {
+            // On a thread, so that a read that waits fails the test instead of hanging it.
+            let (sender, receiver) = std::sync::mpsc::channel();
+            let reading = path.clone();
+            std::thread::spawn(move || {
+                let _ = sender.send(FileSystem.read_at_most(&reading, 1 << 20));
+            });
+            let result = receiver
+                .recv_timeout(std::time::Duration::from_secs(10))
+                .unwrap_or_else(|_| panic!("reading {} waited", path.display()));
+            let error = result.expect_err("read");
+            assert_eq!(NotAFile::of(&error), Some(NotAFile { what }), "{error}");
+            assert!(error.to_string().contains("not a regular file"), "{error}");
         }
     }
 

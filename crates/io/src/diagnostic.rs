@@ -41,6 +41,9 @@ pub struct Diagnostic {
 pub struct SourceLine {
     text: Arc<str>,
     range: Range<usize>,
+    /// The column's byte offset in the line, where the loader knew it: an excerpt of a line
+    /// of megabytes is then cut without counting its characters up to the column.
+    caret: Option<usize>,
 }
 
 impl SourceLine {
@@ -49,6 +52,7 @@ impl SourceLine {
         SourceLine {
             text: Arc::from(line),
             range: 0..line.len(),
+            caret: None,
         }
     }
 
@@ -108,9 +112,19 @@ impl Diagnostic {
     /// `None` when the source line is unknown. A long line is cut to an excerpt around the
     /// column.
     pub fn source_excerpt(&self) -> Option<String> {
-        let source_line = self.source_line()?;
-        let (shown, caret_offset) =
-            excerpt_around(source_line, self.column.saturating_sub(1) as usize);
+        let source = self.source.as_ref()?;
+        let source_line = source.as_str();
+        let column_index = self.column.saturating_sub(1) as usize;
+        let caret = source
+            .caret
+            .filter(|&caret| source_line.is_char_boundary(caret))
+            .unwrap_or_else(|| {
+                source_line
+                    .char_indices()
+                    .nth(column_index)
+                    .map_or(source_line.len(), |(at, _)| at)
+            });
+        let (shown, caret_offset) = excerpt_around(source_line, caret);
         // Reuse the line's own tabs in front of the caret so it lines up however wide the
         // terminal draws a tab.
         let caret_indent: String = shown
@@ -126,24 +140,49 @@ impl Diagnostic {
 /// single line of 89,000 characters).
 const SHOWN_LINE_LIMIT: usize = 120;
 
-/// The part of `line` to display and the caret's character offset in it.
-fn excerpt_around(line: &str, column_index: usize) -> (String, usize) {
-    let length = line.chars().count();
-    if length <= SHOWN_LINE_LIMIT {
-        return (line.to_owned(), column_index);
+/// The part of `line` to display and the caret's character offset in it, for the caret at
+/// byte `caret`. Only the characters shown are walked, so a warning on a line of megabytes
+/// costs no more than one on a short line (thousands of them on one line were quadratic).
+fn excerpt_around(line: &str, caret: usize) -> (String, usize) {
+    let caret = caret.min(line.len());
+    // At most four bytes a character: a line this short has few enough to count.
+    if line.len() <= 4 * SHOWN_LINE_LIMIT && line.chars().count() <= SHOWN_LINE_LIMIT {
+        return (line.to_owned(), line[..caret].chars().count());
     }
-    let start = column_index
-        .saturating_sub(SHOWN_LINE_LIMIT / 2)
-        .min(length - SHOWN_LINE_LIMIT);
-    let end = start + SHOWN_LINE_LIMIT;
+    // Half the excerpt before the caret, then the rest after it; where the line ends first,
+    // the excerpt starts earlier, so that it always shows SHOWN_LINE_LIMIT characters.
+    let mut before = line[..caret]
+        .char_indices()
+        .rev()
+        .take(SHOWN_LINE_LIMIT / 2);
+    let mut start = caret;
+    let mut taken_before = 0;
+    for (at, _) in before.by_ref() {
+        start = at;
+        taken_before += 1;
+    }
+    let after: Vec<usize> = line[start..]
+        .char_indices()
+        .map(|(at, _)| start + at)
+        .take(SHOWN_LINE_LIMIT + 1)
+        .collect();
+    let mut end = after.get(SHOWN_LINE_LIMIT).copied().unwrap_or(line.len());
+    let shortfall = SHOWN_LINE_LIMIT.saturating_sub(after.len().min(SHOWN_LINE_LIMIT));
+    if shortfall > 0 {
+        for (at, _) in line[..start].char_indices().rev().take(shortfall) {
+            start = at;
+            taken_before += 1;
+        }
+        end = line.len();
+    }
     let mut shown = String::new();
-    let mut caret_offset = column_index - start;
+    let mut caret_offset = taken_before;
     if start > 0 {
         shown.push_str("...");
         caret_offset += 3;
     }
-    shown.extend(line.chars().skip(start).take(SHOWN_LINE_LIMIT));
-    if end < length {
+    shown.push_str(&line[start..end]);
+    if end < line.len() {
         shown.push_str("...");
     }
     (shown, caret_offset)
@@ -177,26 +216,53 @@ impl SceneError {
 /// Byte offsets to 1-based line and character column. roxmltree's `text_pos_at` rescans the
 /// document from the start on every call, which is quadratic over scenes with thousands of
 /// shapes; this index answers each query with a binary search, or at once when the line is the
-/// previous query's or the next one (the parsers ask in file order).
+/// previous query's or the next one (the parsers ask in file order). Columns count characters:
+/// in a text that is not all ASCII they come from the characters before every
+/// `CHARS_EVERY`-th byte, counted once, so that a column on a line of megabytes costs at most
+/// `CHARS_EVERY` bytes of counting, not the line's length.
 pub(crate) struct LineIndex<'text> {
     text: &'text str,
     line_starts: Vec<usize>,
     /// The line index of the previous query.
     last_line: Cell<usize>,
-    /// Whether every character is one byte (columns are then byte counts).
-    ascii: bool,
+    /// Characters before byte `k * CHARS_EVERY`, for every k; empty when every character is
+    /// one byte (columns are then byte counts).
+    chars_before: Vec<usize>,
 }
+
+/// Bytes between two entries of `LineIndex::chars_before`: its memory is an eighth of the
+/// text's on 64-bit machines, and a column is counted over at most this many bytes.
+const CHARS_EVERY: usize = 64;
 
 impl<'text> LineIndex<'text> {
     pub fn new(text: &'text str) -> LineIndex<'text> {
         let mut line_starts = vec![0];
         line_starts.extend(memchr::memchr_iter(b'\n', text.as_bytes()).map(|offset| offset + 1));
+        let chars_before = if text.is_ascii() {
+            Vec::new()
+        } else {
+            let mut before = 0;
+            let mut table = Vec::with_capacity(text.len() / CHARS_EVERY + 1);
+            for block in text.as_bytes().chunks(CHARS_EVERY) {
+                table.push(before);
+                before += chars_in(block);
+            }
+            table.push(before);
+            table
+        };
         LineIndex {
             text,
             line_starts,
             last_line: Cell::new(0),
-            ascii: text.is_ascii(),
+            chars_before,
         }
+    }
+
+    /// The characters that start before byte `offset`.
+    fn chars_before(&self, offset: usize) -> usize {
+        let block = offset / CHARS_EVERY;
+        let start = block * CHARS_EVERY;
+        self.chars_before[block] + chars_in(&self.text.as_bytes()[start..offset])
     }
 
     /// The index of the line holding `offset` (a char boundary no further than the text's end).
@@ -224,15 +290,41 @@ impl<'text> LineIndex<'text> {
         }
         let line_index = self.line_of(offset);
         let line_start = self.line_starts[line_index];
-        let column = if self.ascii {
+        let column = if self.chars_before.is_empty() {
             offset - line_start + 1
         } else {
-            self.text[line_start..offset].chars().count() + 1
+            self.chars_before(offset) - self.chars_before(line_start) + 1
         };
         Span {
             line: u32::try_from(line_index + 1).unwrap_or(u32::MAX),
             column: u32::try_from(column).unwrap_or(u32::MAX),
         }
+    }
+
+    /// The byte offset, in the line at `range`, of 1-based character `column`: found from the
+    /// counted blocks in O(log n + CHARS_EVERY), not by walking the line.
+    fn offset_in_line(&self, range: &Range<usize>, column: u32) -> Option<usize> {
+        let wanted = (column as usize).checked_sub(1)?;
+        if self.chars_before.is_empty() {
+            return Some(wanted.min(range.end - range.start));
+        }
+        let target = self.chars_before(range.start) + wanted;
+        // The last block start at or before the target character, then a walk within it.
+        let block = self
+            .chars_before
+            .partition_point(|&before| before <= target);
+        let mut block_start = (block.saturating_sub(1) * CHARS_EVERY).max(range.start);
+        while !self.text.is_char_boundary(block_start) {
+            block_start -= 1;
+        }
+        let skip = target - self.chars_before(block_start);
+        Some(
+            self.text[block_start..range.end]
+                .char_indices()
+                .nth(skip)
+                .map_or(range.end, |(at, _)| block_start + at)
+                - range.start,
+        )
     }
 
     /// The text of 1-based `line`, without its line break.
@@ -254,6 +346,11 @@ impl<'text> LineIndex<'text> {
         }
         Some(start..end)
     }
+}
+
+/// The characters that start in `bytes` (of UTF-8 text): every byte but continuation bytes.
+fn chars_in(bytes: &[u8]) -> usize {
+    bytes.iter().filter(|&&byte| (byte as i8) >= -0x40).count()
 }
 
 /// The collector every stage reports into: it knows the file and its text, so a `Span` is all a
@@ -289,6 +386,7 @@ impl<'text> Diagnostics<'text> {
                 .shared_text
                 .get_or_init(|| Arc::from(self.lines.text))
                 .clone(),
+            caret: self.lines.offset_in_line(&range, span.column),
             range,
         });
         Diagnostic {
@@ -319,27 +417,47 @@ impl<'text> Diagnostics<'text> {
     }
 }
 
+/// Names longer than this get no suggestion: no one mistypes a name of a hundred characters
+/// into another, and the edit distance of two long names costs the product of their lengths.
+const SUGGESTED_NAME_LIMIT: usize = 100;
+
 /// " (did you mean `x`?)" when one of `candidates` is a plausible intended spelling of `word`:
-/// equal ignoring case, or within an edit distance of about a third of its length.
+/// equal ignoring case, or within an edit distance of about a third of its length. Every "did
+/// you mean" goes through here. The work is bounded whatever the names: a word or candidate
+/// over `SUGGESTED_NAME_LIMIT` characters is passed over, one whose length alone puts it out
+/// of reach costs nothing more, and the rest cost at most 100 x 67 cells of one row each.
 pub(crate) fn did_you_mean<'a>(
     word: &str,
     candidates: impl IntoIterator<Item = &'a str>,
 ) -> String {
-    let word_lower = word.to_lowercase();
+    // Byte lengths bound character counts from above: a cheap first test.
+    if word.len() > 4 * SUGGESTED_NAME_LIMIT {
+        return String::new();
+    }
+    let word_lower: Vec<char> = word.chars().flat_map(char::to_lowercase).collect();
+    if word_lower.len() > SUGGESTED_NAME_LIMIT {
+        return String::new();
+    }
     let allowed = (word.chars().count() / 3).max(1);
-    let best = candidates
-        .into_iter()
-        .filter(|candidate| *candidate != word)
-        .map(|candidate| {
-            (
-                edit_distance(&word_lower, &candidate.to_lowercase()),
-                candidate,
-            )
-        })
-        .filter(|&(distance, _)| distance <= allowed)
+    let mut candidate_lower: Vec<char> = Vec::new();
+    let mut best: Option<(usize, &str)> = None;
+    for candidate in candidates {
+        if candidate == word || candidate.len() > 4 * (SUGGESTED_NAME_LIMIT + allowed) {
+            continue;
+        }
+        candidate_lower.clear();
+        candidate_lower.extend(candidate.chars().flat_map(char::to_lowercase));
+        // A closer candidate found already lowers the bound the rest must meet.
+        let bound = best.map_or(allowed, |(distance, _)| distance);
+        let Some(distance) = edit_distance_within(&word_lower, &candidate_lower, bound) else {
+            continue;
+        };
         // Ties go to the alphabetically first candidate, so messages do not depend on the
         // order of a hash map.
-        .min();
+        if best.is_none_or(|current| (distance, candidate) < current) {
+            best = Some((distance, candidate));
+        }
+    }
     match best {
         Some((_, candidate)) => format!(" (did you mean `{candidate}`?)"),
         None => String::new(),
@@ -347,30 +465,41 @@ pub(crate) fn did_you_mean<'a>(
 }
 
 /// Edit distance over characters where swapping two neighbours counts as one edit (optimal
-/// string alignment), since `bleu` for `blue` is a typical slip.
-fn edit_distance(a: &str, b: &str) -> usize {
-    let a: Vec<char> = a.chars().collect();
-    let b: Vec<char> = b.chars().collect();
-    let mut table = vec![vec![0usize; b.len() + 1]; a.len() + 1];
-    for (i, row) in table.iter_mut().enumerate() {
-        row[0] = i;
+/// string alignment), since `bleu` for `blue` is a typical slip; `None` when it is over
+/// `bound`. Three rows of the shorter string's length are held, not the whole table, and a
+/// pair whose lengths differ by more than `bound` is answered at once, as is one whose row
+/// minimum passes `bound` (the distance never falls below a row's minimum).
+fn edit_distance_within(a: &[char], b: &[char], bound: usize) -> Option<usize> {
+    let (a, b) = if a.len() < b.len() { (b, a) } else { (a, b) };
+    if a.len() - b.len() > bound {
+        return None;
     }
-    for (j, cell) in table[0].iter_mut().enumerate() {
-        *cell = j;
-    }
+    let width = b.len() + 1;
+    let mut before: Vec<usize> = vec![0; width];
+    let mut previous: Vec<usize> = (0..width).collect();
+    let mut current: Vec<usize> = vec![0; width];
     for i in 1..=a.len() {
-        for j in 1..=b.len() {
-            let substitution = table[i - 1][j - 1] + usize::from(a[i - 1] != b[j - 1]);
-            let mut best = substitution
-                .min(table[i - 1][j] + 1)
-                .min(table[i][j - 1] + 1);
+        current[0] = i;
+        let mut row_minimum = i;
+        for j in 1..width {
+            let substitution = previous[j - 1] + usize::from(a[i - 1] != b[j - 1]);
+            let mut best = substitution.min(previous[j] + 1).min(current[j - 1] + 1);
             if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                best = best.min(table[i - 2][j - 2] + 1);
+                best = best.min(before[j - 2] + 1);
             }
-            table[i][j] = best;
+            current[j] = best;
+            row_minimum = row_minimum.min(best);
         }
+        // A transposition reaches back two rows, so a row's minimum bounds the distance from
+        // below only together with the row before it.
+        if row_minimum > bound && previous.iter().min().is_some_and(|&m| m > bound) {
+            return None;
+        }
+        std::mem::swap(&mut before, &mut previous);
+        std::mem::swap(&mut previous, &mut current);
     }
-    table[a.len()][b.len()]
+    let distance = previous[b.len()];
+    (distance <= bound).then_some(distance)
 }
 
 #[cfg(test)]
@@ -400,11 +529,22 @@ mod tests {
         ] {
             lookups_agree(text);
         }
+        // Lines longer than the blocks of counted characters, with characters of two, three
+        // and four bytes on both sides of block edges.
+        let mut random = crate::testing::xorshift(0x1234_5678_9abc_def1);
+        let pieces = ["a", "é", "€", "𝄞", " ", "\n", "xyz"];
+        let long: String = (0..900)
+            .map(|_| {
+                let pick = (random() % 40) as usize;
+                pieces[if pick < pieces.len() { pick } else { 0 }]
+            })
+            .collect();
+        lookups_agree(&long);
     }
 
     fn lookups_agree(text: &str) {
         let index = LineIndex::new(text);
-        assert_eq!(index.ascii, text.is_ascii());
+        assert_eq!(index.chars_before.is_empty(), text.is_ascii());
         let expected = |offset: usize| {
             let line = text[..offset].matches('\n').count();
             let start = text[..offset].rfind('\n').map_or(0, |at| at + 1);
@@ -458,6 +598,76 @@ mod tests {
         );
     }
 
+    /// The whole table, as first written: the definition the bounded rows must keep.
+    fn full_table_distance(a: &[char], b: &[char]) -> usize {
+        let mut table = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+        for (i, row) in table.iter_mut().enumerate() {
+            row[0] = i;
+        }
+        for (j, cell) in table[0].iter_mut().enumerate() {
+            *cell = j;
+        }
+        for i in 1..=a.len() {
+            for j in 1..=b.len() {
+                let substitution = table[i - 1][j - 1] + usize::from(a[i - 1] != b[j - 1]);
+                let mut best = substitution
+                    .min(table[i - 1][j] + 1)
+                    .min(table[i][j - 1] + 1);
+                if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
+                    best = best.min(table[i - 2][j - 2] + 1);
+                }
+                table[i][j] = best;
+            }
+        }
+        table[a.len()][b.len()]
+    }
+
+    /// Random words over a small alphabet (so that swaps and near misses are common): the
+    /// bounded distance is the table's wherever that is within the bound, and `None` past it.
+    #[test]
+    fn bounded_distance_agrees_with_the_full_table() {
+        let mut random = crate::testing::xorshift(0x5151_7a7a_0101_3c3c);
+        let word = |random: &mut dyn FnMut() -> u64| -> Vec<char> {
+            let length = (random() % 12) as usize;
+            (0..length)
+                .map(|_| ['a', 'b', 'c', 'é'][(random() % 4) as usize])
+                .collect()
+        };
+        let mut within = 0;
+        for _ in 0..3000 {
+            let a = word(&mut random);
+            let b = word(&mut random);
+            let bound = (random() % 6) as usize;
+            let exact = full_table_distance(&a, &b);
+            let expected = (exact <= bound).then_some(exact);
+            assert_eq!(
+                edit_distance_within(&a, &b, bound),
+                expected,
+                "{a:?} {b:?} {bound}"
+            );
+            within += usize::from(expected.is_some());
+        }
+        assert!(within > 300, "only {within} pairs within their bound");
+    }
+
+    /// Issue 55: two names of 20,000 characters took a 3 GB table. Long names get no
+    /// suggestion, and a long list of near-miss candidates is still answered.
+    #[test]
+    fn long_names_cost_no_table() {
+        let (a, b) = ("a".repeat(20_000), "b".repeat(20_000));
+        assert_eq!(did_you_mean(&b, [a.as_str()]), "");
+        let near = format!("{}x", "a".repeat(99));
+        assert_eq!(
+            did_you_mean(&"a".repeat(100), [a.as_str(), near.as_str()]),
+            format!(" (did you mean `{near}`?)")
+        );
+        // Not the first close candidate but the closest, ties alphabetically.
+        assert_eq!(
+            did_you_mean("shapes", ["shaper", "shape", "shapesx"]),
+            " (did you mean `shape`?)"
+        );
+    }
+
     #[test]
     fn display_puts_a_caret_under_the_column() {
         let diagnostic = Diagnostic {
@@ -472,6 +682,33 @@ mod tests {
             diagnostic.to_string(),
             "scene.xml:3:5: warning: something\n\tab cd\n\t   ^"
         );
+    }
+
+    /// The excerpt cut at the byte offset the loader knows is the one cut by walking to the
+    /// column, on long lines of mixed-width characters, at every column.
+    #[test]
+    fn excerpts_from_the_loader_agree_with_walking() {
+        let mut random = crate::testing::xorshift(0x0bad_5eed_1234_4321);
+        let pieces = ["a", "é", "€", "𝄞", "\t", "xyz"];
+        let line: String = (0..400)
+            .map(|_| pieces[(random() % pieces.len() as u64) as usize])
+            .collect();
+        let text = format!("first\n{line}\nlast");
+        let diagnostics = Diagnostics::new(Path::new("s.xml"), &text);
+        for column in 1..=line.chars().count() as u32 + 1 {
+            let span = Span { line: 2, column };
+            let from_loader = diagnostics.diagnostic(Severity::Error, span, "m".into());
+            assert!(from_loader.source.as_ref().unwrap().caret.is_some());
+            let walked = Diagnostic {
+                source: Some(SourceLine::new(&line)),
+                ..from_loader.clone()
+            };
+            assert_eq!(
+                from_loader.source_excerpt(),
+                walked.source_excerpt(),
+                "{column}"
+            );
+        }
     }
 
     #[test]

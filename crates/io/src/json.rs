@@ -12,6 +12,7 @@ use jsonc_parser::ast;
 use jsonc_parser::common::Ranged;
 
 use crate::diagnostic::{Diagnostics, SceneError};
+use crate::limits::{MemoryBudget, JSON_BYTES_PER_VALUE, TEXT_BYTES_PER_BYTE};
 use crate::tree::{Node, Value};
 
 /// Parses `text` into jsonc-parser's syntax tree of its top-level value; `tree` makes the
@@ -19,8 +20,9 @@ use crate::tree::{Node, Value};
 pub(crate) fn parse<'text>(
     text: &'text str,
     diagnostics: &Diagnostics,
+    memory: &mut MemoryBudget,
 ) -> Result<ast::Value<'text>, SceneError> {
-    check_nesting(text, diagnostics)?;
+    check_nesting(text, diagnostics, memory)?;
     let options = jsonc_parser::ParseOptions {
         allow_comments: true,
         allow_trailing_commas: true,
@@ -53,10 +55,30 @@ pub(crate) fn tree<'a>(value: &'a ast::Value<'_>, diagnostics: &Diagnostics) -> 
 /// anything; such files are refused up front.
 pub(crate) const MAX_NESTING: usize = 100;
 
-/// Counts brackets outside strings and comments, and fails where the nesting gets too deep or
-/// where a string is single-quoted (which jsonc-parser would accept).
-fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError> {
+/// Counts brackets outside strings and comments, and fails where the nesting gets too deep,
+/// where a string is single-quoted (which jsonc-parser would accept), or where what the parse
+/// will hold (`memory`, charged with the text and each value) passes the memory budget: a
+/// value starts after each `[`, `{`, `:` and `,`, so counting those bounds the values from
+/// above before jsonc-parser builds any of them.
+fn check_nesting(
+    text: &str,
+    diagnostics: &Diagnostics,
+    memory: &mut MemoryBudget,
+) -> Result<(), SceneError> {
     let bytes = text.as_bytes();
+    let over_budget = |memory: &MemoryBudget, index: usize| {
+        diagnostics.error(
+            diagnostics.span_at(index),
+            memory.refusal("the file's values"),
+        )
+    };
+    if !memory.charge(
+        (bytes.len() as u64)
+            .saturating_mul(TEXT_BYTES_PER_BYTE)
+            .saturating_add(JSON_BYTES_PER_VALUE),
+    ) {
+        return Err(over_budget(memory, 0));
+    }
     let mut depth = 0usize;
     let mut index = 0;
     while index < bytes.len() {
@@ -85,7 +107,13 @@ fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError
                 }
                 index += 1;
             }
+            b':' | b',' if !memory.charge(JSON_BYTES_PER_VALUE) => {
+                return Err(over_budget(memory, index));
+            }
             b'{' | b'[' => {
+                if !memory.charge(JSON_BYTES_PER_VALUE) {
+                    return Err(over_budget(memory, index));
+                }
                 depth += 1;
                 if depth > MAX_NESTING {
                     return Err(diagnostics.error(

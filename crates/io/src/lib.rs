@@ -69,7 +69,9 @@ mod xml;
 
 use std::path::Path;
 
-pub use assets::{read_file_at_most, Assets, FileSystem, MemoryAssets, TooLarge};
+pub use assets::{
+    open_input, read_file_at_most, Assets, FileSystem, MemoryAssets, NotAFile, TooLarge,
+};
 pub use diagnostic::{Diagnostic, SceneError, Severity, SourceLine};
 pub use display::{
     DisplayTransform, PngEncoding, ToneMap, Transfer, TRANSFER_KEYWORD, TRANSFORM_KEYWORD,
@@ -325,10 +327,11 @@ pub fn load_scene_with_defines(
     let mut diagnostics = Diagnostics::new(path, text);
     let format = detect_format(text, path, &diagnostics)?;
     let json_syntax;
+    let mut memory = limits::MemoryBudget::new(limits);
     let root = match format {
-        Format::Xml => xml::parse(text, &diagnostics)?,
+        Format::Xml => xml::parse(text, &diagnostics, &mut memory)?,
         Format::Json => {
-            json_syntax = json::parse(text, &diagnostics)?;
+            json_syntax = json::parse(text, &diagnostics, &mut memory)?;
             json::tree(&json_syntax, &diagnostics)
         }
     };

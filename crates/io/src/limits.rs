@@ -17,6 +17,10 @@ pub struct Limits {
     pub max_texture_side: u32,
     /// Memory the loaded textures may take together, in bytes (checked before each decode).
     pub max_texture_bytes: u64,
+    /// The render's memory budget, in bytes (the CLI's `--max-memory`): a scene's parse tree
+    /// and a mesh's buffers are estimated against it while they load, from upper bounds of
+    /// what each element, value or triangle holds, and refused where they would pass it.
+    pub max_memory: u64,
 }
 
 /// 256 MiB.
@@ -29,6 +33,9 @@ pub const DEFAULT_MAX_TEXTURE_SIDE: u32 = 8192;
 /// 2 GiB.
 pub const DEFAULT_MAX_TEXTURE_BYTES: u64 = 2 << 30;
 
+/// 4 GiB, what the CLI plans for where it cannot tell the machine's memory.
+pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
+
 /// Memory one decoded texel takes while its texture loads: 12 bytes as the renderer keeps it
 /// (three f32) and up to 8 more in the decoder's buffer and its RGB8 copy.
 pub const BYTES_PER_TEXEL: u64 = 20;
@@ -40,6 +47,7 @@ impl Default for Limits {
             max_triangles: DEFAULT_MAX_TRIANGLES,
             max_texture_side: DEFAULT_MAX_TEXTURE_SIDE,
             max_texture_bytes: DEFAULT_MAX_TEXTURE_BYTES,
+            max_memory: DEFAULT_MAX_MEMORY,
         }
     }
 }
@@ -52,7 +60,70 @@ impl Limits {
             max_triangles: u64::MAX,
             max_texture_side: u32::MAX,
             max_texture_bytes: u64::MAX,
+            max_memory: u64::MAX,
         }
+    }
+}
+
+/// Memory a course or Mitsuba XML file's parse holds per tag (`<` of an element, end tag,
+/// comment or declaration), at most: roxmltree's node for the element and one for the text
+/// after it, the located tree's node, its share of the vectors' spare capacity, and the
+/// warning an unknown element gets. Measured with `scripts/hostile-figures.py`'s
+/// `40 MB empty elements` case at several sizes (see the commit that set it).
+pub(crate) const XML_BYTES_PER_TAG: u64 = 400;
+/// Memory an XML attribute holds, at most: roxmltree's attribute and the located tree's node.
+pub(crate) const XML_BYTES_PER_ATTRIBUTE: u64 = 200;
+/// Memory a JSON value holds, at most: jsonc-parser's syntax node, the located tree's node,
+/// their share of spare capacity and a warning.
+pub(crate) const JSON_BYTES_PER_VALUE: u64 = 160;
+/// Memory a mesh file's triangle holds while it loads, at most: the OBJ reader's corners (a
+/// fan's are one a triangle; separate triangles' are three, with their face record), its
+/// triangle of three corners (36 bytes), and the scene's shape and material index made from
+/// it while the triangles are still held.
+pub(crate) const MESH_BYTES_PER_TRIANGLE: u64 = 160;
+/// Memory a scene file's text holds per byte while it is parsed: the text, and the table of
+/// character counts a text that is not all ASCII gets (`diagnostic::LineIndex`).
+pub(crate) const TEXT_BYTES_PER_BYTE: u64 = 2;
+
+/// The memory a load is estimated to hold, against `Limits::max_memory`: charged as the
+/// parse goes, so that the file, line and column where it would pass the budget are known.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct MemoryBudget {
+    limit: u64,
+    used: u64,
+}
+
+impl MemoryBudget {
+    pub fn new(limits: &Limits) -> MemoryBudget {
+        MemoryBudget {
+            limit: limits.max_memory,
+            used: 0,
+        }
+    }
+
+    /// No budget (for scans whose other findings are wanted alone).
+    #[cfg(test)]
+    pub fn unlimited() -> MemoryBudget {
+        MemoryBudget {
+            limit: u64::MAX,
+            used: 0,
+        }
+    }
+
+    /// Adds `bytes`; false once the total is over the budget.
+    pub fn charge(&mut self, bytes: u64) -> bool {
+        self.used = self.used.saturating_add(bytes);
+        self.used <= self.limit
+    }
+
+    /// The message for a load stopped at the point where `what` passed the budget.
+    pub fn refusal(&self, what: &str) -> String {
+        format!(
+            "{what} would hold about {}, more than the memory budget of {} \
+             (--max-memory raises it)",
+            format_bytes(self.used),
+            format_bytes(self.limit)
+        )
     }
 }
 

@@ -42,6 +42,17 @@ pub(crate) fn load_triangles(
             limits.max_triangles
         )));
     }
+    // What the parse and the scene's copy of the triangles hold, against the memory budget,
+    // before any of it is taken.
+    let mut memory = crate::limits::MemoryBudget::new(limits);
+    if !memory.charge(
+        (bytes.len() as u64)
+            .saturating_add(triangles.saturating_mul(crate::limits::MESH_BYTES_PER_TRIANGLE)),
+    ) {
+        return Err(AssetError::Refused(
+            memory.refusal(&format!("its {triangles} triangles")),
+        ));
+    }
     if let Some(triangles) = crate::obj_fast::parse(&bytes).and_then(|parsed| parsed.triangles()) {
         return Ok(triangles);
     }

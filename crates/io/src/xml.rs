@@ -4,14 +4,18 @@ use std::borrow::Cow;
 
 use crate::desc::Span;
 use crate::diagnostic::{Diagnostics, SceneError};
+use crate::limits::{
+    MemoryBudget, TEXT_BYTES_PER_BYTE, XML_BYTES_PER_ATTRIBUTE, XML_BYTES_PER_TAG,
+};
 use crate::tree::{Node, Value, TEXT_KEY};
 
 /// Parses `text` and returns the root element as a node keyed by its tag name.
 pub(crate) fn parse<'text>(
     text: &'text str,
     diagnostics: &Diagnostics,
+    memory: &mut MemoryBudget,
 ) -> Result<Node<'text>, SceneError> {
-    check_nesting(text, diagnostics)?;
+    check_nesting(text, diagnostics, memory)?;
     let document = roxmltree::Document::parse(text).map_err(|error| {
         let span = match error {
             // roxmltree has no position for these and says 1:1; the problem is where the text
@@ -42,19 +46,50 @@ pub(crate) fn parse<'text>(
 pub(crate) const MAX_NESTING: usize = 100;
 
 /// Counts open and close tags outside comments, CDATA and declarations, and fails where the
-/// nesting gets too deep. Malformed markup is left for roxmltree to report.
-pub(crate) fn check_nesting(text: &str, diagnostics: &Diagnostics) -> Result<(), SceneError> {
-    match too_deep(text.as_bytes()) {
+/// nesting gets too deep, or where what the parse will hold (`memory`, charged with the text,
+/// each tag and each attribute) passes the memory budget: so a file of millions of elements
+/// is refused, at the element where the budget ran out, before roxmltree builds anything.
+/// Malformed markup is left for roxmltree to report.
+pub(crate) fn check_nesting(
+    text: &str,
+    diagnostics: &Diagnostics,
+    memory: &mut MemoryBudget,
+) -> Result<(), SceneError> {
+    match scan(text.as_bytes(), memory) {
         None => Ok(()),
-        Some(start) => Err(diagnostics.error(
+        Some(Stop::TooDeep(start)) => Err(diagnostics.error(
             diagnostics.span_at(start),
             format!("elements nested more than {MAX_NESTING} levels deep; not a scene file"),
+        )),
+        Some(Stop::OverBudget(start)) => Err(diagnostics.error(
+            diagnostics.span_at(start),
+            memory.refusal("the file's elements"),
         )),
     }
 }
 
+/// Where and why `scan` stopped a file.
+#[derive(Debug, PartialEq)]
+enum Stop {
+    /// The open tag that nests deeper than `MAX_NESTING` starts here.
+    TooDeep(usize),
+    /// The tag where the memory budget ran out starts here.
+    OverBudget(usize),
+}
+
 /// Where the open tag that nests deeper than `MAX_NESTING` starts, if one does.
+#[cfg(test)]
 fn too_deep(bytes: &[u8]) -> Option<usize> {
+    match scan(bytes, &mut MemoryBudget::unlimited()) {
+        Some(Stop::TooDeep(start)) => Some(start),
+        _ => None,
+    }
+}
+
+fn scan(bytes: &[u8], memory: &mut MemoryBudget) -> Option<Stop> {
+    if !memory.charge((bytes.len() as u64).saturating_mul(TEXT_BYTES_PER_BYTE)) {
+        return Some(Stop::OverBudget(0));
+    }
     let skip_past = |from: usize, pattern: &[u8]| -> usize {
         memchr::memmem::find(&bytes[from..], pattern)
             .map_or(bytes.len(), |position| from + position + pattern.len())
@@ -63,6 +98,9 @@ fn too_deep(bytes: &[u8]) -> Option<usize> {
     let mut index = 0;
     while let Some(offset) = memchr::memchr(b'<', &bytes[index..]) {
         let start = index + offset;
+        if !memory.charge(XML_BYTES_PER_TAG) {
+            return Some(Stop::OverBudget(start));
+        }
         let rest = &bytes[start..];
         if rest.starts_with(b"<!--") {
             index = skip_past(start, b"-->");
@@ -85,6 +123,10 @@ fn too_deep(bytes: &[u8]) -> Option<usize> {
                 if bytes[end] == b'>' {
                     break;
                 }
+                // A quoted value: an attribute.
+                if !memory.charge(XML_BYTES_PER_ATTRIBUTE) {
+                    return Some(Stop::OverBudget(start));
+                }
                 // A quote: on past its closing twin.
                 let Some(offset) = memchr::memchr(bytes[end], &bytes[end + 1..]) else {
                     end = bytes.len();
@@ -96,7 +138,7 @@ fn too_deep(bytes: &[u8]) -> Option<usize> {
             if !self_closing {
                 depth += 1;
                 if depth > MAX_NESTING {
-                    return Some(start);
+                    return Some(Stop::TooDeep(start));
                 }
             }
             index = (end + 1).min(bytes.len());

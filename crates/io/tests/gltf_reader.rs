@@ -658,6 +658,7 @@ fn mutated_models_never_panic_and_errors_stay_located() {
         max_triangles: 1 << 16,
         max_texture_side: 1024,
         max_texture_bytes: 64 << 20,
+        max_memory: 256 << 20,
     };
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = || {

@@ -67,6 +67,8 @@ struct Parser<'a> {
     /// Files being read, outermost first: an include of one of them is a cycle.
     stack: Vec<PathBuf>,
     elements: usize,
+    /// What the files' parses hold, all of them together.
+    memory: crate::limits::MemoryBudget,
 }
 
 /// Parses the scene file `files[0]` and what it includes.
@@ -84,6 +86,7 @@ pub(crate) fn parse(
         search_paths: Vec::new(),
         stack: Vec::new(),
         elements: 0,
+        memory: crate::limits::MemoryBudget::new(limits),
     };
     let mut roots = parser.parse_file(0)?;
     let root = roots.pop().expect("a file parses into its root element");
@@ -104,7 +107,7 @@ impl Parser<'_> {
         let text = self.files.text(file);
         let path = self.files.path(file).to_path_buf();
         let diagnostics = Diagnostics::new(&path, &text);
-        crate::xml::check_nesting(&text, &diagnostics)?;
+        crate::xml::check_nesting(&text, &diagnostics, &mut self.memory)?;
         let document = roxmltree::Document::parse(&text).map_err(|error| {
             let span = match error {
                 roxmltree::Error::UnexpectedEndOfStream | roxmltree::Error::UnclosedRootNode => {
