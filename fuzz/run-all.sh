@@ -9,7 +9,7 @@ cd "$here"
 runs=${1:-1000000}
 seconds=${2:-3600}
 shift 2 2>/dev/null || shift $#
-targets=${*:-xml json obj ply texture scene mitsuba mitsuba_serialized}
+targets=${*:-xml json obj ply texture image scene mitsuba mitsuba_serialized gltf}
 [ -d corpus ] || ./seed.sh
 nice -n 19 cargo +nightly fuzz build -s none -a >/dev/null 2>&1 || { echo "build failed" >&2; exit 1; }
 for target in $targets; do

@@ -15,6 +15,10 @@ for mesh in $(find "$course" -name '*.obj' -size +200k | head -3); do
 done
 printf 'v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\nf 1/1/1 2/2/2 3/3/3\n' > "$here/corpus/obj/quad.obj"
 find "$course" -name '*.png' -size -64k -exec cp {} "$here/corpus/texture/" \;
+# Images: the same PNGs, and the small EXRs (parts, references) of the shared folder.
+mkdir -p "$here/corpus/image"
+find "$course" -name '*.png' -size -64k -exec cp {} "$here/corpus/image/" \;
+find "$here/../../shared" -name '*.exr' -size -64k -exec cp {} "$here/corpus/image/" \;
 # PLY: the shared models when present, and two small hand-written ones.
 printf 'ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n' > "$here/corpus/ply/ascii.ply"
 printf 'ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n' > "$here/corpus/ply/empty.ply"
@@ -22,4 +26,4 @@ printf 'ply\nformat binary_little_endian 1.0\nelement vertex 0\nproperty float x
 mkdir -p "$here/corpus/gltf"
 gltf="$here/../../shared/gltf"
 [ -d "$gltf" ] && find "$gltf" \( -name '*.gltf' -o -name '*.glb' \) -exec cp {} "$here/corpus/gltf/" \;
-echo "seeded: $(for t in xml json obj ply texture scene; do printf '%s=%s ' $t "$(ls "$here/corpus/$t" | wc -l)"; done)"
+echo "seeded: $(for t in xml json obj ply texture image scene; do printf '%s=%s ' $t "$(ls "$here/corpus/$t" | wc -l)"; done)"

@@ -182,9 +182,10 @@ pub struct LimitOptions {
     #[arg(long, action = ArgAction::SetTrue)]
     pub strict: bool,
 
-    /// Memory a render may plan for: film, textures and acceleration structures, estimated
-    /// before anything is allocated (bytes; K, M, G suffixes) [default: half the machine's
-    /// memory].
+    /// Memory a load and render may plan for: parse trees, meshes, film, textures and
+    /// acceleration structures, estimated before they are allocated (bytes; K, M, G suffixes)
+    /// [default: half of the least of the machine's memory, its control group's limit and
+    /// ulimit -v].
     #[arg(long, value_name = "SIZE", value_parser = parse_size)]
     pub max_memory: Option<u64>,
 
