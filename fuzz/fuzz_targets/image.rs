@@ -28,8 +28,14 @@ libfuzzer_sys::fuzz_target!(|bytes: &[u8]| {
         assert!(header.origin.1 + header.height <= header.full_size.1);
         if let Ok(exr) = glint_io::read_exr_with(&path, &LIMITS) {
             let film = &exr.film;
-            assert_eq!(film.pixels.len(), film.width as usize * film.height as usize);
-            assert!(film.pixels.iter().all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite()));
+            assert_eq!(
+                film.pixels.len(),
+                film.width as usize * film.height as usize
+            );
+            assert!(film
+                .pixels
+                .iter()
+                .all(|p| p.x.is_finite() && p.y.is_finite() && p.z.is_finite()));
         }
     }
     if let Ok(file) = glint_io::open_image(&path, &LIMITS, 12) {
