@@ -61,7 +61,7 @@ pub fn load(
     if !file.exists() {
         return Ok(None);
     }
-    let limits = glint_io::ImageLimits::with_memory(crate::args::default_max_memory());
+    let limits = glint_io::ImageLimits::with_memory(crate::machine::default_max_memory());
     let header = glint_io::read_exr_header(file, &limits).map_err(|e| UsageError(e.to_string()))?;
     let name = file.display();
     for key in farm::IDENTITY_KEYS.iter().chain([&key::SAMPLE_RANGE]) {

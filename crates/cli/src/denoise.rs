@@ -144,7 +144,7 @@ pub fn run(args: &DenoiseArgs, err: &mut dyn Write) -> Result<(), Failure> {
             args.output.display()
         ))
     })?;
-    let limits = glint_io::ImageLimits::with_memory(crate::args::default_max_memory());
+    let limits = glint_io::ImageLimits::with_memory(crate::machine::default_max_memory());
     let input =
         glint_io::read_exr_with(&args.input, &limits).map_err(|error| usage(error.to_string()))?;
     let film = input.film;

@@ -59,7 +59,7 @@ pub struct DiffArgs {
     /// Memory the comparison may take: both images as read, decoded and compared by FLIP,
     /// estimated from their headers before either is decoded (bytes; K, M, G suffixes)
     /// [default: half the machine's memory].
-    #[arg(long, value_name = "SIZE", value_parser = crate::args::parse_size)]
+    #[arg(long, value_name = "SIZE", value_parser = crate::machine::parse_size)]
     pub max_memory: Option<u64>,
 
     /// Print help (`glint` turns off `-h`, which is the image height for renders).
@@ -519,7 +519,7 @@ pub fn run(args: &DiffArgs, out: &mut dyn Write, err: &mut dyn Write) -> u8 {
     // Both headers are checked before either image is decoded: B gets what A leaves.
     let budget = args
         .max_memory
-        .unwrap_or_else(crate::args::default_max_memory);
+        .unwrap_or_else(crate::machine::default_max_memory);
     let compared = open_image(&args.reference, &ImageLimits::with_memory(budget))
         .and_then(|a| {
             let left = budget.saturating_sub(a.bytes_charged);

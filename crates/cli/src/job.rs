@@ -245,7 +245,7 @@ impl Options {
                 .map(|file| (file, self.limits.env_strength)),
             limits,
             max_memory,
-            max_memory_source: crate::args::max_memory_source(self.limits.max_memory),
+            max_memory_source: crate::machine::max_memory_source(self.limits.max_memory),
             scene,
             output,
             settings,
@@ -485,7 +485,7 @@ mod tests {
     use super::*;
     use clap::Parser;
 
-    use crate::args::default_max_memory;
+    use crate::machine::default_max_memory;
 
     fn job(args: &[&str]) -> Result<Job, String> {
         let cli = Cli::try_parse_from(std::iter::once("glint").chain(args.iter().copied()))

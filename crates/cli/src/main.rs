@@ -17,6 +17,7 @@ mod farm;
 mod gpu;
 mod interrupt;
 mod job;
+mod machine;
 mod memory;
 mod merge;
 mod passes;

@@ -462,7 +462,7 @@ pub fn run(args: &MergeArgs, interrupt: &Interrupt, err: &mut dyn Write) -> Resu
     }
     let budget = args
         .max_memory
-        .unwrap_or_else(crate::args::default_max_memory);
+        .unwrap_or_else(crate::machine::default_max_memory);
     let limits = ImageLimits::with_memory(budget);
     let mut parts = Vec::with_capacity(args.parts.len());
     for path in &args.parts {
