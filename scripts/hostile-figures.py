@@ -350,7 +350,10 @@ def cases(glint, work):
     def merge_partial(w):
         # A stale partial file from a merge killed while writing.
         parts(w)
-        write(os.path.join(w, ".glint-999999-stale.partial"), b"x")
+        stale = os.path.join(w, ".glint-999999-stale.partial")
+        write(stale, b"x")
+        # An hour old: left by a run before this one (a newer file may be a live writer's).
+        os.utime(stale, (time.time() - 3600, time.time() - 3600))
 
     def partial_left(w):
         names = [n for n in os.listdir(w) if n.endswith(".partial")]

@@ -363,6 +363,23 @@ pub(crate) struct Diagnostics<'text> {
     warnings: Vec<Diagnostic>,
     /// (line, column, message) of every warning kept: a repeated warning is dropped in O(1).
     seen: HashSet<(u32, u32, String)>,
+    /// Warnings past `MAX_KEPT_WARNINGS`, counted only.
+    dropped: usize,
+    /// Where the last dropped warning was.
+    last_dropped: Span,
+}
+
+/// The warnings a file keeps in full; the rest are counted, and one last warning says how many.
+/// Ten thousand is far beyond what anyone reads, and a hostile file of ten million ignored
+/// elements would otherwise hold gigabytes of messages.
+pub const MAX_KEPT_WARNINGS: usize = 10_000;
+
+/// The warning that stands for `dropped` warnings not kept.
+pub(crate) fn dropped_message(dropped: usize) -> String {
+    format!(
+        "{dropped} more warning{} in this file not listed (only the first {MAX_KEPT_WARNINGS} are kept)",
+        if dropped == 1 { "" } else { "s" }
+    )
 }
 
 impl<'text> Diagnostics<'text> {
@@ -373,7 +390,22 @@ impl<'text> Diagnostics<'text> {
             shared_text: OnceCell::new(),
             warnings: Vec::new(),
             seen: HashSet::new(),
+            dropped: 0,
+            last_dropped: Span::default(),
         }
+    }
+
+    /// As `new`, for a text already shared: its diagnostics point into `text` itself rather
+    /// than into a copy.
+    pub fn new_shared(path: &Path, text: &'text Arc<str>) -> Diagnostics<'text> {
+        let diagnostics = Diagnostics::new(path, text);
+        let _ = diagnostics.shared_text.set(text.clone());
+        diagnostics
+    }
+
+    /// A warning at `span`, for a caller that keeps its own list.
+    pub fn warning(&self, span: Span, message: String) -> Diagnostic {
+        self.diagnostic(Severity::Warning, span, message)
     }
 
     pub fn span_at(&self, offset: usize) -> Span {
@@ -400,6 +432,11 @@ impl<'text> Diagnostics<'text> {
     }
 
     pub fn warn(&mut self, span: Span, message: impl Into<String>) {
+        if self.warnings.len() >= MAX_KEPT_WARNINGS {
+            self.dropped += 1;
+            self.last_dropped = span;
+            return;
+        }
         let message = message.into();
         if !self.seen.insert((span.line, span.column, message.clone())) {
             return;
@@ -412,7 +449,15 @@ impl<'text> Diagnostics<'text> {
         SceneError::Invalid(self.diagnostic(Severity::Error, span, message.into()))
     }
 
-    pub fn into_warnings(self) -> Vec<Diagnostic> {
+    pub fn into_warnings(mut self) -> Vec<Diagnostic> {
+        if self.dropped > 0 {
+            let last = self.diagnostic(
+                Severity::Warning,
+                self.last_dropped,
+                dropped_message(self.dropped),
+            );
+            self.warnings.push(last);
+        }
         self.warnings
     }
 }

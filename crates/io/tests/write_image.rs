@@ -131,6 +131,8 @@ fn exr_keeps_windows_sums_and_metadata() {
         full_size: (20, 10),
         ..film()
     };
+    // Finite: the reader refuses a NaN, which Glint never writes (hostile_images.rs).
+    part.pixels[1].x = 0.125;
     part.sums = Some(glint_render::SampleSums {
         radiance: part.pixels.iter().map(|&c| c * 3.0).collect(),
         counts: vec![3, 0, 3, 2, 3, 3],

@@ -14,12 +14,13 @@ pub(crate) mod shapes;
 mod spectrum;
 mod tables;
 
+use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use crate::assets::Assets;
 use crate::desc::Span;
-use crate::diagnostic::{Diagnostic, Diagnostics, SceneError};
+use crate::diagnostic::{dropped_message, Diagnostic, Diagnostics, SceneError, MAX_KEPT_WARNINGS};
 use crate::limits::Limits;
 use crate::LoadedScene;
 
@@ -27,7 +28,14 @@ use crate::LoadedScene;
 /// element's `Span` can become a located diagnostic.
 pub(crate) struct Files {
     files: Vec<(PathBuf, Arc<str>)>,
-    warnings: Vec<Diagnostic>,
+    /// Warnings as given (file, place, message), made into diagnostics at the end with one
+    /// line index per file: building one per warning cost the whole text each time.
+    warnings: Vec<(usize, Span, String)>,
+    /// The warnings kept, for dropping repeats in O(1).
+    seen: HashSet<(usize, u32, u32, String)>,
+    /// Warnings past `MAX_KEPT_WARNINGS`, counted only, and where the last was.
+    dropped: usize,
+    last_dropped: (usize, Span),
 }
 
 impl Files {
@@ -35,6 +43,9 @@ impl Files {
         Files {
             files: vec![(path.to_path_buf(), Arc::from(text))],
             warnings: Vec::new(),
+            seen: HashSet::new(),
+            dropped: 0,
+            last_dropped: (0, Span::default()),
         }
     }
 
@@ -66,18 +77,38 @@ impl Files {
     }
 
     pub fn warn(&mut self, file: usize, span: Span, message: impl Into<String>) {
-        let message = message.into();
-        let duplicate = self
-            .warnings
-            .iter()
-            .any(|w| w.line == span.line && w.column == span.column && w.message == message);
-        if duplicate {
+        if self.warnings.len() >= MAX_KEPT_WARNINGS {
+            self.dropped += 1;
+            self.last_dropped = (file, span);
             return;
         }
-        let (path, text) = &self.files[file];
-        let mut diagnostics = Diagnostics::new(path, text);
-        diagnostics.warn(span, message);
-        self.warnings.extend(diagnostics.into_warnings());
+        let message = message.into();
+        if self
+            .seen
+            .insert((file, span.line, span.column, message.clone()))
+        {
+            self.warnings.push((file, span, message));
+        }
+    }
+
+    /// The warnings, located, in the order given, and one for those past the limit.
+    fn into_warnings(self) -> Vec<Diagnostic> {
+        let mut indexes: Vec<Option<Diagnostics>> = self.files.iter().map(|_| None).collect();
+        let mut located = |file: usize, span: Span, message: String| {
+            let (path, text) = &self.files[file];
+            indexes[file]
+                .get_or_insert_with(|| Diagnostics::new_shared(path, text))
+                .warning(span, message)
+        };
+        let mut warnings: Vec<Diagnostic> = Vec::with_capacity(self.warnings.len() + 1);
+        for (file, span, message) in self.warnings {
+            warnings.push(located(file, span, message));
+        }
+        if self.dropped > 0 {
+            let (file, span) = self.last_dropped;
+            warnings.push(located(file, span, dropped_message(self.dropped)));
+        }
+        warnings
     }
 }
 
@@ -131,6 +162,6 @@ pub(crate) fn load(
     let parts = build::build(&parsed, &mut files, assets, limits)?;
     Ok(LoadedScene {
         parts,
-        warnings: files.warnings,
+        warnings: files.into_warnings(),
     })
 }

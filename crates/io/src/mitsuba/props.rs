@@ -101,6 +101,9 @@ impl<'e> Props<'e> {
         let error = |span: Span, message: String| files.error(element.file, span, message);
         let plugin = element.value("type").unwrap_or("scene").to_owned();
         let mut list: Vec<Property<'e>> = Vec::new();
+        // The line each name was first given at: a scene holds thousands of objects, and
+        // searching the list for each would be quadratic.
+        let mut named: std::collections::HashMap<String, u32> = std::collections::HashMap::new();
         let mut unnamed = 0;
         for child in &element.children {
             let at = |span| (child.file, span);
@@ -249,18 +252,15 @@ impl<'e> Props<'e> {
                 _ => need_name()?,
             };
             let (file, span) = at(child.span);
-            if let Some(earlier) = list
-                .iter()
-                .find(|p| p.name == name && !name.starts_with("_arg_"))
-            {
-                return Err(files.error(
-                    file,
-                    span,
-                    format!(
-                        "property `{name}` given twice (first at line {})",
-                        earlier.span.line
-                    ),
-                ));
+            if !name.starts_with("_arg_") {
+                if let Some(line) = named.get(&name) {
+                    return Err(files.error(
+                        file,
+                        span,
+                        format!("property `{name}` given twice (first at line {line})"),
+                    ));
+                }
+                named.insert(name.clone(), span.line);
             }
             list.push(Property {
                 name,

@@ -97,18 +97,19 @@ fn within<T: Send + 'static>(limit: Duration, work: impl FnOnce() -> T + Send + 
         .expect("the render did not stop when told to")
 }
 
-/// One pixel of a billion samples, with every integrator: the stop signal, which says stop
-/// from its fourth look on, is heard inside the pixel (the progress callback, heard only
-/// between tiles, never is), and the render hands back no pixel. Before the stop signal was
-/// looked at inside pixels, each of these ran for hours.
+/// One pixel of the most samples a pixel may take (2^24) behind four glass slabs, with every
+/// integrator: the stop signal, which says stop from its fourth look on, is heard inside the
+/// pixel (the progress callback, heard only between tiles, never is), and the render hands
+/// back no pixel. Before the stop signal was looked at inside pixels, each of these ran for
+/// minutes.
 #[test]
-fn a_stop_signal_ends_a_pixel_of_a_billion_samples() {
+fn a_stop_signal_ends_a_pixel_of_the_most_samples() {
     for integrator in IntegratorKind::ALL {
         let looks = within(Duration::from_secs(60), move || {
             let scene = glass_slabs();
             let settings = RenderSettings {
                 threads: Some(2),
-                ..one_pixel(integrator, 1 << 30)
+                ..one_pixel(integrator, crate::MAX_SAMPLES_PER_PIXEL)
             };
             let looks = AtomicU32::new(0);
             let result = render_interruptible(&scene, &settings, &|_| true, &|| {
@@ -135,13 +136,13 @@ fn a_stopped_pass_leaves_the_render_as_it_was() {
             let settings = RenderSettings {
                 width: 3,
                 height: 2,
-                ..one_pixel(integrator, 1 << 30)
+                ..one_pixel(integrator, crate::MAX_SAMPLES_PER_PIXEL)
             };
             let mut passes = ProgressiveRender::new(&settings).unwrap();
             passes.pass(&scene, 4, &|_| true).unwrap();
             let before = passes.film();
             let looks = AtomicU32::new(0);
-            let stopped = passes.pass_interruptible(&scene, 1 << 29, &|_| true, &|| {
+            let stopped = passes.pass_interruptible(&scene, 1 << 23, &|_| true, &|| {
                 looks.fetch_add(1, Ordering::Relaxed) >= 3
             });
             assert_eq!(stopped.unwrap_err(), RenderError::Cancelled);
@@ -330,24 +331,21 @@ fn exact_copies_cost_a_ray_one_test_and_hit_the_first_copy() {
     );
 }
 
-/// Sample counts at the top of `u32`: the course integrator's 65535 x 65535 grid (its
-/// cells, 4,294,836,225, just fit), the path tracers' u32::MAX samples, the last samples of
-/// each through a sample range, and adaptive sampling's checks, with overflow checks on (a
-/// debug build): no arithmetic overflows and the samples are finite.
+/// Sample counts at the cap (`MAX_SAMPLES_PER_PIXEL`, 2^24: the course integrator's
+/// 4096 x 4096 grid, the path tracers' 2^24 samples), the last samples of each through a
+/// sample range, and adaptive sampling's checks at the top of `u32`, with overflow checks on
+/// (a debug build): no arithmetic overflows and the samples are finite. One more sample than
+/// the cap is refused.
 #[test]
-fn the_last_samples_of_a_u32_sample_count_render() {
+fn the_last_samples_of_the_most_samples_a_pixel_may_take() {
     let scene = glass_slabs();
+    let most = crate::MAX_SAMPLES_PER_PIXEL;
     for integrator in IntegratorKind::ALL {
-        let mut settings = one_pixel(integrator, u32::MAX);
+        let mut settings = one_pixel(integrator, most);
         let all = settings.samples_per_pixel();
-        assert_eq!(
-            all,
-            if integrator == IntegratorKind::Path || integrator == IntegratorKind::VolPath {
-                u32::MAX
-            } else {
-                65535 * 65535
-            }
-        );
+        assert_eq!(all, most, "{integrator:?}");
+        assert!(one_pixel(integrator, most + 1).validate().is_err());
+        assert!(one_pixel(integrator, 0).validate().is_err());
         settings.sample_range = Some(all - 3..all);
         settings.features = true;
         let (film, stats) = render(&scene, &settings, &|_| true).unwrap();
