@@ -15,6 +15,10 @@ impl Assets for OneFile {
     fn read(&self, _path: &Path) -> std::io::Result<Vec<u8>> {
         Ok(self.0.clone())
     }
+
+    fn exists(&self, _path: &Path) -> bool {
+        true
+    }
 }
 
 libfuzzer_sys::fuzz_target!(|bytes: &[u8]| {
