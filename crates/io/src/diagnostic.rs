@@ -313,7 +313,10 @@ impl<'text> LineIndex<'text> {
         let block = self
             .chars_before
             .partition_point(|&before| before <= target);
-        let mut block_start = (block.saturating_sub(1) * CHARS_EVERY).max(range.start);
+        // Within the line: a column past its end lands at the end.
+        let mut block_start = (block.saturating_sub(1) * CHARS_EVERY)
+            .max(range.start)
+            .min(range.end);
         while !self.text.is_char_boundary(block_start) {
             block_start -= 1;
         }
