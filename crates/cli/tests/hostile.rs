@@ -2,6 +2,9 @@
 //! a `bad_inputs` suite holds. Every case checks the exit status, where the message points
 //! (`file:line:col`), and that nothing was written: no image, no temporary file.
 
+mod common;
+
+use common::png_declaring;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::time::{Duration, Instant};
@@ -168,38 +171,6 @@ fn mesh_scene(file: &str) -> String {
 
 /// A PNG that declares `width` x `height` but holds one pixel's data: a header must be enough
 /// to refuse it.
-fn png_declaring(width: u32, height: u32) -> Vec<u8> {
-    let mut bytes = Vec::new();
-    image::RgbImage::new(1, 1)
-        .write_to(
-            &mut std::io::Cursor::new(&mut bytes),
-            image::ImageFormat::Png,
-        )
-        .unwrap();
-    // Signature (8), IHDR length (4), "IHDR" (4), width (4), height (4), ..., CRC at 29.
-    assert_eq!(&bytes[12..16], b"IHDR");
-    bytes[16..20].copy_from_slice(&width.to_be_bytes());
-    bytes[20..24].copy_from_slice(&height.to_be_bytes());
-    let crc = crc32(&bytes[12..29]);
-    bytes[29..33].copy_from_slice(&crc.to_be_bytes());
-    bytes
-}
-
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &byte in bytes {
-        crc ^= u32::from(byte);
-        for _ in 0..8 {
-            crc = if crc & 1 == 1 {
-                (crc >> 1) ^ 0xedb8_8320
-            } else {
-                crc >> 1
-            };
-        }
-    }
-    !crc
-}
-
 fn textured_scene(count: usize) -> String {
     let mut extra = String::new();
     for index in 0..count {
