@@ -1,10 +1,11 @@
 #!/bin/bash
 # The farm suite on a real one-node Slurm (loopback, 2 CPUs).
 #   farm/ci.sh install   apt-get slurm-wlm and munge when missing (idempotent)
-#   farm/ci.sh test      start munged, slurmctld and slurmd in a temporary folder, submit a
-#                        4-task array plus the merge job (farm/slurm/submit.sh), wait, compare
+#   farm/ci.sh test      start munged, slurmctld and slurmd in a temporary folder, then submit
+#                        a 4-task array plus the merge job (farm/slurm/submit.sh), wait, compare
 #                        the merged image with a single render bit for bit, stop the daemons.
-#                        GLINT picks the binary (default: a debug build made here).
+#                        GLINT picks the binary (default: a debug build made here), COMPARE the
+#                        exr_compare example (default: built here, in CARGO_TARGET_DIR).
 # Without Slurm the test is SKIPPED with a message, but under CI=1 that is a failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -40,10 +41,11 @@ test_suite() {
   for tool in munged mungekey slurmctld slurmd sbatch squeue sinfo; do
     command -v "$tool" > /dev/null || cannot "$tool is not installed (run farm/ci.sh install)"
   done
-  cargo build --quiet -p glint --example exr_compare
-  cargo build --quiet -p glint
-  glint=${GLINT:-$repo/target/debug/glint}
-  compare="$repo/target/debug/examples/exr_compare"
+  target=${CARGO_TARGET_DIR:-$repo/target}
+  [ -n "${COMPARE:-}" ] || cargo build --quiet -p glint --example exr_compare
+  [ -n "${GLINT:-}" ] || cargo build --quiet -p glint
+  glint=$(realpath "${GLINT:-$target/debug/glint}")
+  compare=$(realpath "${COMPARE:-$target/debug/examples/exr_compare}")
 
   work=$(mktemp -d /tmp/glint-slurm.XXXXXX)
   pids=()
