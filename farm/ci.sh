@@ -2,8 +2,9 @@
 # The farm suite on a real one-node Slurm (loopback, 2 CPUs).
 #   farm/ci.sh install   apt-get slurm-wlm and munge when missing (idempotent)
 #   farm/ci.sh test      start munged, slurmctld and slurmd in a temporary folder, then submit
-#                        a 4-task array plus the merge job (farm/slurm/submit.sh), wait, compare
-#                        the merged image with a single render bit for bit, stop the daemons.
+#                        renders with farm/slurm/submit.sh and check them: a 4-task array plus
+#                        the merge job, tiles and sample ranges, against a single render bit for
+#                        bit; a failed task, the merge that reports it. Stops the daemons.
 #                        GLINT picks the binary (default: a debug build made here), COMPARE the
 #                        exr_compare example (default: built here, in CARGO_TARGET_DIR).
 # Without Slurm the test is SKIPPED with a message, but under CI=1 that is a failure.
@@ -121,10 +122,7 @@ CONF
     ids=$(GLINT="$glint" FARM_SPLIT=$split farm/slurm/submit.sh "$scene" 4 \
       "$work/out/$split.exr" "${args[@]}")
     merge=$(echo "$ids" | awk '/^merge/ {print $2}')
-    for _ in $(seq 300); do
-      [ -z "$(squeue -h -j "$merge" 2> /dev/null)" ] && break
-      sleep 0.5
-    done
+    wait_for "$merge" || true
     wall=$(awk "BEGIN { print $(date +%s.%N) - $start }")
     if [ ! -f "$work/out/$split.exr" ]; then
       echo "FAILED: $split: no merged image" >&2
@@ -146,7 +144,74 @@ CONF
     printf 'slurm: %s: array + merge %.1f s wall, single render (2 threads) %.1f s\n' \
       "$split" "$wall" "$single_time"
   done
+
+  # The cases below use small renders of the same scene, each judged against its own single
+  # render.
+  small=(-w 64 -h 48 -r 16)
+  "$glint" render "$scene" "${small[@]}" -n 2 -o "$work/out/small.exr" 2> "$work/small.log"
+  case_failed_part
   finish
+}
+
+# Waits until job $1 has left the queue (120 s at most). Fails at once when Slurm says it can
+# never run (a dependency that can no longer be satisfied), printing the reason.
+wait_for() {
+  local state
+  for _ in $(seq 240); do
+    state=$(squeue -h -j "$1" -o '%T %r' 2> /dev/null | sort -u) || true
+    [ -n "$state" ] || return 0
+    if [[ $state == *DependencyNeverSatisfied* ]]; then
+      echo "job $1 can never run: $state" >&2
+      return 1
+    fi
+    sleep 0.5
+  done
+  echo "job $1 still queued after 120 s: $state" >&2
+  return 1
+}
+
+# Submits with the suite's glint; the arguments are submit.sh's.
+submit() {
+  GLINT="$glint" farm/slurm/submit.sh "$@"
+}
+
+# A field of `scontrol show job` (e.g. ExitCode, NumCPUs) for job $1, every task on a line.
+job_field() {
+  scontrol -o show job "$1" | grep -o " $2=[^ ]*" | cut -d= -f2-
+}
+
+pass() {
+  echo "passed: $1"
+  passed=$((passed + 1))
+}
+fail() {
+  echo "FAILED: $1" >&2
+  failed=$((failed + 1))
+}
+
+# A task that fails (a checkpoint it cannot read, as a disk error would leave) ends the
+# merge job, which names the part and its log instead of merging.
+case_failed_part() {
+  local out="$work/out/failed.exr" parts="$work/out/failed.exr.parts" ids merge code
+  mkdir -p "$parts"
+  echo "not an EXR" > "$parts/part-1.checkpoint.exr"
+  ids=$(submit "$scene" 4 "$out" "${small[@]}") || true
+  merge=$(echo "$ids" | awk '/^merge/ {print $2}')
+  if [ -z "$merge" ] || ! wait_for "$merge"; then
+    fail "failed part: the merge job never ran"
+    scancel "$merge" 2> /dev/null || true
+    return
+  fi
+  code=$(job_field "$merge" ExitCode)
+  if [ -e "$out" ] || [ "$code" = 0:0 ] ||
+    ! grep -q "part 1 failed.*part-1.exr.*$parts/part-1.log" "$parts/merge.log" ||
+    grep -q "part [023] failed" "$parts/merge.log"; then
+    fail "failed part: merge exit $code, image $([ -e "$out" ] && echo written || echo absent), merge.log:"
+    cat "$parts/merge.log" >&2
+    return
+  fi
+  pass "a failed task ends the merge job (exit $code), which names part 1 and its log"
+  sed 's/^/  merge.log: /' "$parts/merge.log"
 }
 
 case "${1:-}" in
