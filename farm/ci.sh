@@ -4,7 +4,8 @@
 #   farm/ci.sh test      start munged, slurmctld and slurmd in a temporary folder, then submit
 #                        renders with farm/slurm/submit.sh and check them: a 4-task array plus
 #                        the merge job, tiles and sample ranges, against a single render bit for
-#                        bit; a failed task, the merge that reports it. Stops the daemons.
+#                        bit; a failed task, the merge that reports it and the resubmit that
+#                        renders only it. Stops the daemons.
 #                        GLINT picks the binary (default: a debug build made here), COMPARE the
 #                        exr_compare example (default: built here, in CARGO_TARGET_DIR).
 # Without Slurm the test is SKIPPED with a message, but under CI=1 that is a failure.
@@ -149,7 +150,7 @@ CONF
   # render.
   small=(-w 64 -h 48 -r 16)
   "$glint" render "$scene" "${small[@]}" -n 2 -o "$work/out/small.exr" 2> "$work/small.log"
-  case_failed_part
+  case_failed_part_and_resubmit
   finish
 }
 
@@ -190,8 +191,9 @@ fail() {
 }
 
 # A task that fails (a checkpoint it cannot read, as a disk error would leave) ends the
-# merge job, which names the part and its log instead of merging.
-case_failed_part() {
+# merge job, which names the part and its log instead of merging; the same command again
+# renders only that part, and the merge then equals the single render.
+case_failed_part_and_resubmit() {
   local out="$work/out/failed.exr" parts="$work/out/failed.exr.parts" ids merge code
   mkdir -p "$parts"
   echo "not an EXR" > "$parts/part-1.checkpoint.exr"
@@ -212,6 +214,47 @@ case_failed_part() {
   fi
   pass "a failed task ends the merge job (exit $code), which names part 1 and its log"
   sed 's/^/  merge.log: /' "$parts/merge.log"
+
+  local before after
+  before=$(stat -c '%n %i %y' "$parts"/part-{0,2,3}.exr)
+  rm "$parts/part-1.checkpoint.exr"
+  ids=$(submit "$scene" 4 "$out" "${small[@]}" 2> "$work/resubmit.err") || true
+  merge=$(echo "$ids" | awk '/^merge/ {print $2}')
+  local array
+  array=$(echo "$ids" | awk '/^array/ {print $2}')
+  wait_for "$merge" || true
+  after=$(stat -c '%n %i %y' "$parts"/part-{0,2,3}.exr)
+  local tasks
+  tasks=$(scontrol -o show job "$array" | grep -o ' ArrayTaskId=[^ ]*' | cut -d= -f2 | tr '\n' ' ')
+  if [ "$before" != "$after" ] || [ "$tasks" != "1 " ]; then
+    fail "resubmit: tasks run: $tasks; parts 0, 2, 3 $([ "$before" = "$after" ] && echo kept || echo rendered again)"
+  elif ! result=$("$compare" "$out" "$work/out/small.exr" 2>&1); then
+    fail "resubmit: $result"
+    cat "$parts/merge.log" >&2
+  else
+    pass "resubmit renders only part 1 ($(cat "$work/resubmit.err")), merge == single render: $result"
+  fi
+
+  # Other arguments for the same OUT: refused, unless FARM_RESTART=1 starts over.
+  local message
+  if message=$(submit "$scene" 4 "$out" -w 64 -h 48 -r 4 2>&1) ||
+    [[ $message != *"-r 4"* || $message != *FARM_RESTART=1* ]]; then
+    fail "resubmit with -r 4 instead of -r 16 was not refused as it should be: $message"
+    return
+  fi
+  "$glint" render "$scene" -w 64 -h 48 -r 4 -n 2 -o "$work/out/small-r4.exr" 2> /dev/null
+  ids=$(FARM_RESTART=1 submit "$scene" 4 "$out" -w 64 -h 48 -r 4) || true
+  array=$(echo "$ids" | awk '/^array/ {print $2}')
+  merge=$(echo "$ids" | awk '/^merge/ {print $2}')
+  wait_for "$merge" || true
+  tasks=$(scontrol -o show job "$array" | grep -o ' ArrayTaskId=[^ ]*' | cut -d= -f2 | sort | tr '\n' ' ')
+  if [ "$tasks" != "0 1 2 3 " ]; then
+    fail "FARM_RESTART=1: tasks run: $tasks, not all 4"
+  elif ! result=$("$compare" "$out" "$work/out/small-r4.exr" 2>&1); then
+    fail "FARM_RESTART=1: $result"
+  else
+    pass "other arguments for the same OUT are refused; FARM_RESTART=1 renders all parts again: $result"
+  fi
 }
 
 case "${1:-}" in

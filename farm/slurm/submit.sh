@@ -11,10 +11,15 @@
 #
 # The render arguments (-w, -h, -r, --integrator, --seed, ...) go to every task unchanged.
 #
+# Resubmitting the same SCENE N OUT and arguments after a failure submits only the parts not
+# yet in OUT.parts (each resumes from its checkpoint), then the merge. OUT.parts/submission
+# records what the parts were rendered with; a resubmit with other arguments is refused
+# unless FARM_RESTART=1, which deletes the old parts, checkpoints and logs first.
+#
 # Environment: GLINT (the glint binary, default `glint` on PATH; give an absolute path),
-# FARM_SPLIT (tiles | samples), GLINT_CHECKPOINT_EVERY (seconds, 60), SBATCH_ARGS (extra
-# sbatch options for both jobs, e.g. "--partition=render --time=1:00:00").
-# Prints the two job ids: `array JOBID` and `merge JOBID`.
+# FARM_SPLIT (tiles | samples), GLINT_CHECKPOINT_EVERY (seconds, 60), FARM_RESTART (1: start
+# over), SBATCH_ARGS (extra sbatch options for both jobs, e.g. "--partition=render
+# --time=1:00:00"). Prints `array JOBID` (unless every part is already done) and `merge JOBID`.
 set -euo pipefail
 if [ $# -lt 3 ]; then
   awk 'NR > 1 && !/^#/ { exit } NR > 1' "$0" >&2
@@ -38,16 +43,75 @@ args=("$@")
 scene=$(realpath "$scene")
 out=$(realpath -m "$out")
 parts="$out.parts"
+record="$parts/submission"
 mkdir -p "$parts"
 
-# shellcheck disable=SC2086 # SBATCH_ARGS is a list of options.
-array=$(sbatch --parsable ${SBATCH_ARGS:-} \
-  --array="0-$((count - 1))" --output="$parts/part-%a.log" \
-  "$here/render.sbatch" "$split" "$count" "$scene" "$parts" "${args[@]}")
-array=${array%%;*}
+# What the parts are rendered with, so that a resubmit reuses only parts of this render. The
+# thread count is left out: it does not change the image.
+submission=$(
+  echo "# farm/slurm/submit.sh: the parts in this folder are of this render"
+  echo "split $split"
+  echo "count $count"
+  echo "scene $scene"
+  echo "scene-sha256 $(sha256sum < "$scene" | cut -d' ' -f1)"
+  printf 'args'
+  printf ' %q' "${args[@]}"
+  echo
+)
+# A resubmit while the last submission still runs would render its parts twice.
+if [ -f "$parts/jobs" ]; then
+  read -r -a previous < "$parts/jobs"
+  if [ -n "$(squeue -h -j "$(IFS=,; echo "${previous[*]}")" 2> /dev/null)" ]; then
+    die "the last submission for $out (jobs ${previous[*]}) is still queued or running: wait for it, or scancel ${previous[*]}"
+  fi
+fi
+# Checkpoints are not counted: glint refuses to resume one of other settings.
+old_parts=$(find "$parts" -maxdepth 1 -regex '.*/part-[0-9]+\.exr' -print -quit)
+if [ "${FARM_RESTART:-}" = 1 ]; then
+  find "$parts" -maxdepth 1 \( -name 'part-*.exr' -o -name 'part-*.log' -o -name merge.log \
+    -o -name submission -o -name jobs \) -delete
+elif [ -f "$record" ] && [ "$(cat "$record")" != "$submission" ]; then
+  echo "error: $parts holds parts of another render; what differs (< then, > now):" >&2
+  diff <(grep -v '^#' "$record") <(grep -v '^#' <<< "$submission") | grep '^[<>]' >&2 || true
+  die "resubmit with the same arguments to finish that render, or set FARM_RESTART=1 to delete its parts and start over"
+elif [ ! -f "$record" ] && [ -n "$old_parts" ]; then
+  die "$parts holds parts with no record of what they were rendered with ($record); set FARM_RESTART=1 to delete them and start over"
+fi
+echo "$submission" > "$record"
+
+# Parts are written atomically (glint renames a finished image into place), so a part that
+# exists is complete.
+todo=() ranges=''
+for ((i = 0; i < count; i++)); do
+  [ -f "$parts/part-$i.exr" ] || todo+=("$i")
+done
+# Slurm's --array list, runs of indices as ranges: 0-9,12,14-15.
+for ((k = 0; k < ${#todo[@]}; k = j + 1)); do
+  for ((j = k; j + 1 < ${#todo[@]} && todo[j + 1] == todo[j] + 1; j++)); do :; done
+  ranges+=${ranges:+,}${todo[k]}
+  [ "$j" -eq "$k" ] || ranges+=-${todo[j]}
+done
+dependency=()
+jobs=()
+if [ ${#todo[@]} -gt 0 ]; then
+  # shellcheck disable=SC2086 # SBATCH_ARGS is a list of options.
+  array=$(sbatch --parsable ${SBATCH_ARGS:-} \
+    --array="$ranges" --output="$parts/part-%a.log" \
+    "$here/render.sbatch" "$split" "$count" "$scene" "$parts" "${args[@]}")
+  array=${array%%;*}
+  dependency=(--dependency="afterany:$array")
+  jobs+=("$array")
+  if [ ${#todo[@]} -lt "$count" ]; then
+    echo "rendering parts $ranges of 0-$((count - 1)); the others are done" >&2
+  fi
+else
+  echo "all $count parts are done: submitting the merge only" >&2
+fi
 # shellcheck disable=SC2086
-merge=$(sbatch --parsable ${SBATCH_ARGS:-} --dependency="afterany:$array" \
+merge=$(sbatch --parsable ${SBATCH_ARGS:-} "${dependency[@]}" \
   --output="$parts/merge.log" "$here/merge.sbatch" "$count" "$parts" "$out")
 merge=${merge%%;*}
-echo "array $array"
+jobs+=("$merge")
+echo "${jobs[*]}" > "$parts/jobs"
+[ ${#todo[@]} -eq 0 ] || echo "array $array"
 echo "merge $merge"
