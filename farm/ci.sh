@@ -4,8 +4,9 @@
 #   farm/ci.sh test      start munged, slurmctld and slurmd in a temporary folder, then submit
 #                        renders with farm/slurm/submit.sh and check them: a 4-task array plus
 #                        the merge job, tiles and sample ranges, against a single render bit for
-#                        bit; a failed task, the merge that reports it and the resubmit that
-#                        renders only it. Stops the daemons.
+#                        bit; render arguments refused or honoured (-o, -n); a failed task, the
+#                        merge that reports it and the resubmit that renders only it. Stops
+#                        the daemons.
 #                        GLINT picks the binary (default: a debug build made here), COMPARE the
 #                        exr_compare example (default: built here, in CARGO_TARGET_DIR).
 # Without Slurm the test is SKIPPED with a message, but under CI=1 that is a failure.
@@ -150,6 +151,8 @@ CONF
   # render.
   small=(-w 64 -h 48 -r 16)
   "$glint" render "$scene" "${small[@]}" -n 2 -o "$work/out/small.exr" 2> "$work/small.log"
+  case_refused_arguments
+  case_threads
   case_failed_part_and_resubmit
   finish
 }
@@ -188,6 +191,62 @@ pass() {
 fail() {
   echo "FAILED: $1" >&2
   failed=$((failed + 1))
+}
+
+# Options that render.sbatch sets itself are refused before anything is submitted: exit 2,
+# a message naming the option, no parts folder. Each case: the name expected|the arguments.
+case_refused_arguments() {
+  local cases=("-o|-o x.png" "-o|-ox.png" "--outputfile|--outputfile=x.png" "-o|-vo x.png"
+    "--tile|--tile 1/4" "--sample-range|--sample-range=0/2" "--resume|--resume ck.exr"
+    "--checkpoint|--checkpoint ck.exr" "--time|--time 10" "--crop-window|--crop-window 0,1,0,1"
+    "-x|-x 64" "'extra'|extra")
+  local bad=0 i name words out message rc
+  for ((i = 0; i < ${#cases[@]}; i++)); do
+    name=${cases[i]%%|*}
+    read -r -a words <<< "${cases[i]#*|}"
+    out="$work/out/refused-$i.exr"
+    message=$(submit "$scene" 2 "$out" "${small[@]}" "${words[@]}" 2>&1) && rc=0 || rc=$?
+    if [ "$rc" -ne 2 ] || [[ $message != *"$name"* ]] || [ -e "$out.parts" ]; then
+      echo "  submit.sh ... ${words[*]}: exit $rc, parts folder $([ -e "$out.parts" ] && echo made || echo absent), message: $message" >&2
+      bad=$((bad + 1))
+    fi
+  done
+  if [ "$bad" -gt 0 ]; then
+    fail "$bad of ${#cases[@]} kinds of render arguments the farm cannot honour were not refused"
+  else
+    pass "${#cases[@]} kinds of render arguments the farm cannot honour are refused with exit 2, nothing submitted"
+  fi
+  message=$(submit "$scene" 2 "$work/out/refused.exr" "${small[@]}" -o x.png 2>&1) || true
+  echo "  e.g. $message"
+}
+
+# -n THREADS in every form clap takes becomes the tasks' --cpus-per-task (and glint's -n),
+# and the image is still the single render's.
+case_threads() {
+  local forms=("-n 2" "-n2" "--numcpus 2" "--numcpus=2") arrays=() merges=() i ids words cpus out
+  for ((i = 0; i < ${#forms[@]}; i++)); do
+    read -r -a words <<< "${forms[i]}"
+    ids=$(submit "$scene" 2 "$work/out/threads$i.exr" "${small[@]}" "${words[@]}") || true
+    arrays+=("$(echo "$ids" | awk '/^array/ {print $2}')")
+    merges+=("$(echo "$ids" | awk '/^merge/ {print $2}')")
+  done
+  for ((i = 0; i < ${#forms[@]}; i++)); do
+    out="$work/out/threads$i.exr"
+    if [ -z "${merges[i]}" ]; then
+      fail "submit.sh ${forms[i]}: refused"
+      continue
+    fi
+    wait_for "${merges[i]}" || scancel "${merges[i]}"
+    cpus=$(job_field "${arrays[i]}" NumCPUs | sort -u | tr '\n' ' ')
+    if [ "$cpus" != "2 " ]; then
+      fail "submit.sh ${forms[i]}: the tasks were given NumCPUs=$cpus, not 2"
+    elif ! result=$("$compare" "$out" "$work/out/small.exr" 2>&1); then
+      fail "submit.sh ${forms[i]}: $result"
+      tail -n 3 "$out.parts"/*.log >&2 || true
+    else
+      pass "submit.sh ${forms[i]}: tasks with 2 CPUs each, merge == single render: $result"
+    fi
+  done
 }
 
 # A task that fails (a checkpoint it cannot read, as a disk error would leave) ends the
