@@ -5,8 +5,8 @@
 #                        renders with farm/slurm/submit.sh and check them: a 4-task array plus
 #                        the merge job, tiles and sample ranges, against a single render bit for
 #                        bit; render arguments refused or honoured (-o, -n); a failed task, the
-#                        merge that reports it and the resubmit that renders only it. Stops
-#                        the daemons.
+#                        merge that reports it and the resubmit that renders only it; a task
+#                        requeued mid-render that resumes from its checkpoint. Stops the daemons.
 #                        GLINT picks the binary (default: a debug build made here), COMPARE the
 #                        exr_compare example (default: built here, in CARGO_TARGET_DIR).
 # Without Slurm the test is SKIPPED with a message, but under CI=1 that is a failure.
@@ -78,6 +78,8 @@ AuthType=auth/munge
 AuthInfo=socket=$work/munge.sock
 CredType=cred/munge
 MpiDefault=none
+# Many sites do not requeue jobs unless asked: the farm scripts must ask (--requeue).
+JobRequeue=0
 ProctrackType=proctrack/linuxproc
 TaskPlugin=task/none
 SelectType=select/cons_tres
@@ -154,6 +156,7 @@ CONF
   case_refused_arguments
   case_threads
   case_failed_part_and_resubmit
+  case_requeue
   finish
 }
 
@@ -313,6 +316,50 @@ case_failed_part_and_resubmit() {
     fail "FARM_RESTART=1: $result"
   else
     pass "other arguments for the same OUT are refused; FARM_RESTART=1 renders all parts again: $result"
+  fi
+}
+
+# A task requeued mid-render (as preemption does) gets SIGTERM, checkpoints, runs again and
+# resumes from its checkpoint; the merge still equals the single render. JobRequeue=0 in this
+# cluster's slurm.conf, so this needs the tasks' --requeue.
+case_requeue() {
+  # Tall enough for eight bands of rows, so that the first checkpoint comes early in the tile.
+  local long=(-w 64 -h 128 -r 1024) out="$work/out/requeue.exr" parts="$work/out/requeue.exr.parts"
+  local ids array merge state
+  "$glint" render "$scene" "${long[@]}" -n 2 -o "$work/out/long.exr" 2> /dev/null
+  ids=$(GLINT_CHECKPOINT_EVERY=0 submit "$scene" 2 "$out" "${long[@]}") || true
+  array=$(echo "$ids" | awk '/^array/ {print $2}')
+  merge=$(echo "$ids" | awk '/^merge/ {print $2}')
+  # Requeue task 0 once it has checkpointed part of its tile.
+  for _ in $(seq 300); do
+    [ -f "$parts/part-0.checkpoint.exr" ] && break
+    sleep 0.1
+  done
+  if [ -f "$parts/part-0.exr" ]; then
+    fail "requeue: task 0 finished before it could be requeued (a render too short for this machine)"
+    return
+  fi
+  if ! scontrol requeue "${array}_0" 2> "$work/requeue.err"; then
+    fail "scontrol requeue of a running task: $(cat "$work/requeue.err")"
+    scancel "$array" "$merge" 2> /dev/null || true
+    return
+  fi
+  # Slurm holds a requeued job back for a while (BeginTime); let it start at once.
+  for _ in $(seq 100); do
+    state=$(squeue -h -j "${array}_0" -o %T 2> /dev/null) || true
+    [ "$state" = PENDING ] && break
+    sleep 0.1
+  done
+  scontrol update JobId="${array}_0" StartTime=now 2> /dev/null || true
+  wait_for "$merge" || true
+  if ! grep -q "run 2" "$parts/part-0.log" || ! grep -q "resuming" "$parts/part-0.log"; then
+    fail "requeue: task 0 did not run again from its checkpoint; its log:"
+    cat "$parts/part-0.log" >&2
+  elif ! result=$("$compare" "$out" "$work/out/long.exr" 2>&1); then
+    fail "requeue: $result"
+    cat "$parts/merge.log" >&2
+  else
+    pass "a task requeued mid-render resumes from its checkpoint ($(grep -o 'resuming.*' "$parts/part-0.log")), merge == single render: $result"
   fi
 }
 

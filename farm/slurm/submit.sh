@@ -7,7 +7,8 @@
 # range I/N of every pixel (FARM_SPLIT=samples) into OUT.parts/part-I.exr. The merge job runs
 # once every task has ended: it runs `glint merge -o OUT` on the N parts, which checks that
 # they fit together, or, when a part is missing, exits 1 naming each missing part and its log.
-# OUT is .exr or .png. Logs: OUT.parts/part-I.log and OUT.parts/merge.log.
+# OUT is .exr or .png. Logs: OUT.parts/part-I.log (appended to by every run of task I) and
+# OUT.parts/merge.log.
 #
 # The render arguments (-w, -h, -r, --integrator, --seed, ...) go to every task unchanged,
 # except -n/--numcpus THREADS, which becomes the tasks' --cpus-per-task, and
@@ -20,6 +21,11 @@
 # yet in OUT.parts (each resumes from its checkpoint), then the merge. OUT.parts/submission
 # records what the parts were rendered with; a resubmit with other arguments is refused
 # unless FARM_RESTART=1, which deletes the old parts, checkpoints and logs first.
+#
+# Each task is submitted with --requeue --signal=B:TERM@120 --open-mode=append (render.sbatch):
+# a task that is preempted or requeued gets SIGTERM, writes its checkpoint and continues from
+# it when Slurm runs it again; one that reaches its time limit gets SIGTERM two minutes before
+# it and writes its checkpoint, and a resubmit continues it. SBATCH_ARGS overrides these.
 #
 # Environment: GLINT (the glint binary, default `glint` on PATH; give an absolute path),
 # FARM_SPLIT (tiles | samples), GLINT_CHECKPOINT_EVERY (seconds, 60), FARM_RESTART (1: start
