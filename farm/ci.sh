@@ -53,7 +53,29 @@ test_suite() {
   work=$(mktemp -d /tmp/glint-slurm.XXXXXX)
   pids=()
   stop() {
+    # A case that failed can leave jobs queued or running; slurmd does not stop on SIGTERM
+    # while a job step runs, so cancel them and let the queue drain first (10 s at most).
+    if [ -n "${SLURM_CONF:-}" ]; then
+      local left
+      left=$(squeue -h -o %A 2> /dev/null | tr '\n' ' ') || true
+      if [ -n "${left// /}" ]; then
+        # shellcheck disable=SC2086 # a list of job ids
+        scancel $left 2> /dev/null || true
+        for _ in $(seq 20); do
+          [ -z "$(squeue -h 2> /dev/null)" ] && break
+          sleep 0.5
+        done
+      fi
+    fi
     for pid in "${pids[@]}"; do kill "$pid" 2> /dev/null || true; done
+    # Then SIGKILL whatever of ours did not stop, so that the suite never hangs here.
+    for _ in $(seq 20); do
+      local alive=0
+      for pid in "${pids[@]}"; do kill -0 "$pid" 2> /dev/null && alive=1; done
+      [ "$alive" = 0 ] && break
+      sleep 0.5
+    done
+    for pid in "${pids[@]}"; do kill -KILL "$pid" 2> /dev/null || true; done
     for pid in "${pids[@]}"; do wait "$pid" 2> /dev/null || true; done
     rm -rf "$work"
   }
