@@ -30,26 +30,58 @@ from __future__ import annotations
 
 import importlib.util
 import json
+import math
+import numbers
 import os
 import sys
 import warnings
 from collections.abc import Mapping
-from typing import Callable, Union
+from typing import Any, Callable, Union
 
 import numpy as np
 
-from glint import _glint
-from glint._glint import TILE_SIZE, DenoiserUnavailable, Scene, SceneError, SceneWarning
+try:
+    from glint import _glint
+except ImportError as error:
+    # Run from inside python/, `import glint` finds this source folder, which has no compiled
+    # module, before the installed package; Python then reports a confusing circular import.
+    _here = os.path.dirname(os.path.abspath(__file__))
+    _compiled = [
+        name for name in os.listdir(_here) if name.startswith("_glint") and name != "_glint.pyi"
+    ]
+    if _compiled or getattr(error, "name", None) not in ("glint._glint", "glint"):
+        raise
+    raise ImportError(
+        f"glint's native module is missing: this `glint` is the source folder {_here}, which "
+        "has no compiled `_glint` module (Python looks in the current directory, or the "
+        "script's, before the installed packages). "
+        "Run Python from another directory to use the installed glint (pip install ./python), "
+        "or build the module into this folder with `maturin develop --release` (in python/, "
+        "inside a virtual environment)."
+    ) from error
+from glint._glint import (
+    TILE_SIZE,
+    DenoiserUnavailable,
+    GpuUnavailable,
+    Scene,
+    SceneError,
+    SceneWarning,
+)
 
 __all__ = [
     "BALL",
     "INTEGRATORS",
     "RGB",
     "TILE_SIZE",
+    "DEVICES",
     "DenoiserUnavailable",
+    "GpuUnavailable",
+    "Image",
     "Scene",
     "SceneError",
     "SceneWarning",
+    "TONEMAPS",
+    "TRANSFERS",
     "denoise",
     "load_scene",
     "load_scene_text",
@@ -66,6 +98,119 @@ RGB = tuple[float, float, float]
 
 #: The integrators :func:`render` knows, as the CLI's ``--integrator`` names them.
 INTEGRATORS = ("course", "path", "volpath", "normals", "albedo", "depth")
+#: Where :func:`render` runs, as the CLI's ``--device`` names them.
+DEVICES = ("cpu", "gpu")
+#: The tone curves of :func:`write_image`, as the CLI's ``--tonemap`` names them.
+TONEMAPS = ("clamp", "none", "aces", "agx")
+#: The transfer functions of :func:`write_image`, as the CLI's ``--transfer`` names them.
+TRANSFERS = ("srgb", "linear")
+
+# The CLI's limits (crates/cli/src/args.rs), from the native module.
+_MAX_SIDE = _glint.MAX_SIDE
+_MAX_DEPTH = _glint.MAX_DEPTH
+_MAX_THREADS = _glint.MAX_THREADS
+_MAX_SPP = _glint.MAX_SPP
+_MAX_SEED = 2**64 - 1
+_MAX_EXPOSURE = 64.0
+
+
+# Argument checks: a wrong type raises TypeError, a wrong value ValueError, each naming the
+# argument and what it accepts, as the CLI names its flags.
+
+
+def _int(name: str, value: Any, low: int, high: int | None = None) -> int:
+    if isinstance(value, bool) or not isinstance(value, numbers.Integral):
+        raise TypeError(f"{name} must be an int, not {type(value).__name__}")
+    value = int(value)
+    if high is None and value < low:
+        raise ValueError(f"{name} must be at least {low}, got {value}")
+    if high is not None and not low <= value <= high:
+        raise ValueError(f"{name} must be between {low} and {high}, got {value}")
+    return value
+
+
+def _opt_int(name: str, value: Any, low: int, high: int | None = None) -> int | None:
+    return None if value is None else _int(name, value, low, high)
+
+
+def _real(name: str, value: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name} must be a number, not {type(value).__name__}")
+    return float(value)
+
+
+def _non_negative(name: str, value: Any) -> float:
+    number = _real(name, value)
+    if not (math.isfinite(number) and number >= 0):
+        raise ValueError(f"{name} must be a finite number >= 0, got {value!r}")
+    return number
+
+
+def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a str, one of {', '.join(choices)}, not {value!r}")
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {', '.join(choices)}, got {value!r}")
+    return value
+
+
+def _bool(name: str, value: Any) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise TypeError(f"{name} must be True or False, not {value!r}")
+    return bool(value)
+
+
+def _path(name: str, value: Any) -> str:
+    if not isinstance(value, (str, os.PathLike)):
+        raise TypeError(f"{name} must be a path (str or os.PathLike), not {type(value).__name__}")
+    path = os.fspath(value)
+    if not isinstance(path, str):
+        raise TypeError(f"{name} must be a str path, not {type(path).__name__}")
+    return path
+
+
+def _str(name: str, value: Any) -> str:
+    if not isinstance(value, str):
+        raise TypeError(f"{name} must be a str, not {type(value).__name__}")
+    return value
+
+
+def _exposure(value: Any) -> float:
+    exposure = _real("exposure", value)
+    if not (math.isfinite(exposure) and abs(exposure) <= _MAX_EXPOSURE):
+        raise ValueError(f"exposure must be between -64 and 64 (stops), got {value!r}")
+    return exposure
+
+
+class Image(np.ndarray):
+    """A rendered image: :func:`render`'s float32 ``(H, W, 3)`` array, which also says how it
+    was made, so that :func:`write_image` writes its PNG as ``glint render`` would.
+
+    It is a numpy array in every other way; slices, copies and arithmetic on it keep
+    ``integrator``, and ``np.asarray(image)`` is the plain array.
+    """
+
+    #: The integrator that rendered it (one of :data:`INTEGRATORS`), or ``None``.
+    integrator: str | None
+
+    def __array_finalize__(self, obj: object) -> None:
+        self.integrator = getattr(obj, "integrator", None)
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        # numpy pickles the array alone; the integrator goes along with it.
+        rebuild, arguments, state = super().__reduce__()  # type: ignore[misc]
+        return rebuild, arguments, (state, self.integrator)
+
+    def __setstate__(self, state: Any) -> None:
+        array_state, self.integrator = state
+        super().__setstate__(array_state)
+
+
+def _image(array: np.ndarray, integrator: str) -> Image:
+    image = array.view(Image)
+    image.integrator = integrator
+    return image
+
 
 #: A red ball in front of a grey background, lit by a point light: the course's JSON as a dict.
 BALL = {
@@ -144,11 +289,11 @@ def load_scene(
     FileNotFoundError: [Errno 2] No such file or directory: 'no/such/scene.xml'
     """
     loaded = _glint.load_scene(
-        os.fspath(path),
+        _path("path", path),
         _rgb(background),
         _defines(defines),
         *_model(scene, camera, env),
-        env_strength,
+        _non_negative("env_strength", env_strength),
     )
     _issue_warnings(loaded)
     return loaded
@@ -158,15 +303,14 @@ def _model(
     scene: int | None, camera: str | int | None, env: PathLike | None
 ) -> tuple[int | None, str | None, str | None]:
     """``scene``, ``camera`` and ``env`` as the native module takes them."""
-    if scene is not None and (isinstance(scene, bool) or not isinstance(scene, int)):
+    if scene is not None and (isinstance(scene, bool) or not isinstance(scene, numbers.Integral)):
         raise TypeError(f"scene must be an index (int), not {type(scene).__name__}")
-    if camera is not None and (isinstance(camera, bool) or not isinstance(camera, (str, int))):
-        raise TypeError(f"camera must be a name (str) or an index (int), not {camera!r}")
-    return (
-        scene,
-        None if camera is None else str(camera),
-        None if env is None else os.fspath(env),
-    )
+    scene = _opt_int("scene", scene, 0)
+    if camera is not None and not isinstance(camera, str):
+        if isinstance(camera, bool) or not isinstance(camera, numbers.Integral):
+            raise TypeError(f"camera must be a name (str) or an index (int), not {camera!r}")
+        camera = str(_int("camera", camera, 0))
+    return (scene, camera, None if env is None else _path("env", env))
 
 
 def _defines(defines: Mapping[str, str] | None) -> list[tuple[str, str]] | None:
@@ -180,18 +324,26 @@ def _defines(defines: Mapping[str, str] | None) -> list[tuple[str, str]] | None:
     return list(defines.items())
 
 
-def _rgb(background: RGB | None) -> RGB | None:
+def _rgb(background: RGB | None, name: str = "background") -> RGB | None:
     if background is None:
         return None
+    if isinstance(background, (str, bytes)) or not hasattr(background, "__len__"):
+        raise TypeError(f"{name} must be three numbers (r, g, b), not {background!r}")
+    if len(background) != 3:
+        raise ValueError(f"{name} must have three components (r, g, b), got {len(background)}")
+    for c in background:
+        if isinstance(c, bool) or not isinstance(c, numbers.Real):
+            raise TypeError(f"{name} must be three numbers (r, g, b), not {background!r}")
     r, g, b = (float(c) for c in background)
+    if not all(math.isfinite(c) and c >= 0 for c in (r, g, b)):
+        raise ValueError(f"{name} components must be finite and >= 0, got {tuple(background)!r}")
     return (r, g, b)
 
 
 def _text_path(format: str, base_dir: PathLike | None, name: str | None) -> str:
-    if format not in ("json", "xml", "gltf"):
-        raise ValueError(f"format must be 'json', 'xml' or 'gltf', not {format!r}")
-    name = name if name is not None else f"<text>.{format}"
-    return name if base_dir is None else os.path.join(os.fspath(base_dir), name)
+    _choice("format", format, ("json", "xml", "gltf"))
+    name = f"<text>.{format}" if name is None else _str("name", name)
+    return name if base_dir is None else os.path.join(_path("base_dir", base_dir), name)
 
 
 def load_scene_text(
@@ -237,6 +389,8 @@ def load_scene_text(
     Traceback (most recent call last):
     glint.SceneError: <text>.gltf:...: ...top...
     """
+    text = _str("text", text)
+    _choice("format", format, ("json", "xml", "gltf"))
     first = text.lstrip("\ufeff \t\r\n")[:1]
     if (format == "xml" and first in ("{", "[")) or (format in ("json", "gltf") and first == "<"):
         raise ValueError(f"format={format!r}, but the text starts with {first!r}")
@@ -247,7 +401,7 @@ def load_scene_text(
         _rgb(background),
         _defines(defines),
         *_model(scene, camera, env),
-        env_strength,
+        _non_negative("env_strength", env_strength),
     )
     _issue_warnings(loaded)
     return loaded
@@ -273,8 +427,15 @@ def scene_from_dict(
         "bgColor": "0.2 0.2"
                    ^
     """
-    text = json.dumps(scene, indent=2)
-    path = _text_path("json", base_dir, name)
+    if not isinstance(scene, Mapping):
+        raise TypeError(
+            f"scene must be a dict (the course's JSON document), not {type(scene).__name__}"
+        )
+    try:
+        text = json.dumps(scene, indent=2)
+    except (TypeError, ValueError) as error:
+        raise TypeError(f"scene must hold JSON values only: {error}") from None
+    path = _text_path("json", base_dir, _str("name", name))
     loaded = _glint.load_scene_text(text, path, _rgb(background))
     _issue_warnings(loaded)
     return loaded
@@ -308,8 +469,13 @@ def render(
     crop: Crop | None = None,
     features: bool = False,
     progress: Callable[[float], object] | None = None,
-) -> np.ndarray | dict[str, np.ndarray]:
-    """Renders ``scene`` into a linear float32 array of shape ``(height, width, 3)``.
+    device: str = "cpu",
+    background: RGB | None = None,
+    depth: float = 0.0,
+    aperture: float | None = None,
+) -> Image | dict[str, np.ndarray]:
+    """Renders ``scene`` into a linear float32 array of shape ``(height, width, 3)``, an
+    :class:`Image` that remembers its integrator for :func:`write_image`.
 
     The arguments are the CLI's: ``spp`` samples per pixel (``-r``; the course's integrators
     take them on an N x N grid, N = floor(sqrt(spp))), ``integrator`` one of
@@ -327,6 +493,22 @@ def render(
     (``np.s_[y0:y1, x0:x1]``): ``render(s, crop=c)`` equals ``render(s)[c]``, bit for bit.
     With ``features=True`` the result is a dict: ``beauty``, ``albedo`` and ``normal``
     (``(H, W, 3)``) and ``depth`` (``(H, W)``), the first-hit layers a denoiser takes.
+
+    ``device="gpu"`` runs the path tracer (``integrator="path"`` only) on the GPU with wgpu on
+    Vulkan, as the CLI's ``--device gpu``: the same image in distribution, not pixel for
+    pixel; :class:`GpuUnavailable` (a ``RuntimeError``) when there is no adapter, and
+    ``ValueError`` for what the GPU does not do (other integrators, depth of field).
+    ``background=(r, g, b)`` replaces the scene's background for this render (the CLI's
+    ``--background``). ``depth`` turns on depth of field, focused at that distance along the
+    view direction (the CLI's ``-d``/``--depth``; 0, the default, is the course's pinhole), with
+    a lens of radius ``aperture`` in scene units (``--aperture``; default 1/50 of the width the
+    image covers at the focus distance). With ``background`` or ``depth`` the scene is read
+    again from its source (as when unpickled) and built once for them; the last such scene is
+    kept for the next call with the same ones.
+
+    Every argument is checked first: a wrong type raises ``TypeError``, a value out of range
+    ``ValueError``, each naming the argument and the CLI's limits (``width`` and ``height`` 1 to
+    65535, ``spp`` 1 to 16777216, ``max_depth`` 0 to 100, ``threads`` 1 to 1024).
 
     Samples that come out NaN or infinite are left out of their pixels, as in the CLI, with a
     ``RuntimeWarning`` saying how many and where the first was.
@@ -346,11 +528,35 @@ def render(
     >>> corner.shape, seen[-1]
     ((4, 4, 3), 1.0)
     """
+    if not isinstance(scene, Scene):
+        raise TypeError(
+            "scene must be a glint.Scene (from glint.load_scene, load_scene_text or "
+            f"scene_from_dict), not {type(scene).__name__}"
+        )
+    if integrator is not None:
+        _choice("integrator", integrator, INTEGRATORS)
     settled = scene.render_settings(
         width=width, height=height, spp=spp, integrator=integrator, max_depth=max_depth
     )
+    seed = _int("seed", seed, 0, _MAX_SEED)
+    threads = _opt_int("threads", threads, 1, _MAX_THREADS)
+    if aspect is not None:
+        aspect = _real("aspect", aspect)
+        if not (math.isfinite(aspect) and aspect > 0):
+            raise ValueError(f"aspect must be a finite number > 0, got {aspect!r}")
     bounds = None if crop is None else _bounds(crop, settled["width"], settled["height"])
-    return _glint.render(
+    features = _bool("features", features)
+    if progress is not None and not callable(progress):
+        raise TypeError(f"progress must be callable (it gets a float), not {progress!r}")
+    _choice("device", device, DEVICES)
+    depth = _non_negative("depth", depth)
+    if aperture is not None:
+        aperture = _non_negative("aperture", aperture)
+        if depth == 0:
+            raise ValueError(
+                "aperture needs depth of field: give a focus distance depth greater than 0"
+            )
+    rendered = _glint.render(
         scene,
         settled["width"],
         settled["height"],
@@ -363,7 +569,15 @@ def render(
         bounds,
         features,
         progress,
+        device,
+        _rgb(background),
+        depth or None,
+        aperture,
     )
+    if isinstance(rendered, dict):
+        rendered["beauty"] = _image(rendered["beauty"], settled["integrator"])
+        return rendered
+    return _image(rendered, settled["integrator"])
 
 
 def tiles(width: int, height: int, size: int = 4 * TILE_SIZE) -> list[Crop]:
@@ -373,8 +587,9 @@ def tiles(width: int, height: int, size: int = 4 * TILE_SIZE) -> list[Crop]:
     >>> glint.tiles(100, 50, size=64)
     [(slice(0, 50, None), slice(0, 64, None)), (slice(0, 50, None), slice(64, 100, None))]
     """
-    if size < 1:
-        raise ValueError(f"the tile size must be at least 1, not {size}")
+    width = _int("width", width, 1, _MAX_SIDE)
+    height = _int("height", height, 1, _MAX_SIDE)
+    size = _int("size", size, 1, _MAX_SIDE)
     return [
         (slice(y, min(y + size, height)), slice(x, min(x + size, width)))
         for y in range(0, height, size)
@@ -383,29 +598,80 @@ def tiles(width: int, height: int, size: int = 4 * TILE_SIZE) -> list[Crop]:
 
 
 def _float32(name: str, array: object, dimensions: int) -> np.ndarray:
+    if not isinstance(array, np.ndarray):
+        raise TypeError(f"{name} must be a numpy array, not {type(array).__name__}")
+    if not (np.issubdtype(array.dtype, np.floating) or np.issubdtype(array.dtype, np.integer)):
+        raise TypeError(f"{name} must be an array of numbers, not of {array.dtype}")
     array = np.ascontiguousarray(array, dtype=np.float32)
-    if array.ndim != dimensions:
+    if array.ndim != dimensions or (dimensions == 3 and array.shape[2] != 3):
         shape = "(H, W, 3)" if dimensions == 3 else "(H, W)"
         raise ValueError(f"{name} must have shape {shape}, not {array.shape}")
     return array
 
 
-def write_image(path: PathLike, image: np.ndarray | Mapping[str, np.ndarray]) -> None:
-    """Writes an image as the CLI does, by the file name's extension: ``.png`` (8-bit, the
-    course's conversion: clamp, floor(c * 255), no gamma) or ``.exr`` (linear float32).
+def write_image(
+    path: PathLike,
+    image: np.ndarray | Mapping[str, np.ndarray],
+    *,
+    integrator: str | None = None,
+    exposure: float | None = None,
+    tonemap: str | None = None,
+    transfer: str | None = None,
+) -> None:
+    """Writes an image as ``glint render`` does, by the file name's extension: ``.png``
+    (8-bit) or ``.exr`` (linear float32). The file is written whole or not at all.
 
     ``image`` is an ``(H, W, 3)`` array, or :func:`render`'s dict with ``features=True``,
     whose feature layers go into the EXR as the CLI writes them (``Denoising Albedo.R`` ...,
-    ``Denoising Normal.X`` ..., ``Depth.Z``). The file is written whole or not at all.
+    ``Denoising Normal.X`` ..., ``Depth.Z``).
+
+    A PNG's 8-bit values are made as the CLI makes them for the integrator that rendered the
+    image: an :class:`Image` from :func:`render` knows it, else give ``integrator=``. The
+    course integrator and the ``normals`` and ``depth`` views get the course's conversion
+    (clamp, floor(c * 255), no gamma: what the course's reference images are); ``path``,
+    ``volpath`` and ``albedo`` the display transform (exposure, tone curve, sRGB). An array
+    that does not say, with no ``integrator``, gets the course's conversion.
+    ``exposure`` (stops, -64 to 64), ``tonemap`` (one of :data:`TONEMAPS`) and ``transfer``
+    (one of :data:`TRANSFERS`) are the CLI's ``--exposure``, ``--tonemap`` and
+    ``--transfer``: giving any of them turns on the display transform for any integrator,
+    with the defaults 0, ``"clamp"`` and ``"srgb"`` for the others. An EXR keeps linear values:
+    there they have no effect, and a ``UserWarning`` says so (the CLI's note).
 
     >>> import tempfile, pathlib
     >>> folder = pathlib.Path(tempfile.mkdtemp())
-    >>> glint.write_image(folder / "ball.png", glint.render(glint.scene_from_dict(BALL)))
+    >>> scene = glint.scene_from_dict(BALL)
+    >>> glint.write_image(folder / "ball.png", glint.render(scene, integrator="path"))
     >>> (folder / "ball.png").read_bytes()[1:4]
     b'PNG'
     """
-    path = os.fspath(path)
+    path = _path("path", path)
+    beauty = image.get("beauty") if isinstance(image, Mapping) else image
+    if integrator is None:
+        integrator = getattr(beauty, "integrator", None)
+    else:
+        integrator = _choice("integrator", integrator, INTEGRATORS)
+    if exposure is not None:
+        exposure = _exposure(exposure)
+    if tonemap is not None:
+        tonemap = _choice("tonemap", tonemap, TONEMAPS)
+    if transfer is not None:
+        transfer = _choice("transfer", transfer, TRANSFERS)
+    display = (exposure, tonemap, transfer) != (None, None, None)
+    if display and os.path.splitext(path)[1].lower() == ".exr":
+        warnings.warn(
+            "exposure/tonemap/transfer have no effect on an EXR: it keeps linear values",
+            UserWarning,
+            stacklevel=2,
+        )
+    encoding = {
+        "integrator": integrator,
+        "exposure": exposure,
+        "tonemap": tonemap,
+        "transfer": transfer,
+    }
     if isinstance(image, Mapping):
+        if "beauty" not in image:
+            raise ValueError(f"image has no 'beauty' layer: it has {sorted(image)}")
         layers = [(key, image.get(key)) for key in ("albedo", "normal", "depth")]
         _glint.write_image(
             path,
@@ -414,23 +680,30 @@ def write_image(path: PathLike, image: np.ndarray | Mapping[str, np.ndarray]) ->
                 None if layer is None else _float32(key, layer, 2 if key == "depth" else 3)
                 for key, layer in layers
             ),
+            **encoding,
         )
+    elif isinstance(image, np.ndarray):
+        _glint.write_image(path, _float32("image", image, 3), **encoding)
     else:
-        _glint.write_image(path, _float32("the image", image, 3))
+        raise TypeError(
+            "image must be a numpy array (H, W, 3) or render()'s dict of layers, "
+            f"not {type(image).__name__}"
+        )
 
 
 def to_srgb8(array: np.ndarray, exposure: float = 0.0) -> np.ndarray:
     """Linear RGB to displayable 8-bit sRGB: scaled by 2**exposure, clamped to [0, 1], the sRGB
     transfer curve, rounded. NaN becomes 0. For matplotlib's ``imshow`` or ``PIL.Image``.
 
-    (The course's PNGs, which :func:`write_image` writes, have no gamma; this is for looking.)
+    (:func:`write_image` writes the course integrator's PNGs without gamma, as the course does,
+    and the path tracer's with it; this is for looking.)
 
     >>> glint.to_srgb8(np.array([0.0, 0.18, 1.0, 7.0], np.float32)).tolist()
     [0, 118, 255, 255]
     >>> glint.to_srgb8(np.array([0.09], np.float32), exposure=1).tolist()
     [118]
     """
-    linear = np.asarray(array, dtype=np.float32) * np.float32(2.0**exposure)
+    linear = np.asarray(array, dtype=np.float32) * np.float32(2.0 ** _exposure(exposure))
     linear = np.nan_to_num(np.clip(linear, 0.0, 1.0), nan=0.0)
     encoded = np.where(
         linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1.0 / 2.4) - 0.055
@@ -498,4 +771,7 @@ def denoise(
             if layer.shape != color.shape:
                 raise ValueError(f"{name} has shape {layer.shape}, but color has {color.shape}")
         layers.append(layer)
-    return _glint.denoise(color, layers[0], layers[1], bool(prefilter), _pyoidn_library())
+    prefilter = _bool("prefilter", prefilter)
+    denoised = _glint.denoise(color, layers[0], layers[1], prefilter, _pyoidn_library())
+    integrator = getattr(color, "integrator", None)
+    return denoised if integrator is None else _image(denoised, integrator)

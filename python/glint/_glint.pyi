@@ -17,10 +17,19 @@ __all__ = [
     "write_image",
     "denoise",
     "DenoiserUnavailable",
+    "GpuUnavailable",
     "TILE_SIZE",
+    "MAX_SIDE",
+    "MAX_DEPTH",
+    "MAX_THREADS",
+    "MAX_SPP",
 ]
 
 TILE_SIZE: int
+MAX_SIDE: int
+MAX_DEPTH: int
+MAX_THREADS: int
+MAX_SPP: int
 
 class SceneError(ValueError):
     file: str
@@ -29,6 +38,7 @@ class SceneError(ValueError):
     message: str
 
 class DenoiserUnavailable(RuntimeError): ...
+class GpuUnavailable(RuntimeError): ...
 
 class SceneWarning(UserWarning):
     file: str
@@ -111,6 +121,10 @@ def render(
     bounds: tuple[int, int, int, int] | None,
     features: bool,
     progress: Callable[[float], object] | None,
+    device: str = "cpu",
+    background: _RGB | None = None,
+    depth: float | None = None,
+    aperture: float | None = None,
 ) -> npt.NDArray[np.float32] | dict[str, npt.NDArray[np.float32]]: ...
 def write_image(
     path: str,
@@ -118,6 +132,10 @@ def write_image(
     albedo: npt.NDArray[np.float32] | None = None,
     normal: npt.NDArray[np.float32] | None = None,
     depth: npt.NDArray[np.float32] | None = None,
+    integrator: str | None = None,
+    exposure: float | None = None,
+    tonemap: str | None = None,
+    transfer: str | None = None,
 ) -> None: ...
 def denoise(
     color: npt.NDArray[np.float32],

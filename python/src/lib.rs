@@ -12,21 +12,27 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::{Condvar, Mutex, OnceLock};
+use std::sync::{Arc, Condvar, Mutex, OnceLock};
 use std::time::Duration;
 
 use glint_denoise::{DenoiseError, Denoiser, Images, Options as DenoiseOptions};
-use glint_io::{Diagnostic, FileSystem, ImageWriteError, Limits, LoadedScene, ModelOptions};
+use glint_gpu::{GpuError, GpuRenderer};
+use glint_io::{
+    Diagnostic, DisplayTransform, FileSystem, ImageWriteError, Limits, LoadedScene, ModelOptions,
+    PngEncoding, ToneMap, Transfer, WriteOptions,
+};
 use glint_render::{
     Background, Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderDefaults,
-    RenderError, RenderSettings, RenderStats, RequestedSettings, Vec3,
+    RenderError, RenderSettings, RenderStats, RequestedSettings, SceneParts, ThinLens, Vec3,
 };
 use numpy::ndarray::{Array2, Array3, ArrayView2, ArrayView3};
 use numpy::{PyArray2, PyArray3, PyReadonlyArray2, PyReadonlyArray3, PyUntypedArrayMethods};
-use pyo3::exceptions::{PyOSError, PyRuntimeError, PyUserWarning, PyValueError};
+use pyo3::exceptions::{
+    PyOSError, PyOverflowError, PyRuntimeError, PyTypeError, PyUserWarning, PyValueError,
+};
 use pyo3::panic::PanicException;
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyBool, PyDict};
 
 pyo3::create_exception!(
     glint,
@@ -55,6 +61,15 @@ pyo3::create_exception!(
     "Open Image Denoise 2 (OIDN), which :func:`glint.denoise` needs, was not found.\n\n\
      ``str(error)`` is the message the ``glint`` CLI prints: every place tried, and how to get \
      it (``pip install pyoidn``, or ``GLINT_OIDN_LIB`` naming the library)."
+);
+
+pyo3::create_exception!(
+    glint,
+    GpuUnavailable,
+    PyRuntimeError,
+    "``device=\"gpu\"`` found no GPU adapter (no Vulkan driver, or no device), or the device \
+     failed.\n\n``str(error)`` says which, and what to install (Mesa's software Vulkan driver is \
+     Debian's ``mesa-vulkan-drivers``); ``device=\"cpu\"`` renders without one."
 );
 
 /// How often the waiting caller checks for Ctrl-C and reports progress.
@@ -152,6 +167,78 @@ struct PyScene {
     /// What the scene file asks of its render (a Mitsuba scene's film, sampler, integrator).
     defaults: RenderDefaults,
     warnings: Vec<Diagnostic>,
+    /// The last scene `render` built with a background or a lens of its own, kept so that
+    /// the tiles of one frame build it once.
+    derived: Mutex<Option<(Overrides, Arc<glint_render::Scene>)>>,
+}
+
+/// What `render` may change in a loaded scene: its background (`--background`) and its depth
+/// of field (`-d` focus distance, `--aperture` lens radius or the default one).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+struct Overrides {
+    background: Option<[f32; 3]>,
+    lens: Option<(f32, Option<f32>)>,
+}
+
+impl Overrides {
+    fn is_empty(&self) -> bool {
+        *self == Overrides::default()
+    }
+
+    /// Applies them as the CLI does after loading (`run::load`).
+    fn apply(&self, parts: &mut SceneParts) {
+        if let Some([r, g, b]) = self.background {
+            parts.background = Background::Color(Color::new(r, g, b));
+        }
+        if let Some((focus_distance, radius)) = self.lens {
+            let lens = ThinLens::with_default_radius(&parts.camera, focus_distance);
+            parts.camera.lens = Some(ThinLens {
+                radius: radius.unwrap_or(lens.radius),
+                ..lens
+            });
+        }
+    }
+}
+
+impl PyScene {
+    /// The scene's parts read again from its source, loaded as it was (its warnings were
+    /// issued the first time), with `overrides` applied. Reading again instead of keeping a
+    /// copy of the parts costs a load when asked for, and no memory otherwise.
+    fn parts(&self, overrides: &Overrides) -> Result<SceneParts, glint_io::SceneError> {
+        let source = match &self.source {
+            Source::File(_) => Source::File(self.absolute_path.clone()),
+            Source::Text { text, .. } => Source::Text {
+                text: text.clone(),
+                path: self.absolute_path.clone(),
+            },
+        };
+        let (mut parts, _warnings) = read_parts(&source, &self.options)?;
+        overrides.apply(&mut parts);
+        Ok(parts)
+    }
+
+    /// The scene to render with `overrides`: this one without any, else one built for them
+    /// (the last one kept).
+    fn with_overrides(
+        &self,
+        overrides: &Overrides,
+    ) -> Result<Option<Arc<glint_render::Scene>>, glint_io::SceneError> {
+        if overrides.is_empty() {
+            return Ok(None);
+        }
+        let mut derived = self
+            .derived
+            .lock()
+            .unwrap_or_else(|poison| poison.into_inner());
+        if let Some((key, scene)) = derived.as_ref() {
+            if key == overrides {
+                return Ok(Some(Arc::clone(scene)));
+            }
+        }
+        let scene = Arc::new(glint_render::Scene::new(self.parts(overrides)?));
+        *derived = Some((*overrides, Arc::clone(&scene)));
+        Ok(Some(scene))
+    }
 }
 
 #[pymethods]
@@ -177,25 +264,42 @@ impl PyScene {
     /// A scene that names an integrator renders with ``path``; its depth applies only then.
     /// Returns a dict with ``width``, ``height``, ``spp``, ``integrator`` and ``max_depth``
     /// (``None``: the integrator's default), the ``glint`` CLI's rule for its flags.
+    /// A wrong value raises ``ValueError``, a wrong type ``TypeError``, naming the argument.
     #[pyo3(signature = (width=None, height=None, spp=None, integrator=None, max_depth=None))]
     fn render_settings<'py>(
         &self,
         py: Python<'py>,
-        width: Option<u32>,
-        height: Option<u32>,
-        spp: Option<u32>,
-        integrator: Option<&str>,
-        max_depth: Option<u32>,
+        width: Option<&Bound<'py, PyAny>>,
+        height: Option<&Bound<'py, PyAny>>,
+        spp: Option<&Bound<'py, PyAny>>,
+        integrator: Option<&Bound<'py, PyAny>>,
+        max_depth: Option<&Bound<'py, PyAny>>,
     ) -> PyResult<Bound<'py, PyDict>> {
+        let side = |name, value| int_arg(name, value, 1, MAX_SIDE.into());
+        let (width, height) = (side("width", width)?, side("height", height)?);
+        let spp = int_arg("spp", spp, 1, glint_render::MAX_SAMPLES_PER_PIXEL.into())?;
         // The caller's depth has the CLI's `-k` limit; a scene's depth is for the path tracer,
         // which does not recurse, so it has none.
-        check_depth(max_depth)?;
+        let max_depth = int_arg("max_depth", max_depth, 0, MAX_DEPTH.into())?;
+        let integrator = match integrator.filter(|value| !value.is_none()) {
+            None => None,
+            Some(value) => {
+                let name: String = value.extract().map_err(|_| {
+                    PyTypeError::new_err(format!(
+                        "integrator must be a str, not {}",
+                        type_name(value)
+                    ))
+                })?;
+                Some(integrator_named(&name)?)
+            }
+        };
+        // In range, so the casts keep every value.
         let requested = RequestedSettings {
-            width,
-            height,
-            samples_per_pixel: spp,
-            integrator: integrator.map(integrator_named).transpose()?,
-            max_depth,
+            width: width.map(|w| w as u32),
+            height: height.map(|h| h as u32),
+            samples_per_pixel: spp.map(|s| s as u32),
+            integrator,
+            max_depth: max_depth.map(|d| d as u32),
         };
         let settings = requested.settle(&self.defaults);
         let settled = PyDict::new(py);
@@ -258,9 +362,27 @@ fn path_string(path: &Path) -> PyResult<String> {
     })
 }
 
-/// Loads and builds a scene with the GIL released, with `options`: `background` replaces the
-/// scene's (the CLI's `--background`), after an environment map (`--env`) when both are given,
-/// as in the CLI.
+/// Reads a scene's parts and its warnings with `options`: `background` replaces the scene's
+/// (the CLI's `--background`), after an environment map (`--env`) when both are given, as in
+/// the CLI.
+fn read_parts(
+    source: &Source,
+    options: &LoadOptions,
+) -> Result<(SceneParts, Vec<Diagnostic>), glint_io::SceneError> {
+    let LoadedScene {
+        mut parts,
+        warnings,
+    } = source.load(options)?;
+    if let Some((env, strength)) = &options.environment {
+        parts.background = glint_io::load_environment(env, *strength, &Limits::default())?;
+    }
+    if let Some([r, g, b]) = options.background {
+        parts.background = Background::Color(Color::new(r, g, b));
+    }
+    Ok((parts, warnings))
+}
+
+/// Loads and builds a scene with the GIL released, with `options` (see `read_parts`).
 fn load(py: Python<'_>, source: Source, mut options: LoadOptions) -> PyResult<PyScene> {
     if let Some(rgb) = options.background {
         if rgb.iter().any(|c| !c.is_finite() || *c < 0.0) {
@@ -279,33 +401,9 @@ fn load(py: Python<'_>, source: Source, mut options: LoadOptions) -> PyResult<Py
         // Absolute, so that an unpickled scene finds it from another working directory.
         *env = std::path::absolute(&*env)?;
     }
-    let loaded = py
-        .detach(|| {
-            let loaded = source.load(&options)?;
-            let environment = match &options.environment {
-                Some((env, strength)) => Some(glint_io::load_environment(
-                    env,
-                    *strength,
-                    &Limits::default(),
-                )?),
-                None => None,
-            };
-            Ok::<_, glint_io::SceneError>((loaded, environment))
-        })
+    let (parts, warnings) = py
+        .detach(|| read_parts(&source, &options))
         .map_err(|error| scene_error(py, error))?;
-    let (
-        LoadedScene {
-            mut parts,
-            warnings,
-        },
-        environment,
-    ) = loaded;
-    if let Some(environment) = environment {
-        parts.background = environment;
-    }
-    if let Some([r, g, b]) = options.background {
-        parts.background = Background::Color(Color::new(r, g, b));
-    }
     let defaults = parts.physical.defaults;
     let scene = py.detach(|| glint_render::Scene::new(parts));
     let absolute_path = std::path::absolute(source.name())?;
@@ -316,6 +414,7 @@ fn load(py: Python<'_>, source: Source, mut options: LoadOptions) -> PyResult<Py
         options,
         defaults,
         warnings,
+        derived: Mutex::new(None),
     })
 }
 
@@ -510,11 +609,13 @@ impl<T> Slot<T> {
     }
 }
 
-/// Renders `scene`; the keyword-friendly `glint.render` in `__init__.py` calls this. `bounds`
-/// is `(x0, x1, y0, y1)`.
+/// Renders `scene`; the keyword-friendly `glint.render` in `__init__.py` calls this, with its
+/// arguments checked. `bounds` is `(x0, x1, y0, y1)`; `device` is `"cpu"` or `"gpu"`;
+/// `background` and the depth of field (`depth`, the focus distance, 0 for none, and
+/// `aperture`, the lens radius) are the CLI's `--background`, `-d` and `--aperture`.
 #[pyfunction]
 #[allow(clippy::too_many_arguments)]
-#[pyo3(signature = (scene, width, height, spp, integrator, seed, threads, max_depth, aspect, bounds, features, progress))]
+#[pyo3(signature = (scene, width, height, spp, integrator, seed, threads, max_depth, aspect, bounds, features, progress, device="cpu", background=None, depth=None, aperture=None))]
 fn render<'py>(
     py: Python<'py>,
     scene: &Bound<'py, PyScene>,
@@ -529,6 +630,10 @@ fn render<'py>(
     bounds: Option<(u32, u32, u32, u32)>,
     features: bool,
     progress: Option<Bound<'py, PyAny>>,
+    device: &str,
+    background: Option<[f32; 3]>,
+    depth: Option<f32>,
+    aperture: Option<f32>,
 ) -> PyResult<Bound<'py, PyAny>> {
     let integrator = integrator_named(integrator)?;
     if width > MAX_SIDE || height > MAX_SIDE {
@@ -547,6 +652,40 @@ fn render<'py>(
             "threads must be between 1 and {MAX_THREADS}, not {threads}"
         )));
     }
+    let gpu = match device {
+        "cpu" => false,
+        "gpu" => true,
+        _ => {
+            return Err(PyValueError::new_err(format!(
+                "device must be one of cpu, gpu, got {device:?}"
+            )))
+        }
+    };
+    let non_negative = |value: f32| value.is_finite() && value >= 0.0;
+    if let Some(rgb) = background.filter(|rgb| !rgb.iter().all(|&c| non_negative(c))) {
+        return Err(PyValueError::new_err(format!(
+            "background components must be finite and >= 0, got {rgb:?}"
+        )));
+    }
+    for (name, value) in [("depth", depth), ("aperture", aperture)] {
+        if let Some(value) = value.filter(|&value| !non_negative(value)) {
+            return Err(PyValueError::new_err(format!(
+                "{name} must be a finite number >= 0, got {value}"
+            )));
+        }
+    }
+    // The CLI's rule: depth 0 is the pinhole, and a radius without a focus distance means
+    // nothing.
+    let depth = depth.filter(|&distance| distance > 0.0);
+    if aperture.is_some() && depth.is_none() {
+        return Err(PyValueError::new_err(
+            "aperture needs depth of field: give a focus distance depth greater than 0",
+        ));
+    }
+    let overrides = Overrides {
+        background,
+        lens: depth.map(|distance| (distance, aperture)),
+    };
     let settings = RenderSettings {
         width,
         height,
@@ -564,12 +703,113 @@ fn render<'py>(
     };
     settings.validate().map_err(PyValueError::new_err)?;
 
-    let scene = &scene.get().scene;
-    let (film, stats) = render_waiting(py, scene, &settings, progress.as_ref())?;
+    let scene = scene.get();
+    let (film, stats) = if gpu {
+        render_gpu(py, scene, &overrides, &settings, progress.as_ref())?
+    } else {
+        let derived = py
+            .detach(|| scene.with_overrides(&overrides))
+            .map_err(|error| scene_error(py, error))?;
+        let built = derived.as_deref().unwrap_or(&scene.scene);
+        render_waiting(py, progress.as_ref(), |on_progress| {
+            let on_tile = |report: &Progress| on_progress(report.tiles_done, report.tiles_total);
+            glint_render::render(built, &settings, &on_tile).map_err(|error| match error {
+                RenderError::Invalid(why) => PyValueError::new_err(why),
+                // Only the waiting caller cancels, and then its exception is raised instead.
+                RenderError::Cancelled => PyValueError::new_err("the render was cancelled"),
+            })
+        })?
+    };
     if stats.nonfinite_samples > 0 {
         warn_nonfinite(py, &stats)?;
     }
     film_to_python(py, film)
+}
+
+/// Renders on the GPU back end (the path tracer only): the scene's parts are read again, as
+/// glint-gpu builds its own buffers from them.
+fn render_gpu(
+    py: Python<'_>,
+    scene: &PyScene,
+    overrides: &Overrides,
+    settings: &RenderSettings,
+    progress: Option<&Bound<'_, PyAny>>,
+) -> PyResult<(Film, RenderStats)> {
+    // The CLI's words for its flags, in this function's.
+    let gpu_error = |error: GpuError| {
+        let text = error
+            .to_string()
+            .replace("--device cpu", "device=\"cpu\"")
+            .replace("(-d)", "(depth=)")
+            .replace("--integrator path", "integrator=\"path\"");
+        match error {
+            GpuError::NoAdapter(_) | GpuError::Device(_) => GpuUnavailable::new_err(text),
+            GpuError::Unsupported(_) | GpuError::Invalid(_) | GpuError::Cancelled => {
+                PyValueError::new_err(text)
+            }
+        }
+    };
+    let parts = py
+        .detach(|| scene.parts(overrides))
+        .map_err(|error| scene_error(py, error))?;
+    // What the GPU does not do is refused before a device is opened.
+    glint_gpu::check_supported(&parts, settings).map_err(gpu_error)?;
+    let renderer = py.detach(GpuRenderer::new).map_err(gpu_error)?;
+    render_waiting(py, progress, |on_progress| {
+        let on_pass = |done: u32, total: u32| on_progress(done as usize, total as usize);
+        let (film, gpu_stats) = renderer
+            .render(&parts, settings, &on_pass)
+            .map_err(gpu_error)?;
+        // The CPU's statistics, as far as the GPU has them.
+        let stats = RenderStats {
+            nonfinite_samples: gpu_stats.nonfinite_samples,
+            first_nonfinite_pixel: gpu_stats.first_nonfinite_pixel,
+            ..RenderStats::default()
+        };
+        Ok((film, stats))
+    })
+}
+
+/// The name of `value`'s type, for messages.
+fn type_name(value: &Bound<'_, PyAny>) -> String {
+    value
+        .get_type()
+        .qualname()
+        .map_or_else(|_| "?".to_owned(), |name| name.to_string())
+}
+
+/// An optional integer argument within `low..=high`: `TypeError` for anything but an int
+/// (`bool` included, numpy's integers accepted), `ValueError` outside the range, both naming
+/// the argument.
+fn int_arg(
+    name: &str,
+    value: Option<&Bound<'_, PyAny>>,
+    low: u64,
+    high: u64,
+) -> PyResult<Option<u64>> {
+    let Some(value) = value.filter(|value| !value.is_none()) else {
+        return Ok(None);
+    };
+    let not_an_int =
+        || PyTypeError::new_err(format!("{name} must be an int, not {}", type_name(value)));
+    if value.is_instance_of::<PyBool>() {
+        return Err(not_an_int());
+    }
+    let out_of_range = |shown: String| {
+        PyValueError::new_err(format!(
+            "{name} must be between {low} and {high}, got {shown}"
+        ))
+    };
+    match value.extract::<i128>() {
+        Ok(number) if (i128::from(low)..=i128::from(high)).contains(&number) => {
+            Ok(Some(number as u64))
+        }
+        Ok(number) => Err(out_of_range(number.to_string())),
+        Err(error) if error.is_instance_of::<PyOverflowError>(value.py()) => {
+            Err(out_of_range(value.str()?.to_string()))
+        }
+        Err(_) => Err(not_an_int()),
+    }
 }
 
 /// Refuses a path length past `MAX_DEPTH`.
@@ -615,29 +855,31 @@ fn warn_nonfinite(py: Python<'_>, stats: &RenderStats) -> PyResult<()> {
     PyErr::warn(py, &category, &message, 2)
 }
 
-/// Runs the render on a helper thread; the caller waits without the GIL and, every `POLL`,
-/// takes it back to check for signals (a `KeyboardInterrupt` cancels the render at the end of
-/// the tiles in flight) and to report progress. An exception from either cancels the render
-/// and is raised once the render thread has stopped.
-fn render_waiting(
+/// Runs `render` on a helper thread, handing it a progress function (steps done, steps in
+/// all; it returns false once the render is to stop); the caller waits without the GIL and,
+/// every `POLL`, takes it back to check for signals (a `KeyboardInterrupt` cancels the render
+/// at the end of the steps in flight) and to report progress. An exception from either
+/// cancels the render and is raised once the render thread has stopped.
+fn render_waiting<R>(
     py: Python<'_>,
-    scene: &glint_render::Scene,
-    settings: &RenderSettings,
     progress: Option<&Bound<'_, PyAny>>,
-) -> PyResult<(Film, RenderStats)> {
+    render: R,
+) -> PyResult<(Film, RenderStats)>
+where
+    R: FnOnce(&(dyn Fn(usize, usize) -> bool + Sync)) -> PyResult<(Film, RenderStats)> + Send,
+{
     let tiles_done = AtomicUsize::new(0);
     let tiles_total = AtomicUsize::new(0);
     let cancel = AtomicBool::new(false);
-    let on_tile = |report: &Progress| {
-        tiles_total.store(report.tiles_total, Ordering::Relaxed);
-        tiles_done.fetch_max(report.tiles_done, Ordering::Relaxed);
+    let on_progress = |done: usize, total: usize| {
+        tiles_total.store(total, Ordering::Relaxed);
+        tiles_done.fetch_max(done, Ordering::Relaxed);
         !cancel.load(Ordering::Relaxed)
     };
     let outcome = Slot::new();
     std::thread::scope(|threads| {
-        let (on_tile, outcome_ref) = (&on_tile, &outcome);
-        let worker =
-            threads.spawn(move || outcome_ref.put(glint_render::render(scene, settings, on_tile)));
+        let (on_progress, outcome_ref) = (&on_progress, &outcome);
+        let worker = threads.spawn(move || outcome_ref.put(render(on_progress)));
         let mut reported = None;
         let result = loop {
             let finished = py.detach(|| outcome.take(Some(POLL)));
@@ -686,12 +928,9 @@ fn render_waiting(
                 "the renderer panicked: {why}"
             )));
         }
-        match result? {
-            Ok(rendered) => Ok(rendered),
-            Err(RenderError::Invalid(why)) => Err(PyValueError::new_err(why)),
-            // Only this function cancels, and then `result` is the exception that made it.
-            Err(RenderError::Cancelled) => Err(PyValueError::new_err("the render was cancelled")),
-        }
+        // A cancelled render's own error is dropped: `result` is then the exception that
+        // cancelled it.
+        result?
     })
 }
 
@@ -741,10 +980,61 @@ fn check_rgb(name: &str, shape: &[usize], expected: (usize, usize)) -> PyResult<
     Ok(())
 }
 
-/// Writes an image with `glint_io::write_image`: `.png` (8-bit, the course's conversion) or
-/// `.exr` (linear float32, with the feature layers when all three are given).
+/// How a PNG is encoded, the CLI's rule (`png_encoding` in the CLI's `job.rs`): the display
+/// transform when any of its options is given, its defaults for the others; else the
+/// integrator's own (`PngEncoding::default_for`), the course's conversion when it is unknown.
+fn png_encoding(
+    integrator: Option<&str>,
+    exposure: Option<f32>,
+    tonemap: Option<&str>,
+    transfer: Option<&str>,
+) -> PyResult<PngEncoding> {
+    if exposure.is_none() && tonemap.is_none() && transfer.is_none() {
+        return Ok(match integrator {
+            Some(name) => PngEncoding::default_for(integrator_named(name)?),
+            None => PngEncoding::Course,
+        });
+    }
+    let defaults = DisplayTransform::default();
+    if let Some(exposure) = exposure.filter(|ev| !(ev.is_finite() && ev.abs() <= 64.0)) {
+        return Err(PyValueError::new_err(format!(
+            "exposure must be between -64 and 64, got {exposure}"
+        )));
+    }
+    let tone_map = match tonemap {
+        None => defaults.tone_map,
+        Some("clamp" | "none") => ToneMap::Clamp,
+        Some("aces") => ToneMap::Aces,
+        Some("agx") => ToneMap::Agx,
+        Some(other) => {
+            return Err(PyValueError::new_err(format!(
+                "tonemap must be one of clamp, none, aces, agx, got {other:?}"
+            )))
+        }
+    };
+    let transfer = match transfer {
+        None => defaults.transfer,
+        Some("srgb") => Transfer::Srgb,
+        Some("linear") => Transfer::Linear,
+        Some(other) => {
+            return Err(PyValueError::new_err(format!(
+                "transfer must be one of srgb, linear, got {other:?}"
+            )))
+        }
+    };
+    Ok(PngEncoding::Display(DisplayTransform {
+        exposure: exposure.unwrap_or(defaults.exposure),
+        tone_map,
+        transfer,
+    }))
+}
+
+/// Writes an image with `glint_io::write_image_with`: `.png` (8-bit, encoded by
+/// `png_encoding`) or `.exr` (linear float32, with the feature layers when all three are
+/// given).
 #[pyfunction]
-#[pyo3(signature = (path, beauty, albedo=None, normal=None, depth=None))]
+#[allow(clippy::too_many_arguments)]
+#[pyo3(signature = (path, beauty, albedo=None, normal=None, depth=None, integrator=None, exposure=None, tonemap=None, transfer=None))]
 fn write_image(
     py: Python<'_>,
     path: PathBuf,
@@ -752,7 +1042,14 @@ fn write_image(
     albedo: Option<PyReadonlyArray3<'_, f32>>,
     normal: Option<PyReadonlyArray3<'_, f32>>,
     depth: Option<PyReadonlyArray2<'_, f32>>,
+    integrator: Option<&str>,
+    exposure: Option<f32>,
+    tonemap: Option<&str>,
+    transfer: Option<&str>,
 ) -> PyResult<()> {
+    let options = WriteOptions {
+        png: png_encoding(integrator, exposure, tonemap, transfer)?,
+    };
     let shape = beauty.shape();
     let (height, width) = (shape[0], shape[1]);
     check_rgb("the image", shape, (height, width))?;
@@ -795,7 +1092,7 @@ fn write_image(
         sums: None,
         samples: None,
     };
-    let written = py.detach(|| glint_io::write_image(&path, &film));
+    let written = py.detach(|| glint_io::write_image_with(&path, &film, &options));
     written.map_err(|error| match &error {
         ImageWriteError::UnsupportedExtension { .. } | ImageWriteError::InvalidFilm { .. } => {
             PyValueError::new_err(error.to_string())
@@ -891,6 +1188,7 @@ fn _glint(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add("SceneError", py.get_type::<SceneError>())?;
     module.add("SceneWarning", py.get_type::<SceneWarning>())?;
     module.add("DenoiserUnavailable", py.get_type::<DenoiserUnavailable>())?;
+    module.add("GpuUnavailable", py.get_type::<GpuUnavailable>())?;
     module.add_class::<PyScene>()?;
     module.add_function(wrap_pyfunction!(load_scene, module)?)?;
     module.add_function(wrap_pyfunction!(load_scene_text, module)?)?;
@@ -899,5 +1197,10 @@ fn _glint(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_function(wrap_pyfunction!(write_image, module)?)?;
     module.add_function(wrap_pyfunction!(denoise, module)?)?;
     module.add("TILE_SIZE", glint_render::TILE_SIZE)?;
+    // The CLI's limits, for the checks in `__init__.py`.
+    module.add("MAX_SIDE", MAX_SIDE)?;
+    module.add("MAX_DEPTH", MAX_DEPTH)?;
+    module.add("MAX_THREADS", MAX_THREADS)?;
+    module.add("MAX_SPP", glint_render::MAX_SAMPLES_PER_PIXEL)?;
     Ok(())
 }
