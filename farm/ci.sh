@@ -7,9 +7,11 @@
 #                        bit; render arguments refused or honoured (-o, -n); a failed task, the
 #                        merge that reports it and the resubmit that renders only it; a task
 #                        requeued mid-render that resumes from its checkpoint. Stops the daemons.
+#                        First, without Slurm: farm/local.sh with -n (honoured) and -o (refused).
 #                        GLINT picks the binary (default: a debug build made here), COMPARE the
 #                        exr_compare example (default: built here, in CARGO_TARGET_DIR).
-# Without Slurm the test is SKIPPED with a message, but under CI=1 that is a failure.
+# Without Slurm the Slurm cases are SKIPPED with a message (farm/local.sh's still run), but under
+# CI=1 that is a failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 repo=$(pwd)
@@ -41,9 +43,6 @@ cannot() {
 }
 
 test_suite() {
-  for tool in munged mungekey slurmctld slurmd sbatch squeue sinfo; do
-    command -v "$tool" > /dev/null || cannot "$tool is not installed (run farm/ci.sh install)"
-  done
   target=${CARGO_TARGET_DIR:-$repo/target}
   [ -n "${COMPARE:-}" ] || cargo build --quiet -p glint --example exr_compare
   [ -n "${GLINT:-}" ] || cargo build --quiet -p glint
@@ -81,6 +80,16 @@ test_suite() {
   }
   trap stop EXIT
   mkdir -p "$work/spool" "$work/state" "$work/out"
+
+  # farm/local.sh needs no Slurm: its cases run first, on a small render of the scene below.
+  scene=$(realpath "${FARM_CI_SCENE:-$repo/scenes/three_spheres.xml}")
+  small=(-w 64 -h 48 -r 16)
+  "$glint" render "$scene" "${small[@]}" -n 2 -o "$work/out/small.exr" 2> "$work/small.log"
+  case_local
+
+  for tool in munged mungekey slurmctld slurmd sbatch squeue sinfo; do
+    command -v "$tool" > /dev/null || cannot "$tool is not installed (run farm/ci.sh install)"
+  done
   mungekey --create --keyfile="$work/munge.key" > /dev/null 2>&1 ||
     dd if=/dev/urandom of="$work/munge.key" bs=1024 count=1 2> /dev/null
   chmod 0400 "$work/munge.key"
@@ -138,7 +147,6 @@ CONF
 
   # One scene, split two ways: 4 tiles, and 4 sample ranges.
   # FARM_CI_SCENE and FARM_CI_ARGS pick another render (e.g. a longer one to time).
-  scene=$(realpath "${FARM_CI_SCENE:-$repo/scenes/three_spheres.xml}")
   read -r -a args <<< "${FARM_CI_ARGS:--w 320 -h 240 -r 36}"
   start=$(date +%s.%N)
   "$glint" render "$scene" "${args[@]}" -n 2 -o "$work/out/single.exr" 2> "$work/single.log"
@@ -171,10 +179,8 @@ CONF
       "$split" "$wall" "$single_time"
   done
 
-  # The cases below use small renders of the same scene, each judged against its own single
-  # render.
-  small=(-w 64 -h 48 -r 16)
-  "$glint" render "$scene" "${small[@]}" -n 2 -o "$work/out/small.exr" 2> "$work/small.log"
+  # The cases below use small renders of the same scene ($small), each judged against its own
+  # single render.
   case_refused_arguments
   case_threads
   case_failed_part_and_resubmit
@@ -216,6 +222,29 @@ pass() {
 fail() {
   echo "FAILED: $1" >&2
   failed=$((failed + 1))
+}
+
+# farm/local.sh takes the same render arguments as submit.sh: -n THREADS is each part's thread
+# count and the merge is the single render bit for bit; -o is refused with exit 2, a message
+# naming it, and nothing written (no parts folder, no image).
+case_local() {
+  local out="$work/out/local.exr" message rc
+  if ! message=$(GLINT="$glint" farm/local.sh "$scene" 2 "$out" "${small[@]}" -n 2 2>&1); then
+    fail "local.sh -n 2: $message"
+  elif ! result=$("$compare" "$out" "$work/out/small.exr" 2>&1); then
+    fail "local.sh -n 2: $result"
+  else
+    pass "local.sh ... -n 2: 2 parts + merge == single render: $result"
+  fi
+  out="$work/out/local-o.exr"
+  message=$(cd "$work/out" && GLINT="$glint" "$repo/farm/local.sh" "$scene" 2 "$out" \
+    "${small[@]}" -o x.png 2>&1) && rc=0 || rc=$?
+  if [ "$rc" -ne 2 ] || [[ $message != *"-o cannot be used with farm/local.sh"* ]] ||
+    [ -e "$out.parts" ] || [ -e "$out" ] || [ -e "$work/out/x.png" ]; then
+    fail "local.sh ... -o x.png: exit $rc, parts folder $([ -e "$out.parts" ] && echo made || echo absent), x.png $([ -e "$work/out/x.png" ] && echo written || echo absent), message: $message"
+  else
+    pass "local.sh ... -o x.png is refused with exit 2, nothing written: $message"
+  fi
 }
 
 # Options that render.sbatch sets itself are refused before anything is submitted: exit 2,

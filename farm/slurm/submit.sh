@@ -49,112 +49,12 @@ case $split in tiles | samples) ;; *) die "FARM_SPLIT is tiles or samples, not '
 if [ ! -f "$scene" ] || [ ! -r "$scene" ]; then die "cannot read the scene '$scene'"; fi
 case ${out,,} in *.exr | *.png) ;; *) die "OUT is .exr or .png, not '$out'" ;; esac
 
-# The render arguments, checked here rather than by N failing tasks. glint's parser (clap)
-# takes `-n 8`, `-n8`, `-n=8`, `-vn8`, `--numcpus 8` and `--numcpus=8`: all are recognised.
-# Options of `glint render` that take a value, so that a value is never taken for an option.
-short_valued=owhrknadsxyD
-valued_names=(outputfile width height rpp spp noise-threshold min-spp time recursionDepth numcpus
-  aspect background seed integrator shader exposure tonemap transfer device crop-window
-  pixel-bounds tile sample-range checkpoint checkpoint-every resume progress-every depth
-  aperture split winwidth winheight max-memory max-file-size max-texture-size max-triangles
-  define scene camera env env-strength)
-long_valued=" ${valued_names[*]} "
-refuse() {
-  local instead
-  case $1 in
-    -o | --outputfile | --output)
-      instead="OUT is the third argument (submit.sh SCENE N OUT): the tasks write OUT.parts/part-I.exr and the merge job writes OUT" ;;
-    --tile | --sample-range)
-      instead="the script splits the render itself into N parts (the second argument), tiles or sample ranges by FARM_SPLIT" ;;
-    --crop-window | --pixel-bounds)
-      instead="the farm renders the whole image in N parts; render a crop with glint render alone" ;;
-    --checkpoint | --resume)
-      instead="each task checkpoints to OUT.parts/part-I.checkpoint.exr and resumes from it by itself" ;;
-    --time)
-      instead="a time budget cannot be split into parts; give -r, and a Slurm time limit with SBATCH_ARGS=--time=..." ;;
-    -x | -y | --winwidth | --winheight | --preview-close)
-      instead="it opens a preview window, and a batch task has no display" ;;
-    -i | --inputfile)
-      instead="SCENE is the first argument" ;;
-    -'?' | --help)
-      instead="glint render --help lists the render options" ;;
-  esac
-  die "$1 cannot be used with farm/slurm/submit.sh: $instead"
-}
-threads='' args=()
-take_threads() {
-  [[ $1 =~ ^[1-9][0-9]*$ ]] || die "-n/--numcpus takes a number of threads >= 1, not '$1'"
-  threads=$1
-}
-take_checkpoint_every() {
-  [[ $1 =~ ^[0-9]+(\.[0-9]+)?$ ]] || die "--checkpoint-every takes seconds, not '$1'"
-  export GLINT_CHECKPOINT_EVERY=$1
-}
-# One option with its value (long or short, without dashes): honoured, refused or kept.
-option() {
-  case $1 in
-    n | numcpus) take_threads "$2" ;;
-    checkpoint-every) take_checkpoint_every "$2" ;;
-    o | outputfile | output | tile | sample-range | crop-window | pixel-bounds | checkpoint | \
-      resume | time | x | y | winwidth | winheight | i | inputfile)
-      if [ ${#1} -eq 1 ]; then refuse "-$1"; else refuse "--$1"; fi ;;
-    ?) args+=("-$1" "$2") ;;
-    *) args+=("--$1" "$2") ;;
-  esac
-}
-while [ $# -gt 0 ]; do
-  arg=$1
-  shift
-  case $arg in
-    --*=*)
-      name=${arg%%=*}
-      option "${name#--}" "${arg#*=}"
-      ;;
-    --preview-close | --help) refuse "$arg" ;;
-    --?*)
-      name=${arg#--}
-      if [[ $long_valued == *" $name "* ]]; then
-        [ $# -gt 0 ] || die "$arg needs a value"
-        option "$name" "$1"
-        shift
-      else
-        args+=("$arg")
-        # An option this script does not know keeps the value that follows it: glint judges.
-        if [[ " denoise verbose stats strict " != *" $name "* ]] && [ $# -gt 0 ] && [[ $1 != -* ]]; then
-          args+=("$1")
-          shift
-        fi
-      fi
-      ;;
-    -?*)
-      # A cluster of short options: flags (-v), then at most one that takes a value, written
-      # after it (-n8, -n=8) or as the next argument (-n 8).
-      flags=''
-      for ((c = 1; c < ${#arg}; c++)); do
-        letter=${arg:c:1}
-        case $letter in '?' | i) refuse "-$letter" ;; esac
-        if [[ $short_valued != *"$letter"* ]]; then
-          flags+=$letter
-          continue
-        fi
-        [ -z "$flags" ] || args+=("-$flags")
-        flags=''
-        value=${arg:c+1}
-        if [ -z "$value" ]; then
-          [ $# -gt 0 ] || die "-$letter needs a value"
-          value=$1
-          shift
-        fi
-        option "$letter" "${value#=}"
-        break
-      done
-      [ -z "$flags" ] || args+=("-$flags")
-      ;;
-    *)
-      die "unexpected argument '$arg': SCENE is the first argument and the render arguments are options"
-      ;;
-  esac
-done
+# The render arguments, checked here rather than by N failing tasks (farm/render-args.sh).
+# shellcheck source=farm/render-args.sh
+. "$here/../render-args.sh"
+farm_render_args submit "$@"
+args=("${farm_args[@]}") threads=$farm_threads
+[ -z "$farm_checkpoint_every" ] || export GLINT_CHECKPOINT_EVERY=$farm_checkpoint_every
 
 scene=$(realpath "$scene")
 out=$(realpath -m "$out")
