@@ -715,7 +715,9 @@ test('the page opens with the first example ready to render; Render without a sc
 test('every control says what it does, and background, depth of field and exposure render as the CLI', async () => {
   const { page, context, errors } = await openPage();
   // A tooltip on every control, its own or its label's, naming the CLI option or its range.
-  const untitled = await page.evaluate(() => [...document.querySelectorAll('main input, main select, main button, main textarea')]
+  const untitled = await page.evaluate(() => [...document.querySelectorAll(
+    'main input, main select, main button, main textarea',
+  )]
     .filter((control) => !(control.title || control.closest('label')?.title))
     .map((control) => control.id || control.outerHTML));
   assert.deepEqual(untitled, []);
@@ -784,7 +786,8 @@ async function watchPreview(page) {
       if (log.events.at(-1) !== state && state !== 'rendering') log.events.push(state);
     };
     new MutationObserver(seen).observe(canvas, { attributes: true });
-    new MutationObserver(seen).observe(status, { attributes: true, childList: true, characterData: true, subtree: true });
+    new MutationObserver(seen).observe(status,
+      { attributes: true, childList: true, characterData: true, subtree: true });
   });
 }
 
