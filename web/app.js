@@ -1,8 +1,10 @@
 // The page: choose or drop a scene or a glTF model, check it with the renderer (diagnostics as
 // the CLI prints them), render it in tiles on a pool of Web Workers (the path tracers in passes
 // over the whole image, optionally to a time budget), and download the image encoded by the same
-// Rust code as the CLI's.
-import init, { Files, Settings, encode, load_bytes as loadBytes } from './pkg/glint_wasm.js';
+// Rust code as the CLI's. A render starts with a coarse preview of the whole image (1/8 of its
+// width and height, one sample per pixel, drawn in 8x8 blocks) that its tiles then replace.
+import init, { Files, Settings, load_bytes as loadBytes } from './pkg/glint_wasm.js';
+import { makeSettings } from './settings.js';
 
 const EXAMPLES = [
   { name: 'Three spheres', root: 'scenes/', scene: 'three_spheres.xml', assets: [] },
@@ -14,6 +16,13 @@ const EXAMPLES = [
   },
 ];
 const TILE = 32;
+// The preview's pixels stand for PREVIEW x PREVIEW blocks of the image: 1/64 of its samples (at
+// one sample per pixel), so it is on screen in a small share of a pass's time.
+const PREVIEW = 8;
+// No preview for images of at most this many tiles: they are on screen about as soon.
+const PREVIEW_MIN_TILES = 4;
+// Pixels in a strip of the preview (a quarter of a tile).
+const PREVIEW_STRIP = (TILE * TILE) / 4;
 // The longest time budget, as `glint render --time` takes: a year.
 const MAX_TIME_BUDGET = 365 * 24 * 3600;
 const SCENE_FILE = /\.(xml|json|gltf|glb)$/i;
@@ -26,10 +35,13 @@ const ui = {
   openFolder: $('open-folder'), sceneFile: $('scene-file'), sceneText: $('scene-text'),
   assetList: $('asset-list'), diagnostics: $('diagnostics'), width: $('width'),
   height: $('height'), spp: $('spp'), integrator: $('integrator'), maxDepth: $('max-depth'),
-  seed: $('seed'), time: $('time'), features: $('features'), render: $('render'), cancel: $('cancel'),
+  seed: $('seed'), time: $('time'), background: $('background'), focus: $('focus'),
+  aperture: $('aperture'), exposure: $('exposure'), tonemap: $('tonemap'), transfer: $('transfer'),
+  features: $('features'), render: $('render'), cancel: $('cancel'),
   downloadPng: $('download-png'), downloadExr: $('download-exr'), status: $('status'),
   progress: $('progress'), tiles: $('tiles'), elapsed: $('elapsed'),
-  raysPerSecond: $('rays-per-second'), firstPixel: $('first-pixel'), workers: $('workers'),
+  raysPerSecond: $('rays-per-second'), firstPixel: $('first-pixel'), firstImage: $('first-image'),
+  workers: $('workers'),
   canvas: $('canvas'),
 };
 
@@ -111,6 +123,8 @@ function sceneBytes() {
 
 async function chooseExample(index) {
   const example = EXAMPLES[index];
+  // Until the example is in, the diagnostics are not its: whoever waits for them waits on.
+  delete ui.diagnostics.dataset.state;
   const names = [example.scene, ...example.assets];
   const bytes = await Promise.all(names.map(async (name) => {
     const response = await fetch(example.root + name);
@@ -215,16 +229,30 @@ function readSettings() {
     features: ui.features.checked,
     // Seconds, or null for no budget; checked in startRender.
     time: ui.time.value.trim() === '' ? null : Number(ui.time.value),
+    // As the CLI's flags: undefined where not given. Checked by glint-wasm (`makeSettings`).
+    background: ui.background.value.trim(),
+    focus: optionalNumber(ui.focus),
+    aperture: optionalNumber(ui.aperture),
+    exposure: optionalNumber(ui.exposure),
+    tonemap: ui.tonemap.value || undefined,
+    transfer: ui.transfer.value || undefined,
   };
+}
+
+// A number input's value, undefined when empty; NaN (refused by glint-wasm) when not a number.
+function optionalNumber(input) {
+  return input.value.trim() === '' ? undefined : Number(input.value);
+}
+
+// The preview's size: glint-wasm's `Settings.preview(PREVIEW)`, which the workers render.
+function previewSize({ width, height }) {
+  return { width: Math.ceil(width / PREVIEW), height: Math.ceil(height / PREVIEW) };
 }
 
 // Why these settings cannot render in passes (glint-render's rule, in its words, naming `what`),
 // or null when they can. Throws what the workers would for settings that cannot render at all.
 function progressiveRefusal(settings, what) {
-  const s = settings;
-  const renderSettings = new Settings(
-    s.width, s.height, s.spp, s.integrator, BigInt(s.seed), s.maxDepth, s.features,
-  );
+  const renderSettings = makeSettings(Settings, settings);
   try {
     renderSettings.check_progressive(what);
     return null;
@@ -237,6 +265,13 @@ function progressiveRefusal(settings, what) {
 
 function startRender() {
   if (render?.running) return;
+  if (!BINARY_SCENE.test(scenePath) && ui.sceneText.value.trim() === '') {
+    const what = 'no scene to render: choose an example, open a scene file or drop one here';
+    ui.diagnostics.textContent = `error: ${what}`;
+    ui.diagnostics.dataset.state = 'error';
+    setStatus('error', what);
+    return;
+  }
   if (!checkScene()) {
     setStatus('error', 'the scene has an error: see below the scene text');
     return;
@@ -263,13 +298,28 @@ function startRender() {
     }
   }
   const pixelCount = width * height;
+  // The preview, in strips of its rows ahead of the tiles in the shared queue: strips of about
+  // PREVIEW_STRIP pixels, so that the first is on screen in a fraction of a tile's time.
+  const preview = tiles.length > PREVIEW_MIN_TILES ? previewSize(settings) : null;
+  const previewTiles = [];
+  if (preview) {
+    const rows = Math.max(1, Math.floor(PREVIEW_STRIP / preview.width));
+    for (let y0 = 0; y0 < preview.height; y0 += rows) {
+      previewTiles.push({
+        preview: true, x0: 0, y0, x1: preview.width, y1: Math.min(y0 + rows, preview.height),
+      });
+    }
+  }
   render = {
     job: ++jobCounter,
     running: true,
     settings,
     tiles,
-    queue: [...tiles],
+    queue: [...previewTiles, ...tiles],
     total: tiles.length,
+    preview,
+    previewLeft: previewTiles.length,
+    firstImage: null,
     done: 0,
     // In passes (the path tracers): the pass in flight, the samples per pixel it reaches, and
     // those of the last pass complete (what the image holds). Workers' own queues from pass 2.
@@ -293,6 +343,12 @@ function startRender() {
   const context = ui.canvas.getContext('2d');
   context.clearRect(0, 0, width, height);
   ui.firstPixel.textContent = '–';
+  ui.firstImage.textContent = '–';
+  delete ui.firstPixel.dataset.ms;
+  delete ui.firstImage.dataset.ms;
+  // `pending` until the preview covers the canvas, then `done` (for whoever watches).
+  if (preview) ui.canvas.dataset.preview = 'pending';
+  else delete ui.canvas.dataset.preview;
   ui.render.disabled = true;
   ui.cancel.disabled = false;
   ui.downloadPng.disabled = true;
@@ -311,6 +367,7 @@ function startRender() {
     path: scenePath,
     files: [...files],
     settings,
+    preview: preview ? PREVIEW : null,
   };
   for (const worker of pool) worker.postMessage(message);
   render.timer = setInterval(showProgress, 250);
@@ -323,6 +380,10 @@ function nextTile(worker) {
   const queue = render.queues ? render.queues.get(worker) : render.queue;
   const tile = queue?.shift();
   if (!tile) return;
+  if (tile.preview) {
+    worker.postMessage({ type: 'preview', job: render.job, tile });
+    return;
+  }
   if (!render.progressive) {
     worker.postMessage({ type: 'tile', job: render.job, tile });
     return;
@@ -340,6 +401,9 @@ function onWorkerMessage(worker, data) {
   if (!render?.running || data.job !== render.job) return;
   if (data.type === 'ready') {
     nextTile(worker);
+  } else if (data.type === 'tile' && data.tile.preview) {
+    drawPreview(data);
+    nextTile(worker);
   } else if (data.type === 'tile') {
     storeTile(data);
     nextTile(worker);
@@ -352,11 +416,59 @@ function onWorkerMessage(worker, data) {
   }
 }
 
+// A strip of the preview, scaled up to the blocks it stands for and drawn behind what the
+// canvas holds ('destination-over'), so that it never covers a tile already rendered.
+function drawPreview({ tile, rgb8, rays }) {
+  const tileWidth = tile.x1 - tile.x0;
+  const tileHeight = tile.y1 - tile.y0;
+  const strip = new OffscreenCanvas(tileWidth, tileHeight);
+  strip.getContext('2d').putImageData(rgbaImage(rgb8, tileWidth, tileHeight), 0, 0);
+  const context = ui.canvas.getContext('2d');
+  context.save();
+  context.globalCompositeOperation = 'destination-over';
+  context.imageSmoothingEnabled = false;
+  context.drawImage(strip, tile.x0 * PREVIEW, tile.y0 * PREVIEW, tileWidth * PREVIEW, tileHeight * PREVIEW);
+  context.restore();
+  render.rays += rays;
+  markFirstPixel();
+  render.previewLeft -= 1;
+  if (render.previewLeft === 0) {
+    markFirstImage();
+    ui.canvas.dataset.preview = 'done';
+  }
+}
+
+function rgbaImage(rgb8, width, height) {
+  const image = new ImageData(width, height);
+  for (let i = 0; i < width * height; i += 1) {
+    image.data[i * 4] = rgb8[i * 3];
+    image.data[i * 4 + 1] = rgb8[i * 3 + 1];
+    image.data[i * 4 + 2] = rgb8[i * 3 + 2];
+    image.data[i * 4 + 3] = 255;
+  }
+  return image;
+}
+
+// The first thing on screen (a strip of the preview or a tile).
+function markFirstPixel() {
+  if (render.firstPixel !== null) return;
+  render.firstPixel = performance.now() - render.start;
+  ui.firstPixel.textContent = `${render.firstPixel.toFixed(0)} ms`;
+  ui.firstPixel.dataset.ms = String(render.firstPixel);
+}
+
+// The whole canvas holds an image: the preview's, pass 1's, or the final one.
+function markFirstImage() {
+  if (render.firstImage !== null) return;
+  render.firstImage = performance.now() - render.start;
+  ui.firstImage.textContent = `${render.firstImage.toFixed(0)} ms`;
+  ui.firstImage.dataset.ms = String(render.firstImage);
+}
+
 function storeTile({ tile, rgb8, pixels, albedo, normal, depth, rays, nonfinite }) {
   const { width } = render.settings;
   const tileWidth = tile.x1 - tile.x0;
   const tileHeight = tile.y1 - tile.y0;
-  const image = new ImageData(tileWidth, tileHeight);
   for (let row = 0; row < tileHeight; row += 1) {
     const start = ((tile.y0 + row) * width + tile.x0);
     const from = row * tileWidth;
@@ -367,18 +479,8 @@ function storeTile({ tile, rgb8, pixels, albedo, normal, depth, rays, nonfinite 
       render.depth.set(depth.subarray(from, from + tileWidth), start);
     }
   }
-  for (let i = 0; i < tileWidth * tileHeight; i += 1) {
-    image.data[i * 4] = rgb8[i * 3];
-    image.data[i * 4 + 1] = rgb8[i * 3 + 1];
-    image.data[i * 4 + 2] = rgb8[i * 3 + 2];
-    image.data[i * 4 + 3] = 255;
-  }
-  ui.canvas.getContext('2d').putImageData(image, tile.x0, tile.y0);
-  if (render.firstPixel === null) {
-    render.firstPixel = performance.now() - render.start;
-    ui.firstPixel.textContent = `${render.firstPixel.toFixed(0)} ms`;
-    ui.firstPixel.dataset.ms = String(render.firstPixel);
-  }
+  ui.canvas.getContext('2d').putImageData(rgbaImage(rgb8, tileWidth, tileHeight), tile.x0, tile.y0);
+  markFirstPixel();
   render.done += 1;
   render.rays += rays;
   render.nonfinite += nonfinite;
@@ -394,6 +496,7 @@ function passDone() {
   const perSample = (now - render.passStart) / 1000 / added;
   render.taken = render.target;
   const { spp, time } = render.settings;
+  markFirstImage();
   markPass(render.pass, render.taken);
   ui.downloadPng.disabled = false;
   ui.downloadExr.disabled = false;
@@ -449,6 +552,7 @@ function endRender() {
 }
 
 function finishRender() {
+  markFirstImage();
   endRender();
   ui.downloadPng.disabled = false;
   ui.downloadExr.disabled = false;
@@ -492,12 +596,19 @@ function failRender(error) {
 function download(format) {
   const { width, height } = render.settings;
   const features = format === 'exr' && render.albedo;
-  const bytes = encode(
-    format, render.settings.integrator, width, height, render.pixels,
-    features ? render.albedo : undefined,
-    features ? render.normal : undefined,
-    features ? render.depth : undefined,
-  );
+  // The render's own settings (checked when it started): its display transform for the PNG.
+  const settings = makeSettings(Settings, render.settings);
+  let bytes;
+  try {
+    bytes = settings.encode(
+      format, width, height, render.pixels,
+      features ? render.albedo : undefined,
+      features ? render.normal : undefined,
+      features ? render.depth : undefined,
+    );
+  } finally {
+    settings.free();
+  }
   const url = URL.createObjectURL(new Blob([bytes], { type: `image/${format === 'png' ? 'png' : 'x-exr'}` }));
   const link = document.createElement('a');
   link.href = url;
@@ -534,6 +645,11 @@ async function main() {
   ui.downloadPng.onclick = () => download('png');
   ui.downloadExr.onclick = () => download('exr');
   startPool();
+  // A newcomer's page is ready to render: the first example is loaded before the page says so.
+  ui.example.value = '0';
+  await chooseExample(0).catch((error) => {
+    ui.diagnostics.textContent = `error: ${error.message}`;
+  });
   ui.render.disabled = false;
   setStatus('idle', 'ready');
 }

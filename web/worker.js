@@ -2,21 +2,26 @@
 // the page hands it, one at a time, until the page terminates it. For the path tracers a tile
 // comes once a pass: the worker keeps its running sums (`TilePasses`) from pass to pass, and the
 // page sends each tile back to the worker that rendered its first pass.
+// A render's preview (`Settings.preview`) comes first, in strips, rendered as tiles are.
 import init, { Files, Settings, load_bytes as loadBytes } from './pkg/glint_wasm.js';
+import { makeSettings } from './settings.js';
 
 const ready = init();
-let current = null; // { job, loaded, settings, passes: Map(tile index -> TilePasses) }
+// { job, loaded, settings, preview (or null), passes: Map(tile index -> TilePasses) }
+let current = null;
 
 function release() {
   if (current) {
     for (const passes of current.passes.values()) passes.free();
     current.loaded.free();
     current.settings.free();
+    current.preview?.free();
     current = null;
   }
 }
 
-function startJob({ job, bytes, path, files, settings }) {
+// `preview`: the preview's scale (its pixels stand for preview x preview blocks), or null.
+function startJob({ job, bytes, path, files, settings, preview }) {
   release();
   const assets = new Files();
   for (const [name, bytes] of files) assets.add(name, bytes);
@@ -27,11 +32,23 @@ function startJob({ job, bytes, path, files, settings }) {
     loaded.free();
     return { type: 'failed', job, error };
   }
-  const s = settings;
-  const renderSettings = new Settings(
-    s.width, s.height, s.spp, s.integrator, BigInt(s.seed), s.maxDepth, s.features,
-  );
-  current = { job, loaded, settings: renderSettings, passes: new Map() };
+  let renderSettings;
+  try {
+    renderSettings = makeSettings(Settings, settings);
+    // The CLI's --background, -d and --aperture change the scene, once per job.
+    loaded.apply(renderSettings);
+  } catch (error) {
+    renderSettings?.free();
+    loaded.free();
+    return { type: 'failed', job, error: String(error) };
+  }
+  current = {
+    job,
+    loaded,
+    settings: renderSettings,
+    preview: preview ? renderSettings.preview(preview) : null,
+    passes: new Map(),
+  };
   return { type: 'ready', job };
 }
 
@@ -47,10 +64,12 @@ function passTile(tile, samples) {
 }
 
 // `samples` (the samples per pixel the tile's pass reaches) is there only for a render in passes.
-function renderTile({ job, tile, samples }) {
+// A preview strip is a tile of the preview's settings.
+function renderTile({ type, job, tile, samples }) {
   if (!current || current.job !== job) return { type: 'failed', job, error: 'no scene loaded' };
+  const settings = type === 'preview' ? current.preview : current.settings;
   const { result, taken } = samples === undefined
-    ? { result: current.loaded.render_tile(current.settings, tile.x0, tile.y0, tile.x1, tile.y1) }
+    ? { result: current.loaded.render_tile(settings, tile.x0, tile.y0, tile.x1, tile.y1) }
     : passTile(tile, samples);
   const message = {
     type: 'tile',

@@ -67,9 +67,14 @@ async function setSettings(page, { width, height, spp }) {
   await page.fill('#spp', String(spp));
 }
 
+const EXAMPLE_SCENES = ['three_spheres.xml', 'textured/textured.xml'];
+
+// Waits for the example's own scene (a lasting state): the page opens with example 0 loaded,
+// so diagnostics alone may still be the last scene's.
 async function chooseExample(page, index) {
   await page.selectOption('#example', String(index));
-  await page.waitForSelector('#diagnostics[data-state]');
+  await page.waitForFunction((scene) => document.getElementById('scene-file').value === scene
+    && document.getElementById('diagnostics').dataset.state, EXAMPLE_SCENES[index]);
 }
 
 async function downloadBytes(page, button) {
@@ -110,16 +115,22 @@ function comparisonFigure(cli, canvas, width, height) {
   return { figure: PNG.sync.write(figure), largest, differing };
 }
 
+const TEXTURED = path.join(web, 'scenes', 'textured');
+
+/** Renders the textured example with the CLI to `output/name` with `flags`; returns the file. */
+function cliTextured(name, settings, flags = []) {
+  const file = path.join(output, name);
+  const run = runGlint(['render', path.join(TEXTURED, 'textured.xml'), '-o', file,
+    '-w', String(settings.width), '-h', String(settings.height), '-r', String(settings.spp),
+    ...flags]);
+  assert.equal(run.status, 0, run.stderr);
+  return file;
+}
+
 test('the page renders the example scene with its assets exactly as the CLI', async () => {
   const settings = { width: 200, height: 150, spp: 4 };
-  const scene = path.join(web, 'scenes', 'textured', 'textured.xml');
-  const cliPng = path.join(output, 'cli.png');
-  const cliExr = path.join(output, 'cli.exr');
-  for (const file of [cliPng, cliExr]) {
-    const run = runGlint(['render', scene, '-o', file, '-w', String(settings.width),
-      '-h', String(settings.height), '-r', String(settings.spp)]);
-    assert.equal(run.status, 0, run.stderr);
-  }
+  const cliPng = cliTextured('cli.png', settings);
+  const cliExr = cliTextured('cli.exr', settings);
 
   const { page, context, errors } = await openPage();
   await chooseExample(page, 1);
@@ -354,7 +365,9 @@ test('a scene opened without its assets names each missing file, as the CLI does
 
   const { page, context, errors } = await openPage();
   await page.setInputFiles('#open-files', path.join(folder, 'textured.xml'));
-  await page.waitForSelector('#diagnostics[data-state="ok"]');
+  // The page opens with an example loaded: wait for this scene, not for any diagnostics.
+  await page.waitForFunction(() => document.getElementById('scene-file').value === 'textured.xml');
+  assert.equal(await page.getAttribute('#diagnostics', 'data-state'), 'ok');
   // The same text, but for the cause: the CLI's operating system has no such file, the page has
   // not been given one.
   const cause = 'No such file or directory (os error 2)';
@@ -378,7 +391,9 @@ test('Cancel stops a render, and the next render runs', async () => {
   await chooseExample(page, 0);
   await setSettings(page, { width: 1200, height: 900, spp: 64 });
   await page.click('#render');
-  await page.waitForSelector('#first-pixel[data-ms]', { timeout: 60_000 });
+  // A tile done (lasting: the count only grows); the first pixel may be the preview's.
+  await page.waitForFunction(() => Number(document.getElementById('tiles').textContent.split(' / ')[0]) >= 1,
+    null, { timeout: 60_000 });
   await page.click('#cancel');
   await page.waitForSelector('#status[data-state="cancelled"]');
   const tiles = await page.textContent('#tiles');
@@ -463,7 +478,8 @@ test('a Mitsuba scene renders at its own film size and samples, as the CLI does'
   const { page, context, errors } = await openPage();
   const defaults = await controls(page);
   await dropText(page, 'mitsuba.xml', MITSUBA);
-  await page.waitForSelector('#diagnostics[data-state="ok"]');
+  await page.waitForFunction(() => document.getElementById('scene-file').value === 'mitsuba.xml');
+  assert.equal(await page.getAttribute('#diagnostics', 'data-state'), 'ok');
   assert.deepEqual(await controls(page),
     { width: '24', height: '16', spp: '4', integrator: 'path', 'max-depth': '2' });
   await page.click('#render');
@@ -610,6 +626,237 @@ test('a .gltf dropped without its .bin shows the located error', async (t) => {
     cli.text.replaceAll(cause, 'no such file among the files given'));
   await page.click('#render');
   await page.waitForSelector('#status[data-state="error"]');
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+/** The canvas's RGBA bytes and whether they equal `png`'s (decoded) exactly. */
+async function canvasAgainst(page, png) {
+  const canvas = await canvasPixels(page);
+  const { largest, differing } = channelDifference(png.data, canvas);
+  return { canvas, largest, differing };
+}
+
+test('loose files: a scene with its mesh and texture opened without folders renders as the CLI', async () => {
+  const settings = { width: 200, height: 150, spp: 4 };
+  const cli = decodePng(fs.readFileSync(cliTextured('cli-loose.png', settings)));
+  const loose = ['textured.xml', 'objFiles/pyramid.obj', 'images/checker.png'];
+  // What a multi-file picker gives: base names, no folders. Each asset is found by its base
+  // name, which the diagnostics note.
+  const notes = [
+    'note: objFiles/pyramid.obj: using pyramid.obj from the files given',
+    'note: images/checker.png: using checker.png from the files given',
+  ];
+
+  const { page, context, errors } = await openPage();
+  await page.setInputFiles('#open-files', loose.map((name) => path.join(TEXTURED, name)));
+  await page.waitForFunction(() => document.getElementById('scene-file').value === 'textured.xml');
+  assert.equal(await page.getAttribute('#diagnostics', 'data-state'), 'ok');
+  assert.deepEqual((await page.textContent('#diagnostics')).split('\n').sort(), [...notes].sort());
+  await setSettings(page, settings);
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 120_000 });
+  const { largest, differing } = await canvasAgainst(page, cli);
+  assert.equal(largest, 0, `${differing} channels differ from the CLI's`);
+  const png = decodePng(await downloadBytes(page, '#download-png'));
+  assert.ok(Buffer.from(png.data).equals(Buffer.from(cli.data)), 'the PNG differs from the CLI\'s');
+
+  // The same loose files dropped on the page (the scene renamed, to tell it from the last):
+  // the same notes.
+  await dropFiles(page, Object.fromEntries(loose.map((name) => [
+    name === 'textured.xml' ? 'dropped.xml' : path.basename(name),
+    fs.readFileSync(path.join(TEXTURED, name)),
+  ])));
+  await page.waitForFunction(() => document.getElementById('scene-file').value === 'dropped.xml');
+  assert.equal(await page.getAttribute('#diagnostics', 'data-state'), 'ok');
+  assert.deepEqual((await page.textContent('#diagnostics')).split('\n').sort(), [...notes].sort());
+
+  // Two files of the mesh's base name, neither at its path: an error naming both, not a guess.
+  const folder = path.join(output, 'two-pyramids');
+  for (const where of ['a', 'b', 'images']) fs.mkdirSync(path.join(folder, where), { recursive: true });
+  fs.copyFileSync(path.join(TEXTURED, 'textured.xml'), path.join(folder, 'textured.xml'));
+  fs.copyFileSync(path.join(TEXTURED, 'images', 'checker.png'), path.join(folder, 'images', 'checker.png'));
+  for (const where of ['a', 'b']) {
+    fs.copyFileSync(path.join(TEXTURED, 'objFiles', 'pyramid.obj'), path.join(folder, where, 'pyramid.obj'));
+  }
+  await page.setInputFiles('#open-folder', folder);
+  await page.waitForFunction(() => document.getElementById('scene-file').value === 'two-pyramids/textured.xml');
+  assert.equal(await page.getAttribute('#diagnostics', 'data-state'), 'error');
+  assert.equal(await page.textContent('#diagnostics'), 'error: two-pyramids/textured.xml: '
+    + 'objFiles/pyramid.obj: 2 files named pyramid.obj among the files given '
+    + '(two-pyramids/a/pyramid.obj, two-pyramids/b/pyramid.obj), and none at its path: open the '
+    + 'scene\'s folder (or drop it) so that the path finds the file');
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="error"]');
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('the page opens with the first example ready to render; Render without a scene says what to do', async () => {
+  const { page, context, errors } = await openPage();
+  assert.equal(await page.inputValue('#example'), '0');
+  assert.equal(await page.inputValue('#scene-file'), 'three_spheres.xml');
+  assert.equal(await page.inputValue('#scene-text'),
+    fs.readFileSync(path.join(web, 'scenes', 'three_spheres.xml'), 'utf8'));
+  assert.equal(await page.getAttribute('#diagnostics', 'data-state'), 'ok');
+  await setSettings(page, { width: 40, height: 30, spp: 1 });
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 60_000 });
+
+  // The text emptied (or never given): what to do, not a parser's complaint.
+  await page.fill('#scene-text', '  \n');
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="error"]');
+  const what = 'no scene to render: choose an example, open a scene file or drop one here';
+  assert.equal(await page.textContent('#status'), what);
+  assert.equal(await page.textContent('#diagnostics'), `error: ${what}`);
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+test('every control says what it does, and background, depth of field and exposure render as the CLI', async () => {
+  const { page, context, errors } = await openPage();
+  // A tooltip on every control, its own or its label's, naming the CLI option or its range.
+  const untitled = await page.evaluate(() => [...document.querySelectorAll(
+    'main input, main select, main button, main textarea',
+  )]
+    .filter((control) => !(control.title || control.closest('label')?.title))
+    .map((control) => control.id || control.outerHTML));
+  assert.deepEqual(untitled, []);
+  for (const id of ['background', 'focus', 'aperture', 'exposure', 'tonemap', 'transfer']) {
+    assert.match(await page.$eval(`#${id}`, (control) => control.closest('label').title),
+      /glint render --?\w+/, id);
+  }
+
+  const settings = { width: 200, height: 150, spp: 4 };
+  const flags = ['--background', '0.2,0.5,0.8', '-d', '7', '--aperture', '0.2',
+    '--exposure', '1', '--tonemap', 'aces'];
+  const cli = decodePng(fs.readFileSync(cliTextured('cli-options.png', settings, flags)));
+  const plain = decodePng(fs.readFileSync(cliTextured('cli-plain.png', settings)));
+  // The options change the image (else this would test nothing).
+  assert.ok(channelDifference(cli.data, plain.data).differing > cli.data.length / 4);
+
+  await chooseExample(page, 1);
+  await setSettings(page, settings);
+  await page.fill('#background', '0.2,0.5,0.8');
+  await page.fill('#focus', '7');
+  await page.fill('#aperture', '0.2');
+  await page.fill('#exposure', '1');
+  await page.selectOption('#tonemap', 'aces');
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 120_000 });
+  const { largest, differing } = await canvasAgainst(page, cli);
+  assert.equal(largest, 0, `${differing} channels differ from the CLI's`);
+  const png = await downloadBytes(page, '#download-png');
+  fs.writeFileSync(path.join(output, 'page-options.png'), png);
+  assert.ok(Buffer.from(decodePng(png).data).equals(Buffer.from(cli.data)),
+    'the PNG differs from the CLI\'s');
+
+  // Refused as the CLI refuses them, in its words.
+  await page.fill('#background', 'blue');
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="error"]');
+  assert.equal(await page.textContent('#status'), 'the render failed: background: expected three '
+    + 'comma-separated numbers R,G,B (e.g. 0.2,0.2,0.2), got 1 value');
+  await page.fill('#background', '');
+  await page.fill('#focus', '');
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="error"]');
+  assert.equal(await page.textContent('#status'), 'the render failed: the aperture needs depth '
+    + 'of field: give a focus distance greater than 0');
+  assert.deepEqual(errors, []);
+  await context.close();
+});
+
+/**
+ * Records, in the page, when the preview first covers the canvas and when a pass or the render
+ * completes (a MutationObserver runs in the task that made the change), with the canvas then.
+ */
+async function watchPreview(page) {
+  await page.evaluate(() => {
+    const status = document.getElementById('status');
+    const canvas = document.getElementById('canvas');
+    window.previewLog = { events: [], preview: null };
+    const seen = () => {
+      const log = window.previewLog;
+      if (canvas.dataset.preview === 'done' && !log.preview) {
+        const { data } = canvas.getContext('2d').getImageData(0, 0, canvas.width, canvas.height);
+        log.preview = { data: Array.from(data), tiles: document.getElementById('tiles').textContent };
+        log.events.push('preview');
+      }
+      const state = status.dataset.pass ? `pass ${status.dataset.pass}` : status.dataset.state;
+      if (log.events.at(-1) !== state && state !== 'rendering') log.events.push(state);
+    };
+    new MutationObserver(seen).observe(canvas, { attributes: true });
+    new MutationObserver(seen).observe(status,
+      { attributes: true, childList: true, characterData: true, subtree: true });
+  });
+}
+
+/** The share of the image's 8x8 blocks (whole ones) whose pixels are all one colour. */
+function uniformBlocks(data, width, height) {
+  let uniform = 0;
+  let blocks = 0;
+  for (let by = 0; by + 8 <= height; by += 8) {
+    for (let bx = 0; bx + 8 <= width; bx += 8) {
+      blocks += 1;
+      const first = ((by * width) + bx) * 4;
+      let same = true;
+      for (let y = by; y < by + 8 && same; y += 1) {
+        for (let x = bx; x < bx + 8 && same; x += 1) {
+          const i = (y * width + x) * 4;
+          same = data[i] === data[first] && data[i + 1] === data[first + 1] && data[i + 2] === data[first + 2];
+        }
+      }
+      if (same) uniform += 1;
+    }
+  }
+  return uniform / blocks;
+}
+
+test('a render shows a coarse preview before its first pass, and ends as the CLI\'s image', async () => {
+  // 20 tiles: enough for a preview (more than 4), few enough to be quick.
+  const settings = { width: 160, height: 120, spp: 2 };
+  const { page, context, errors } = await openPage();
+  await chooseExample(page, 0);
+  await setSettings(page, settings);
+  await page.selectOption('#integrator', 'path');
+  await watchPreview(page);
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 120_000 });
+  const { events, preview } = await page.evaluate(() => window.previewLog);
+  // The preview covered the canvas before pass 1 was complete: every pixel drawn, in 8x8
+  // blocks but where a tile had already replaced it.
+  assert.deepEqual(events, ['preview', 'pass 1', 'pass 2'], events.join(', '));
+  for (let i = 3; i < preview.data.length; i += 4) {
+    assert.equal(preview.data[i], 255, 'a pixel the preview did not cover');
+  }
+  const [done, total] = preview.tiles.split(' / ').map(Number);
+  assert.ok(done < total, preview.tiles);
+  const blocky = uniformBlocks(preview.data, settings.width, settings.height);
+  assert.ok(blocky > 0.5, `${(blocky * 100).toFixed(0)}% of the preview's 8x8 blocks are uniform`);
+  const firstImage = Number(await page.getAttribute('#first-image', 'data-ms'));
+  console.log(`# preview: whole canvas after ${firstImage.toFixed(0)} ms, `
+    + `first pixel after ${Number(await page.getAttribute('#first-pixel', 'data-ms')).toFixed(0)} ms; `
+    + `${preview.tiles} tiles of pass 1 then`);
+  // The final image is the passes' as before: the CLI's, within wasm's one level (see above).
+  const cli = cliPath('cli-preview.png', settings);
+  const ours = decodePng(await downloadBytes(page, '#download-png'));
+  assert.ok(channelDifference(cli.data, ours.data).largest <= 1);
+
+  // Tile by tile (the course integrator): preview first too, the final canvas the CLI's exactly.
+  await page.selectOption('#integrator', 'course');
+  await watchPreview(page);
+  await page.click('#render');
+  await page.waitForSelector('#status[data-state="done"]', { timeout: 120_000 });
+  const course = await page.evaluate(() => window.previewLog);
+  assert.deepEqual(course.events, ['preview', 'done']);
+  const cliCourse = path.join(output, 'cli-preview-course.png');
+  const run = runGlint(['render', path.join(web, 'scenes', 'three_spheres.xml'), '-o', cliCourse,
+    '-w', String(settings.width), '-h', String(settings.height), '-r', String(settings.spp)]);
+  assert.equal(run.status, 0, run.stderr);
+  const { largest, differing } = await canvasAgainst(page, decodePng(fs.readFileSync(cliCourse)));
+  assert.equal(largest, 0, `${differing} channels differ from the CLI's`);
   assert.deepEqual(errors, []);
   await context.close();
 });

@@ -375,8 +375,9 @@ fn glb_and_gltf_bytes_load_with_the_dropped_files() {
     );
     let loaded = load_bytes(&gltf, "models/Box.gltf", &files, None, None);
     assert!(loaded.ok(), "{:?}", loaded.messages());
-    // Without it, a located error naming it; a camera it lacks, another.
-    let missing = load_bytes(&gltf, "Box.gltf", &files, None, None);
+    // Without it, a located error naming it; a camera it lacks, another. (With it anywhere
+    // among the files, the only one of its name, it would be found by that name.)
+    let missing = load_bytes(&gltf, "Box.gltf", &Files::new(), None, None);
     assert!(!missing.ok());
     let error = &missing.messages()[0];
     assert!(error.text.starts_with("error: Box.gltf:"), "{error:?}");
@@ -388,4 +389,84 @@ fn glb_and_gltf_bytes_load_with_the_dropped_files() {
         camera.messages()
     );
     assert!(!load_bytes(&gltf, "models/Box.gltf", &files, Some(1), None).ok());
+}
+
+#[test]
+fn loose_files_are_found_by_their_base_name_with_a_note_and_two_are_an_error() {
+    let (text, files) = example_files();
+    let root = Path::new(WEB).join("scenes/textured");
+    let read = |name: &str| std::fs::read(root.join(name)).unwrap();
+    let settings = Settings::new(24, 18, 1, "course", 0, None, false).unwrap();
+    let whole = load(&text, "textured/textured.xml", &files);
+    assert!(whole.ok());
+    assert!(whole.messages().is_empty(), "{:?}", whole.messages());
+
+    // A multi-file picker's base names: found, noted, and the same image.
+    let mut loose = Files::new();
+    loose.add("pyramid.obj", read("objFiles/pyramid.obj"));
+    loose.add("checker.png", read("images/checker.png"));
+    let loaded = load(&text, "textured.xml", &loose);
+    assert!(loaded.ok(), "{:?}", loaded.messages());
+    let mut texts: Vec<String> = loaded.messages().into_iter().map(|m| m.text).collect();
+    texts.sort();
+    assert_eq!(
+        texts,
+        [
+            "note: images/checker.png: using checker.png from the files given",
+            "note: objFiles/pyramid.obj: using pyramid.obj from the files given",
+        ]
+    );
+    let tile = |loaded: &glint_wasm::Loaded| loaded.render_tile(&settings, 0, 0, 24, 18).unwrap();
+    assert_eq!(tile(&loaded).pixels, tile(&whole).pixels);
+
+    // Two of that name and none at the path: an error naming both.
+    let mut two = Files::new();
+    two.add("a/pyramid.obj", read("objFiles/pyramid.obj"));
+    two.add("b/pyramid.obj", read("objFiles/pyramid.obj"));
+    two.add("images/checker.png", read("images/checker.png"));
+    let ambiguous = load(&text, "textured.xml", &two);
+    assert!(!ambiguous.ok());
+    let error = &ambiguous.messages()[0].text;
+    assert!(
+        error.starts_with("error: textured.xml: objFiles/pyramid.obj: 2 files named pyramid.obj")
+            && error.contains("(a/pyramid.obj, b/pyramid.obj)"),
+        "{error}"
+    );
+}
+
+#[test]
+fn background_depth_of_field_and_display_settings_are_checked_and_applied() {
+    let (text, files) = example_files();
+    let mut loaded = load(&text, "textured/textured.xml", &files);
+    let plain = Settings::new(24, 18, 4, "course", 0, None, false).unwrap();
+    let mut options = plain.clone();
+    options.set_background("0.2,0.5,0.8").unwrap();
+    options.set_depth_of_field(Some(7.0), Some(0.2)).unwrap();
+    options
+        .set_display(Some(1.0), Some("aces".into()), None)
+        .unwrap();
+    let before = loaded.render_tile(&plain, 0, 0, 24, 18).unwrap();
+    loaded.apply(&options).unwrap();
+    let after = loaded.render_tile(&options, 0, 0, 24, 18).unwrap();
+    assert_ne!(before.pixels, after.pixels);
+    assert_ne!(before.rgb8, after.rgb8);
+    // Plain settings again: the scene's own background and camera.
+    loaded.apply(&plain).unwrap();
+    assert_eq!(
+        loaded.render_tile(&plain, 0, 0, 24, 18).unwrap().pixels,
+        before.pixels
+    );
+
+    let mut bad = plain.clone();
+    assert!(bad
+        .set_background("1,2")
+        .unwrap_err()
+        .starts_with("background: expected three"));
+    assert!(bad.set_background("1,-2,3").is_err());
+    assert!(bad.set_depth_of_field(None, Some(0.1)).is_err());
+    assert!(bad.set_depth_of_field(Some(0.0), Some(0.1)).is_err());
+    assert!(bad.set_depth_of_field(Some(f32::NAN), None).is_err());
+    assert!(bad.set_display(Some(65.0), None, None).is_err());
+    assert!(bad.set_display(None, Some("filmic".into()), None).is_err());
+    assert!(bad.set_display(None, None, Some("gamma".into())).is_err());
 }
