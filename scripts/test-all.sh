@@ -7,7 +7,8 @@
 # Suites: the Rust workspace (`cargo test --workspace`: unit, reference-image, corpus, Mitsuba,
 # software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh),
 # Mitsuba's own test scenes by its rule (scripts/mitsuba-suite.sh), the release binary's SIMD intrinsics inlined (scripts/inlined-intrinsics.sh), every
-# README command in a fresh clone (scripts/readme-examples.sh), and each
+# README command in a fresh clone (scripts/readme-examples.sh), again as a newcomer without
+# ../shared (--newcomer), and each
 # front end's own script (`ci.sh install|test`, listed in SUITES below).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -104,6 +105,12 @@ CARGO_TARGET_DIR="$root/target" scripts/readme-examples.sh 2>&1 | tee "$logs/rea
 result[readme]=$(tail -n 1 "$logs/readme.log")
 [ "$status" = 0 ] || failed=1
 
+echo "== README as a newcomer: a fresh clone, no ../shared (scripts/readme-examples.sh --newcomer)"
+status=0
+CARGO_TARGET_DIR="$root/target" scripts/readme-examples.sh --newcomer 2>&1 | tee "$logs/newcomer.log" || status=$?
+result[newcomer]=$(tail -n 1 "$logs/newcomer.log")
+[ "$status" = 0 ] || failed=1
+
 for suite in "${SUITES[@]}"; do
   echo "== $suite test"
   status=0
@@ -114,7 +121,7 @@ done
 
 echo
 echo "== summary"
-for name in cargo same-images mitsuba-suite intrinsics readme "${SUITES[@]}"; do
+for name in cargo same-images mitsuba-suite intrinsics readme newcomer "${SUITES[@]}"; do
   printf '%-26s %s\n' "$name" "${result[$name]}"
 done
 if [ "$failed" != 0 ]; then
