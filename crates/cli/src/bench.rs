@@ -28,8 +28,8 @@ pub struct BenchArgs {
     #[command(subcommand)]
     pub command: BenchCommand,
 
-    /// Print help (`glint` turns off `-h`, which is the image height for renders).
-    #[arg(short = '?', long, action = clap::ArgAction::Help, global = true)]
+    /// Print help (-? and -h alike; -h is the image height only where a command renders).
+    #[arg(short = '?', short_alias = 'h', long, action = clap::ArgAction::Help, global = true)]
     pub help: Option<bool>,
 }
 

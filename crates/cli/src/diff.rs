@@ -62,8 +62,8 @@ pub struct DiffArgs {
     #[arg(long, value_name = "SIZE", value_parser = crate::machine::parse_size)]
     pub max_memory: Option<u64>,
 
-    /// Print help (`glint` turns off `-h`, which is the image height for renders).
-    #[arg(short = '?', long, action = clap::ArgAction::Help)]
+    /// Print help (-? and -h alike; -h is the image height only where a command renders).
+    #[arg(short = '?', short_alias = 'h', long, action = clap::ArgAction::Help)]
     pub help: Option<bool>,
 }
 
