@@ -4,24 +4,38 @@
 //! first, a progress bar over sample passes, and a closing line in samples per second (the GPU
 //! does not count rays).
 //!
+//! A `glint` built without the `gpu` feature has no wgpu: `--device gpu` is refused (exit 2)
+//! before the scene is read (`features::refuse_missing`).
+//!
 //! Exit statuses: 2 when the GPU path does not support what was asked (another integrator,
 //! or a scene whose buffers exceed what the adapter can bind), like any other unusable
 //! argument; 1 when there is no adapter or the device fails, since then the machine, not the
 //! input, is at fault.
 
 use std::io::Write;
-use std::time::Instant;
 
-use glint_gpu::{GpuError, GpuRenderer};
-use glint_render::{RenderStats, SceneParts};
+use glint_render::SceneParts;
 
 use crate::failure::Failure;
-use crate::interrupt::{Interrupt, Phase};
-use crate::job::{Job, UsageError};
-use crate::progress::{self, Unit};
-use crate::report::{finish, rendering_line, warn_nonfinite, Device, Summary};
+use crate::interrupt::Interrupt;
+use crate::job::Job;
+use crate::report::Summary;
+
+/// Without the `gpu` feature: never reached, since `features::refuse_missing` refuses
+/// `--device gpu` before the scene is read; refused the same way all the same.
+#[cfg(not(feature = "gpu"))]
+pub fn run(
+    _job: &Job,
+    _parts: &SceneParts,
+    _interrupt: &Interrupt,
+    _err: &mut dyn Write,
+    _progress_bar: bool,
+) -> Result<Summary, Failure> {
+    Err(crate::features::missing_gpu())
+}
 
 /// Renders `parts` on the GPU and writes the image.
+#[cfg(feature = "gpu")]
 pub fn run(
     job: &Job,
     parts: &SceneParts,
@@ -29,6 +43,15 @@ pub fn run(
     err: &mut dyn Write,
     progress_bar: bool,
 ) -> Result<Summary, Failure> {
+    use std::time::Instant;
+
+    use glint_gpu::{GpuError, GpuRenderer};
+    use glint_render::RenderStats;
+
+    use crate::interrupt::Phase;
+    use crate::progress::{self, Unit};
+    use crate::report::{finish, rendering_line, warn_nonfinite, Device};
+
     let settings = &job.settings;
     // Options of the CPU pipeline the GPU path does not have: refused, never ignored.
     let cpu_only = [
@@ -89,7 +112,12 @@ pub fn run(
 
 /// The failure for a `GpuError`: what the user asked for (exit 2) or what the machine lacks
 /// (exit 1).
-fn unsupported(error: GpuError) -> Failure {
+#[cfg(feature = "gpu")]
+fn unsupported(error: glint_gpu::GpuError) -> Failure {
+    use glint_gpu::GpuError;
+
+    use crate::job::UsageError;
+
     match error {
         GpuError::Unsupported(_) => Failure::GpuUnsupported(error),
         GpuError::Invalid(why) => Failure::Usage(UsageError(why)),

@@ -14,6 +14,7 @@ mod denoise;
 mod diff;
 mod failure;
 mod farm;
+mod features;
 mod gpu;
 mod interrupt;
 mod job;
@@ -91,6 +92,9 @@ fn main() -> ExitCode {
         Ok(job) => job,
         Err(error) => return fail(&Failure::Usage(error)),
     };
+    if let Err(failure) = features::refuse_missing(&job) {
+        return fail(&failure);
+    }
 
     handle_signals();
 

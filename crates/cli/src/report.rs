@@ -23,6 +23,8 @@ pub struct Summary {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Device {
     Cpu,
+    // Only a build with the `gpu` feature renders on the GPU.
+    #[cfg_attr(not(feature = "gpu"), allow(dead_code))]
     Gpu,
 }
 
