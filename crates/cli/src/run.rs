@@ -527,7 +527,7 @@ fn print_stats(
     let _ = write!(
         err,
         "{}",
-        pool.install(|| bvh_stats(&built.scene, &job.settings))
+        pool.install(|| bvh_stats(&built.scene, &job.settings, built.build_time))
     );
 }
 
