@@ -1,8 +1,8 @@
 //! `--device gpu`: the path tracer on the GPU back end (glint-gpu) instead of the CPU's render
 //! pipeline. The run is the CPU's (`run::run` loads the scene, this module renders and writes),
 //! and so is its reporting (`progress`, `report`), in the GPU's own terms: the adapter's name
-//! first, a progress bar over sample passes, and a closing line in samples per second (the GPU
-//! does not count rays).
+//! first, a progress bar over sample passes, and a closing line in samples per second, as on
+//! the CPU (the GPU kernel does not count rays).
 //!
 //! A `glint` built without the `gpu` feature has no wgpu: `--device gpu` is refused (exit 2)
 //! before the scene is read (`features::refuse_missing`).
@@ -50,7 +50,7 @@ pub fn run(
 
     use crate::interrupt::Phase;
     use crate::progress::{self, Unit};
-    use crate::report::{finish, rendering_line, warn_nonfinite, Device};
+    use crate::report::{finish, rendering_line, warn_nonfinite, Counts, Device};
 
     let settings = &job.settings;
     // Options of the CPU pipeline the GPU path does not have: refused, never ignored.
@@ -106,8 +106,11 @@ pub fn run(
     warn_nonfinite(Device::Gpu, &stats, err);
     let options = glint_io::WriteOptions { png: job.png };
     glint_io::write_image_with(&job.output, &film, &options).map_err(Failure::Write)?;
-    let samples = gpu_stats.samples;
-    Ok(finish(job, Device::Gpu, samples, stats, render_time, err))
+    let counts = Counts {
+        samples: gpu_stats.samples,
+        rays: None,
+    };
+    Ok(finish(job, Device::Gpu, counts, stats, render_time, err))
 }
 
 /// The failure for a `GpuError`: what the user asked for (exit 2) or what the machine lacks
