@@ -21,6 +21,41 @@ use crate::interrupt::Interrupt;
 use crate::job::Job;
 use crate::report::Summary;
 
+/// Keeps Mesa's device-selection layer from probing for a display where there is none. That
+/// implicit Vulkan layer (VK_LAYER_MESA_device_select) connects to Wayland while wgpu lists
+/// the adapters, to put the display's GPU first, and libwayland prints "error: XDG_RUNTIME_DIR
+/// is invalid or not set in the environment." for each attempt: an error that is not Glint's,
+/// about a display a headless render does not use. Without `WAYLAND_DISPLAY`,
+/// `WAYLAND_SOCKET` and `DISPLAY` there is no display to find, and wgpu chooses the adapter
+/// itself (by power preference), so the layer is turned off through its own switch,
+/// `NODEVICE_SELECT=1`; not when the user set any of the layer's variables. Only the layer's
+/// probing goes: the driver's own messages still reach stderr.
+///
+/// Changes the environment, so it must run before any other thread starts (`main` calls it
+/// right after parsing).
+pub fn quiet_display_probe() {
+    quiet_display_probe_in(&mut |name| std::env::var_os(name), &mut |name, value| {
+        std::env::set_var(name, value)
+    });
+}
+
+/// `quiet_display_probe` over a given environment (for the tests).
+fn quiet_display_probe_in(
+    get: &mut dyn FnMut(&str) -> Option<std::ffi::OsString>,
+    set: &mut dyn FnMut(&str, &str),
+) {
+    const DISPLAYS: [&str; 3] = ["WAYLAND_DISPLAY", "WAYLAND_SOCKET", "DISPLAY"];
+    const LAYER_SETTINGS: [&str; 3] = ["NODEVICE_SELECT", "MESA_VK_DEVICE_SELECT", "DRI_PRIME"];
+    let display = DISPLAYS
+        .iter()
+        .any(|name| get(name).is_some_and(|value| !value.is_empty()));
+    let chosen = LAYER_SETTINGS.iter().any(|name| get(name).is_some());
+    if display || chosen {
+        return;
+    }
+    set("NODEVICE_SELECT", "1");
+}
+
 /// Without the `gpu` feature: never reached, since `features::refuse_missing` refuses
 /// `--device gpu` before the scene is read; refused the same way all the same.
 #[cfg(not(feature = "gpu"))]
@@ -126,5 +161,42 @@ fn unsupported(error: glint_gpu::GpuError) -> Failure {
         GpuError::Invalid(why) => Failure::Usage(UsageError(why)),
         GpuError::Cancelled => Failure::Interrupted,
         GpuError::NoAdapter(_) | GpuError::Device(_) => Failure::Gpu(error),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use std::collections::HashMap;
+    use std::ffi::OsString;
+
+    use super::quiet_display_probe_in;
+
+    /// What `quiet_display_probe` sets in an environment holding `vars`.
+    fn probe(vars: &[(&str, &str)]) -> HashMap<String, String> {
+        let env: HashMap<String, OsString> = vars
+            .iter()
+            .map(|(name, value)| (name.to_string(), OsString::from(value)))
+            .collect();
+        let mut set = HashMap::new();
+        quiet_display_probe_in(&mut |name| env.get(name).cloned(), &mut |name, value| {
+            set.insert(name.to_string(), value.to_string());
+        });
+        set
+    }
+
+    #[test]
+    fn the_layer_is_turned_off_only_without_a_display_or_the_users_choice() {
+        let off = HashMap::from([("NODEVICE_SELECT".to_string(), "1".to_string())]);
+        assert_eq!(probe(&[]), off);
+        assert_eq!(probe(&[("DISPLAY", "")]), off);
+        for kept in [
+            ("DISPLAY", ":0"),
+            ("WAYLAND_DISPLAY", "wayland-0"),
+            ("NODEVICE_SELECT", "0"),
+            ("MESA_VK_DEVICE_SELECT", "1002:67df"),
+            ("DRI_PRIME", "1"),
+        ] {
+            assert!(probe(&[kept]).is_empty(), "{kept:?}");
+        }
     }
 }

@@ -95,6 +95,10 @@ fn main() -> ExitCode {
     if let Err(failure) = features::refuse_missing(&job) {
         return fail(&failure);
     }
+    if job.device == crate::args::DeviceArg::Gpu {
+        // Before any thread starts: it sets an environment variable.
+        gpu::quiet_display_probe();
+    }
 
     handle_signals();
 

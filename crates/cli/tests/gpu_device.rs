@@ -219,6 +219,30 @@ fn render_furnace(device: &str, removed: &[&str]) -> Option<String> {
     Some(stderr)
 }
 
+/// Headless, without XDG_RUNTIME_DIR (a container, a CI job, ssh), Mesa's device-selection
+/// layer used to look for a Wayland display and libwayland printed "error: XDG_RUNTIME_DIR is
+/// invalid or not set in the environment." twice, which read as Glint's error.
+#[test]
+fn a_headless_gpu_render_prints_no_display_errors() {
+    let headless = [
+        "XDG_RUNTIME_DIR",
+        "WAYLAND_DISPLAY",
+        "WAYLAND_SOCKET",
+        "DISPLAY",
+        "NODEVICE_SELECT",
+        "MESA_VK_DEVICE_SELECT",
+        "DRI_PRIME",
+    ];
+    let Some(stderr) = render_furnace("gpu", &headless) else {
+        return;
+    };
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+    assert!(
+        stderr.lines().all(|line| !line.starts_with("error")),
+        "{stderr}"
+    );
+}
+
 /// Both devices' closing lines measure the render in the same unit, samples per second (the
 /// CPU adds its rays per second after it).
 #[test]
