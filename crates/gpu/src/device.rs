@@ -27,7 +27,7 @@ pub struct GpuStats {
 }
 
 /// The accumulation buffer's bytes per pixel (three vec4: `ACCUM_STRIDE` in `path.wgsl`).
-const ACCUM_BYTES_PER_PIXEL: usize = 48;
+pub(crate) const ACCUM_BYTES_PER_PIXEL: usize = 48;
 
 /// An opened GPU device with the path-tracing pipeline compiled.
 pub struct GpuRenderer {

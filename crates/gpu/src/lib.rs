@@ -253,7 +253,7 @@ mod tests {
         }
         assert_eq!(
             kernel_constant("ACCUM_STRIDE") as usize * 16,
-            super::ACCUM_BYTES_PER_PIXEL
+            crate::device::ACCUM_BYTES_PER_PIXEL
         );
     }
 
