@@ -298,10 +298,10 @@ impl Packets {
             out.lanes.push(lanes);
             out.index.push(index);
         };
-        // A whole number of rows of `width` (rust-version 1.80: no `is_multiple_of`).
+        // A whole number of rows of `width`.
         let rows = width
             .map(|w| w as usize)
-            .filter(|&w| w > 0 && rays.len() / w * w == rays.len());
+            .filter(|&w| w > 0 && rays.len().is_multiple_of(w));
         match rows {
             Some(w) => {
                 let h = rays.len() / w;
