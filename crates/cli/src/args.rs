@@ -99,8 +99,8 @@ pub enum Command {
         #[command(flatten)]
         limits: LimitOptions,
 
-        /// Print help.
-        #[arg(short = '?', long, action = ArgAction::Help)]
+        /// Print help (-? and -h alike).
+        #[arg(short = '?', short_alias = 'h', long, action = ArgAction::Help)]
         help: Option<bool>,
     },
     /// Assemble farm parts (tiles, sample ranges: EXRs written by `glint render`) into one
@@ -123,6 +123,7 @@ gap), pixels in two tiles (an overlap), samples in no part or in two.";
 
 /// `glint merge -o OUT PART...`
 #[derive(Args, Debug, Clone)]
+#[command(disable_help_flag = true)]
 pub struct MergeArgs {
     /// The merged image, .exr or .png.
     #[arg(short = 'o', long = "outputfile", value_name = "FILE", required = true)]
@@ -138,6 +139,10 @@ pub struct MergeArgs {
     /// this process may use].
     #[arg(long, value_name = "SIZE", value_parser = parse_size)]
     pub max_memory: Option<u64>,
+
+    /// Print help (-? and -h alike).
+    #[arg(short = '?', short_alias = 'h', long, action = ArgAction::Help)]
+    pub help: Option<bool>,
 }
 
 /// `glint denoise IN.exr -o OUT [--no-prefilter]`
@@ -162,8 +167,8 @@ pub struct DenoiseArgs {
           value_parser = clap::value_parser!(u64).range(1..=MAX_THREADS))]
     pub threads: Option<u64>,
 
-    /// Print help.
-    #[arg(short = '?', long, action = ArgAction::Help)]
+    /// Print help (-? and -h alike).
+    #[arg(short = '?', short_alias = 'h', long, action = ArgAction::Help)]
     pub help: Option<bool>,
 }
 

@@ -28,8 +28,8 @@ pub struct BenchArgs {
     #[command(subcommand)]
     pub command: BenchCommand,
 
-    /// Print help (`glint` turns off `-h`, which is the image height for renders).
-    #[arg(short = '?', long, action = clap::ArgAction::Help, global = true)]
+    /// Print help (-? and -h alike; -h is the image height only where a command renders).
+    #[arg(short = '?', short_alias = 'h', long, action = clap::ArgAction::Help, global = true)]
     pub help: Option<bool>,
 }
 
@@ -298,10 +298,10 @@ impl Packets {
             out.lanes.push(lanes);
             out.index.push(index);
         };
-        // A whole number of rows of `width` (rust-version 1.80: no `is_multiple_of`).
+        // A whole number of rows of `width`.
         let rows = width
             .map(|w| w as usize)
-            .filter(|&w| w > 0 && rays.len() / w * w == rays.len());
+            .filter(|&w| w > 0 && rays.len().is_multiple_of(w));
         match rows {
             Some(w) => {
                 let h = rays.len() / w;

@@ -15,6 +15,10 @@
 //!
 //! Exit status: 0 within every `--threshold`, 1 past one (or when the heat map cannot be
 //! written), 2 bad input (an unreadable file, images of different sizes, non-finite values).
+//!
+//! Without the `flip` feature (no nv-flip, whose C++ needs a compiler) every measure but FLIP
+//! is computed and printed; what needs FLIP (`--heatmap`, a FLIP threshold) is refused with
+//! exit status 2 before any image is read.
 
 use std::fmt;
 use std::io::Write;
@@ -62,8 +66,8 @@ pub struct DiffArgs {
     #[arg(long, value_name = "SIZE", value_parser = crate::machine::parse_size)]
     pub max_memory: Option<u64>,
 
-    /// Print help (`glint` turns off `-h`, which is the image height for renders).
-    #[arg(short = '?', long, action = clap::ArgAction::Help)]
+    /// Print help (-? and -h alike; -h is the image height only where a command renders).
+    #[arg(short = '?', short_alias = 'h', long, action = clap::ArgAction::Help)]
     pub help: Option<bool>,
 }
 
@@ -122,7 +126,8 @@ impl Measure {
 
     fn value(self, report: &Report) -> f64 {
         match self {
-            Measure::Flip => report.flip_mean,
+            // Refused before any image is read where FLIP is not built in.
+            Measure::Flip => report.flip_mean.unwrap_or(f64::NAN),
             Measure::Mae => report.levels.mae,
             Measure::Rmse => report.levels.rmse,
             Measure::Psnr => report.levels.psnr(255.0),
@@ -348,7 +353,8 @@ pub struct Report {
     pub pixels_over: usize,
     pub pixels: usize,
     pub threshold_levels: u8,
-    pub flip_mean: f64,
+    /// `None` in a build without the `flip` feature.
+    pub flip_mean: Option<f64>,
 }
 
 impl Report {
@@ -357,12 +363,42 @@ impl Report {
     }
 }
 
-/// Compares `test` with `reference`, and returns FLIP's error map beside the measures.
+/// FLIP's per-pixel error map (an uninhabited type without the `flip` feature).
+#[cfg(feature = "flip")]
+pub type ErrorMap = nv_flip::FlipImageFloat;
+/// FLIP's per-pixel error map (an uninhabited type without the `flip` feature).
+#[cfg(not(feature = "flip"))]
+#[derive(Debug)]
+pub enum ErrorMap {}
+
+/// FLIP's mean and error map of two images of the same size.
+#[cfg(feature = "flip")]
+fn flip(reference: &DiffImage, test: &DiffImage) -> Option<(f64, ErrorMap)> {
+    let flip_image = |image: &DiffImage| {
+        nv_flip::FlipImageRgb8::with_data(image.width, image.height, &image.levels)
+    };
+    let error_map = nv_flip::flip(
+        flip_image(reference),
+        flip_image(test),
+        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
+    );
+    let mean = f64::from(nv_flip::FlipPool::from_image(&error_map).mean());
+    Some((mean, error_map))
+}
+
+/// No FLIP in this build.
+#[cfg(not(feature = "flip"))]
+fn flip(_reference: &DiffImage, _test: &DiffImage) -> Option<(f64, ErrorMap)> {
+    None
+}
+
+/// Compares `test` with `reference`, and returns FLIP's error map beside the measures (when
+/// FLIP is built in).
 pub fn compare(
     reference: &DiffImage,
     test: &DiffImage,
     threshold_levels: u8,
-) -> Result<(Report, nv_flip::FlipImageFloat), BadInput> {
+) -> Result<(Report, Option<ErrorMap>), BadInput> {
     if (reference.width, reference.height) != (test.width, test.height) {
         return Err(BadInput(format!(
             "the images differ in size: A is {}x{}, B is {}x{} (glint diff compares images of \
@@ -394,15 +430,7 @@ pub fn compare(
                 .any(|(&a, &b)| a.abs_diff(b) > threshold_levels)
         })
         .count();
-    let flip_image = |image: &DiffImage| {
-        nv_flip::FlipImageRgb8::with_data(image.width, image.height, &image.levels)
-    };
-    let error_map = nv_flip::flip(
-        flip_image(reference),
-        flip_image(test),
-        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
-    );
-    let flip_mean = f64::from(nv_flip::FlipPool::from_image(&error_map).mean());
+    let (flip_mean, error_map) = flip(reference, test).unzip();
     let report = Report {
         levels,
         linear,
@@ -416,12 +444,18 @@ pub fn compare(
 
 /// The report as printed: one measure family per line, numbers first after their names.
 pub fn format_report(a: &DiffImage, b: &DiffImage, report: &Report) -> String {
+    let flip = match report.flip_mean {
+        Some(mean) => {
+            format!("mean {mean:.6} (LDR-FLIP, {FLIP_PIXELS_PER_DEGREE} pixels per degree)")
+        }
+        None => "not in this build (feature `flip`)".to_owned(),
+    };
     format!(
         "A: {}\nB: {}\n\
          8-bit:  MAE {:.4} levels  RMSE {:.4} levels  PSNR {:.2} dB\n\
          linear: MAE {:.6}  RMSE {:.6}  PSNR {:.2} dB\n\
          over {} levels: {:.4} % of pixels ({} of {})\n\
-         FLIP: mean {:.6} (LDR-FLIP, {} pixels per degree)\n",
+         FLIP: {flip}\n",
         a.description,
         b.description,
         report.levels.mae,
@@ -434,8 +468,6 @@ pub fn format_report(a: &DiffImage, b: &DiffImage, report: &Report) -> String {
         100.0 * report.over_fraction(),
         report.pixels_over,
         report.pixels,
-        report.flip_mean,
-        nv_flip::DEFAULT_PIXELS_PER_DEGREE,
     )
 }
 
@@ -471,9 +503,23 @@ pub fn failed_thresholds(report: &Report, thresholds: &[Threshold]) -> Vec<Strin
         .collect()
 }
 
+/// FLIP's viewing distance in pixels per degree.
+#[cfg(feature = "flip")]
+const FLIP_PIXELS_PER_DEGREE: f32 = nv_flip::DEFAULT_PIXELS_PER_DEGREE;
+/// Unused without FLIP, whose mean is then never printed.
+#[cfg(not(feature = "flip"))]
+const FLIP_PIXELS_PER_DEGREE: f32 = f32::NAN;
+
+/// No heat map without FLIP: there is no error map to write.
+#[cfg(not(feature = "flip"))]
+fn write_heatmap(_path: &Path, error_map: &ErrorMap) -> Result<(), String> {
+    match *error_map {}
+}
+
 /// Writes FLIP's error map through the magma colour map, atomically (a temporary file in the
 /// target directory, renamed).
-fn write_heatmap(path: &Path, error_map: &nv_flip::FlipImageFloat) -> Result<(), String> {
+#[cfg(feature = "flip")]
+fn write_heatmap(path: &Path, error_map: &ErrorMap) -> Result<(), String> {
     let colored = error_map.apply_color_lut(&nv_flip::magma_lut());
     let image = image::RgbImage::from_raw(colored.width(), colored.height(), colored.to_vec())
         .ok_or("the heat map's size does not match its pixels")?;
@@ -503,6 +549,19 @@ fn write_heatmap(path: &Path, error_map: &nv_flip::FlipImageFloat) -> Result<(),
 
 /// Runs `glint diff`: the report on `out`, problems on `err`; returns the exit status.
 pub fn run(args: &DiffArgs, out: &mut dyn Write, err: &mut dyn Write) -> u8 {
+    if !cfg!(feature = "flip") {
+        let flip_threshold = args.threshold.iter().any(|t| t.measure == Measure::Flip);
+        let needs = match (&args.heatmap, flip_threshold) {
+            (Some(_), _) => Some("--heatmap needs"),
+            (None, true) => Some("a FLIP threshold (flip=, or a bare number) needs"),
+            (None, false) => None,
+        };
+        if let Some(needs) = needs {
+            let why = crate::features::missing("FLIP", "flip", needs);
+            let _ = writeln!(err, "error: {why}; the other measures need no feature");
+            return 2;
+        }
+    }
     if let Some(heatmap) = &args.heatmap {
         let is_png = heatmap
             .extension()
@@ -541,8 +600,8 @@ pub fn run(args: &DiffArgs, out: &mut dyn Write, err: &mut dyn Write) -> u8 {
         }
     };
     let _ = write!(out, "{}", format_report(&a, &b, &report));
-    if let Some(heatmap) = &args.heatmap {
-        if let Err(why) = write_heatmap(heatmap, &error_map) {
+    if let (Some(heatmap), Some(error_map)) = (&args.heatmap, &error_map) {
+        if let Err(why) = write_heatmap(heatmap, error_map) {
             let _ = writeln!(err, "error: cannot write {}: {why}", heatmap.display());
             return 1;
         }
@@ -607,9 +666,13 @@ mod tests {
         let psnr = 20.0 * (255.0 / (104.0f64 / 12.0).sqrt()).log10();
         assert!((report.levels.psnr(255.0) - psnr).abs() < 1e-9);
         assert!((report.linear.mae - 12.0 / 12.0 / 255.0).abs() < 1e-6);
-        assert!(report.flip_mean > 0.0);
+        if cfg!(feature = "flip") {
+            assert!(report.flip_mean.is_some_and(|mean| mean > 0.0));
+        }
         let (same, _) = compare(&a, &a, 8).unwrap();
-        assert_eq!(same.flip_mean, 0.0);
+        if cfg!(feature = "flip") {
+            assert_eq!(same.flip_mean, Some(0.0));
+        }
         assert_eq!(same.levels.psnr(255.0), f64::INFINITY);
     }
 

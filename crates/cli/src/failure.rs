@@ -23,8 +23,11 @@ pub enum Failure {
     Write(ImageWriteError),
     /// The GPU back end cannot render this scene with these settings (exit 2: like a bad
     /// argument, the user asked for something this device does not do).
+    // Without the `gpu` feature no GPU render starts, so neither GPU failure happens.
+    #[cfg_attr(not(feature = "gpu"), allow(dead_code))]
     GpuUnsupported(glint_gpu::GpuError),
     /// No GPU adapter, or the device failed (exit 1: the machine, not the input, is at fault).
+    #[cfg_attr(not(feature = "gpu"), allow(dead_code))]
     Gpu(glint_gpu::GpuError),
     /// The render threads could not be started (exit 1).
     ThreadPool(rayon::ThreadPoolBuildError),

@@ -116,6 +116,11 @@ impl Job {
 }
 
 impl Job {
+    /// `--tile I/N`, if given: the closing line names the tile.
+    pub fn tile(&self) -> Option<crate::farm::TileSpec> {
+        self.options.tile
+    }
+
     /// The job as a `--time` render that took `samples` per pixel ended: what its image
     /// holds, for its metadata and the closing line.
     pub fn with_samples_taken(&self, samples: u32) -> Job {

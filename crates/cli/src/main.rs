@@ -14,6 +14,7 @@ mod denoise;
 mod diff;
 mod failure;
 mod farm;
+mod features;
 mod gpu;
 mod interrupt;
 mod job;
@@ -91,6 +92,13 @@ fn main() -> ExitCode {
         Ok(job) => job,
         Err(error) => return fail(&Failure::Usage(error)),
     };
+    if let Err(failure) = features::refuse_missing(&job) {
+        return fail(&failure);
+    }
+    if job.device == crate::args::DeviceArg::Gpu {
+        // Before any thread starts: it sets an environment variable.
+        gpu::quiet_display_probe();
+    }
 
     handle_signals();
 

@@ -9,14 +9,25 @@
 //! to the window by nearest neighbour and are shown as the PNG writer stores them
 //! (clamped, floor(c · 255), no gamma), so at the image's own size the window shows exactly
 //! the written PNG.
+//!
+//! Without the `preview` feature there is no window (no minifb): `-x`/`-y` are refused before
+//! the render (`features::refuse_missing`), and `Preview` cannot be made.
 
-use std::sync::mpsc::{channel, Receiver, RecvTimeoutError, Sender};
+// Without a window nothing reads the tiles the sink would carry.
+#![cfg_attr(not(feature = "preview"), allow(dead_code))]
+
+use std::sync::mpsc::Sender;
+#[cfg(feature = "preview")]
+use std::sync::mpsc::{channel, Receiver, RecvTimeoutError};
+#[cfg(feature = "preview")]
 use std::time::{Duration, Instant};
 
 use glint_render::{Color, PixelBounds, Progress};
+#[cfg(feature = "preview")]
 use minifb::{Key, Window, WindowOptions};
 
 /// The longest the window waits between redraws while tiles arrive.
+#[cfg(feature = "preview")]
 const FRAME: Duration = Duration::from_millis(50);
 
 /// One finished tile in display pixels (`0x00RRGGBB`, row-major), and the progress.
@@ -51,7 +62,36 @@ pub fn display_pixel(c: Color) -> u32 {
     (channel(c.x) << 16) | (channel(c.y) << 8) | channel(c.z)
 }
 
+/// Without the `preview` feature: no window can be opened, so no `Preview` exists.
+#[cfg(not(feature = "preview"))]
+#[derive(Debug)]
+pub enum Preview {}
+
+#[cfg(not(feature = "preview"))]
+impl Preview {
+    /// Fails: this build has no window.
+    pub fn open(
+        _width: usize,
+        _height: usize,
+        _image_width: u32,
+        _image_height: u32,
+    ) -> Result<Preview, String> {
+        Err("this glint was built without the preview window (feature `preview`)".to_owned())
+    }
+
+    /// Never runs: there is no `Preview` to run it on.
+    pub fn run_while<T: Send, E: Send>(
+        self,
+        _close: bool,
+        _stop: &dyn Fn() -> bool,
+        _work: impl FnOnce(TileSink) -> Result<T, E> + Send,
+    ) -> Result<T, E> {
+        match self {}
+    }
+}
+
 /// An open preview window.
+#[cfg(feature = "preview")]
 pub struct Preview {
     window: Window,
     buffer: Vec<u32>,
@@ -59,6 +99,7 @@ pub struct Preview {
     image_size: (u32, u32),
 }
 
+#[cfg(feature = "preview")]
 impl Preview {
     /// Opens a `width` x `height` window for a `image_width` x `image_height` image. Fails
     /// (with why) where there is no display.

@@ -16,6 +16,8 @@ pub enum Unit {
     Tiles,
     /// The GPU's sample passes over the whole image, one after another: the bar gives the
     /// samples per pixel done of all.
+    // Only a build with the `gpu` feature renders on the GPU.
+    #[cfg_attr(not(feature = "gpu"), allow(dead_code))]
     SamplePasses,
 }
 

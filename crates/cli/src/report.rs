@@ -5,7 +5,7 @@ use std::io::Write;
 use std::time::Duration;
 
 use glint_io::Diagnostic;
-use glint_render::{RenderStats, ThinLens};
+use glint_render::{PixelBounds, RenderStats, ThinLens};
 
 use crate::job::Job;
 
@@ -18,16 +18,18 @@ pub struct Summary {
 }
 
 /// Where a render runs: the CPU's pipeline or the GPU back end. The lines of both read the
-/// same except where the devices differ: the CPU counts rays and runs on `-n` threads; the
-/// GPU counts only the samples it traced.
+/// same except where the devices differ: the CPU also counts rays and runs on `-n` threads.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Device {
     Cpu,
+    // Only a build with the `gpu` feature renders on the GPU.
+    #[cfg_attr(not(feature = "gpu"), allow(dead_code))]
     Gpu,
 }
 
 /// `-v`'s line before a render: `rendering 250x250, 16 samples per pixel, depth 4, seed 0,
-/// course integrator, 2 threads -> out.png`; `lens` is the camera's, if it has one.
+/// course integrator, 2 threads -> out.png`; `lens` is the camera's, if it has one. A farm
+/// part names its part, as the closing line does.
 pub fn rendering_line(job: &Job, device: Device, lens: Option<&ThinLens>) -> String {
     let settings = &job.settings;
     let lens = lens.map_or(String::new(), |lens| {
@@ -40,16 +42,58 @@ pub fn rendering_line(job: &Job, device: Device, lens: Option<&ThinLens>) -> Str
         Device::Cpu => format!(", {}", threads_text(job.threads)),
         Device::Gpu => " on the GPU".to_string(),
     };
+    let spp = settings.samples_per_pixel();
+    let samples = settings.samples();
+    let samples = if samples == (0..spp) {
+        format!("{spp} samples per pixel")
+    } else {
+        format!(
+            "samples {}..{} of {spp} per pixel",
+            samples.start, samples.end
+        )
+    };
     format!(
-        "rendering {}x{}, {} samples per pixel, depth {}, seed {}, {} integrator{lens}{on} -> {}",
-        settings.width,
-        settings.height,
-        settings.samples_per_pixel(),
+        "rendering {}, {samples}, depth {}, seed {}, {} integrator{lens}{on} -> {}",
+        rendered_area(job),
         settings.max_depth(),
         settings.seed,
         settings.integrator.name(),
         job.output.display()
     )
+}
+
+/// The pixels a render covers: `640x480` for the whole image; for a part (`--tile`,
+/// `--crop-window`, `--pixel-bounds`), which pixels of which image, half-open as the options
+/// take them: `tile 1/4 (pixels 320..640 x 0..240 of 640x480)`.
+pub fn rendered_area(job: &Job) -> String {
+    let settings = &job.settings;
+    let (width, height) = (settings.width, settings.height);
+    let b = settings.bounds();
+    if b == PixelBounds::full(width, height) {
+        return format!("{width}x{height}");
+    }
+    let pixels = format!(
+        "pixels {}..{} x {}..{} of {width}x{height}",
+        b.x0, b.x1, b.y0, b.y1
+    );
+    match job.tile() {
+        Some(tile) => format!("tile {}/{} ({pixels})", tile.index, tile.count),
+        None => pixels,
+    }
+}
+
+/// What a render rendered, for its closing line: the area (`rendered_area`) and the samples,
+/// `16 rpp` or, for a `--sample-range` part, `samples 4..8 of 16 rpp`.
+pub fn rendered_part(job: &Job) -> String {
+    let settings = &job.settings;
+    let spp = settings.samples_per_pixel();
+    let samples = settings.samples();
+    let samples = if samples == (0..spp) {
+        format!("{spp} rpp")
+    } else {
+        format!("samples {}..{} of {spp} rpp", samples.start, samples.end)
+    };
+    format!("{}, {samples}", rendered_area(job))
 }
 
 /// Warns about the samples a render left out of the image for being NaN or infinite. On the
@@ -80,17 +124,26 @@ pub fn warn_nonfinite(device: Device, stats: &RenderStats, err: &mut dyn Write) 
     );
 }
 
+/// What a render counted. Both devices count the samples they took (one camera path each),
+/// so both report samples per second, the one figure that compares them; the CPU also counts
+/// its rays (camera, secondary and shadow), which the GPU kernel does not.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Counts {
+    pub samples: u64,
+    pub rays: Option<u64>,
+}
+
 /// Prints the closing line and returns the run's summary: the one ending of a render on
-/// either device. `count` is what the device counts: rays on the CPU, samples on the GPU.
+/// either device.
 pub fn finish(
     job: &Job,
     device: Device,
-    count: u64,
+    counts: Counts,
     stats: RenderStats,
     render_time: Duration,
     err: &mut dyn Write,
 ) -> Summary {
-    let _ = writeln!(err, "{}", closing_line(job, device, count, render_time));
+    let _ = writeln!(err, "{}", closing_line(job, device, counts, render_time));
     Summary {
         stats,
         render_time,
@@ -101,28 +154,31 @@ pub fn finish(
     }
 }
 
-/// `rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png` on
-/// the CPU, `rendered 250x250, 16 rpp in 1.23 s on the GPU: 1.0 M samples, 813.0 k
-/// samples/s -> out.png` on the GPU.
-pub fn closing_line(job: &Job, device: Device, count: u64, render_time: Duration) -> String {
-    let settings = &job.settings;
+/// `rendered 250x250, 16 rpp in 1.23 s: 1.0 M samples, 813.0 k samples/s, 4.5 M rays, 3.7 M
+/// rays/s, 2 threads -> out.png` on the CPU, `rendered 250x250, 16 rpp in 1.23 s on the GPU:
+/// 1.0 M samples, 813.0 k samples/s -> out.png` on the GPU; a farm part says which part it
+/// rendered (`rendered_part`).
+pub fn closing_line(job: &Job, device: Device, counts: Counts, render_time: Duration) -> String {
     let seconds = render_time.as_secs_f64();
-    let rate = if seconds > 0.0 {
-        count as f64 / seconds
-    } else {
-        0.0
+    let rate = |count: u64| {
+        if seconds > 0.0 {
+            count as f64 / seconds
+        } else {
+            0.0
+        }
     };
-    let (on, unit, threads) = match device {
-        Device::Cpu => ("", "rays", format!(", {}", threads_text(job.threads))),
-        Device::Gpu => (" on the GPU", "samples", String::new()),
+    let rays = counts.rays.map_or(String::new(), |rays| {
+        format!(", {} rays, {} rays/s", si(rays as f64), si(rate(rays)))
+    });
+    let (on, threads) = match device {
+        Device::Cpu => ("", format!(", {}", threads_text(job.threads))),
+        Device::Gpu => (" on the GPU", String::new()),
     };
     format!(
-        "rendered {}x{}, {} rpp in {seconds:.2} s{on}: {} {unit}, {} {unit}/s{threads} -> {}",
-        settings.width,
-        settings.height,
-        settings.samples_per_pixel(),
-        si(count as f64),
-        si(rate),
+        "rendered {} in {seconds:.2} s{on}: {} samples, {} samples/s{rays}{threads} -> {}",
+        rendered_part(job),
+        si(counts.samples as f64),
+        si(rate(counts.samples)),
         job.output.display()
     )
 }
@@ -211,14 +267,87 @@ mod tests {
     #[test]
     fn closing_line_names_size_samples_rays_threads_and_output() {
         let job = job(glint_render::IntegratorKind::Course);
+        let cpu = Counts {
+            samples: 1_000_000,
+            rays: Some(4_500_000),
+        };
         assert_eq!(
-            closing_line(&job, Device::Cpu, 4_500_000, Duration::from_millis(1230)),
-            "rendered 250x250, 16 rpp in 1.23 s: 4.5 M rays, 3.7 M rays/s, 2 threads -> out.png"
+            closing_line(&job, Device::Cpu, cpu, Duration::from_millis(1230)),
+            "rendered 250x250, 16 rpp in 1.23 s: 1.0 M samples, 813.0 k samples/s, 4.5 M rays, \
+             3.7 M rays/s, 2 threads -> out.png"
         );
+        let gpu = Counts {
+            samples: 1_000_000,
+            rays: None,
+        };
         assert_eq!(
-            closing_line(&job, Device::Gpu, 1_000_000, Duration::from_millis(1230)),
+            closing_line(&job, Device::Gpu, gpu, Duration::from_millis(1230)),
             "rendered 250x250, 16 rpp in 1.23 s on the GPU: 1.0 M samples, 813.0 k samples/s -> \
              out.png"
+        );
+    }
+
+    /// A farm part's lines say which part: the tile with its pixels, the sample range, both.
+    #[test]
+    fn a_part_says_which_part_it_rendered() {
+        use clap::Parser;
+        let part = |extra: &[&str]| {
+            let mut args = vec![
+                "glint",
+                "-i",
+                "s.xml",
+                "-o",
+                "out.exr",
+                "-w",
+                "640",
+                "-h",
+                "480",
+                "-r",
+                "16",
+                "-n",
+                "2",
+                "--integrator",
+                "path",
+            ];
+            args.extend_from_slice(extra);
+            let job = crate::args::Cli::try_parse_from(args)
+                .unwrap()
+                .into_job(2)
+                .unwrap();
+            let counts = Counts {
+                samples: 1_000,
+                rays: Some(2_000),
+            };
+            let line = closing_line(&job, Device::Cpu, counts, Duration::from_secs(1));
+            let verbose = rendering_line(&job, Device::Cpu, None);
+            (line, verbose)
+        };
+        let (whole, _) = part(&[]);
+        assert!(whole.starts_with("rendered 640x480, 16 rpp in "), "{whole}");
+        let (tile, verbose) = part(&["--tile", "1/4"]);
+        assert!(
+            tile.starts_with("rendered tile 1/4 (pixels 320..640 x 0..240 of 640x480), 16 rpp in "),
+            "{tile}"
+        );
+        assert!(
+            verbose.starts_with(
+                "rendering tile 1/4 (pixels 320..640 x 0..240 of 640x480), 16 samples per pixel,"
+            ),
+            "{verbose}"
+        );
+        let (range, verbose) = part(&["--sample-range", "1/4"]);
+        assert!(
+            range.starts_with("rendered 640x480, samples 4..8 of 16 rpp in "),
+            "{range}"
+        );
+        assert!(
+            verbose.starts_with("rendering 640x480, samples 4..8 of 16 per pixel,"),
+            "{verbose}"
+        );
+        let (both, _) = part(&["--pixel-bounds", "0,10,20,30", "--sample-range", "0..2"]);
+        assert!(
+            both.starts_with("rendered pixels 0..10 x 20..30 of 640x480, samples 0..2 of 16 rpp"),
+            "{both}"
         );
     }
 

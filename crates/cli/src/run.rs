@@ -21,8 +21,8 @@ use crate::memory;
 use crate::preview::TileSink;
 use crate::progress::{self, ProgressLog, Unit};
 use crate::report::{
-    finish, located, plural, print_warnings, rendering_line, warn_nonfinite, Device, Summary,
-    MAX_SHOWN_WARNINGS,
+    finish, located, plural, print_warnings, rendering_line, warn_nonfinite, Counts, Device,
+    Summary, MAX_SHOWN_WARNINGS,
 };
 use crate::stats::{bvh_stats, peak_rss, rays_section, seconds, Stats};
 
@@ -89,8 +89,11 @@ pub fn run(
     }
     warn_nonfinite(Device::Cpu, &rendered.stats, err);
     let write_time = write(job, &pool, &built, &rendered, denoiser.as_ref(), err)?;
-    let (rays, stats) = (rendered.stats.rays, rendered.stats);
-    let summary = finish(job, Device::Cpu, rays, stats, rendered.time, err);
+    let counts = Counts {
+        samples: rendered.samples,
+        rays: Some(rendered.stats.rays),
+    };
+    let summary = finish(job, Device::Cpu, counts, rendered.stats, rendered.time, err);
     if job.stats {
         print_stats(job, &pool, &built, &summary, write_time, err);
     }
@@ -144,6 +147,8 @@ struct Rendered {
     time: Duration,
     /// Samples per pixel a `--time` render took: what its image holds.
     samples_taken: Option<u32>,
+    /// Samples this run took, over all its pixels (not those of a resumed checkpoint's rows).
+    samples: u64,
 }
 
 /// Notes about accepted options that have no effect.
@@ -429,12 +434,23 @@ fn render(
         Ok(rendered) => rendered,
         Err(failure) => return Err(failure),
     };
+    // Adaptive sampling counts each pixel's samples; otherwise every pixel this run rendered
+    // took the same number.
+    let samples = match &film.samples {
+        Some(per_pixel) => per_pixel.iter().map(|&n| u64::from(n)).sum(),
+        None => {
+            let pixels = u64::from(bounds.width()) * u64::from(bounds.height()) - done_pixels;
+            let per_pixel = samples_taken.unwrap_or(settings.samples().len() as u32);
+            pixels * u64::from(per_pixel)
+        }
+    };
     Ok(Rendered {
         film,
         stats,
         render_seconds,
         time,
         samples_taken,
+        samples,
     })
 }
 
@@ -527,7 +543,7 @@ fn print_stats(
     let _ = write!(
         err,
         "{}",
-        pool.install(|| bvh_stats(&built.scene, &job.settings))
+        pool.install(|| bvh_stats(&built.scene, &job.settings, built.build_time))
     );
 }
 

@@ -3,7 +3,7 @@
 use std::fmt::Write as _;
 use std::time::Duration;
 
-use glint_render::{IntegratorKind, RenderSettings, RenderStats, Scene};
+use glint_render::{BuildPhases, IntegratorKind, RenderSettings, RenderStats, Scene};
 
 use crate::report::plural;
 
@@ -100,41 +100,63 @@ pub fn rays_section(report: &mut Stats, settings: &RenderSettings, stats: &Rende
         .row("total", stats.rays);
 }
 
-/// `--stats`' BVH figures: how the split method shaped the tree and what it costs the camera
-/// rays (measured in a separate counting pass, so the render itself counted nothing).
-pub fn bvh_stats(scene: &Scene, settings: &RenderSettings) -> String {
+/// `--stats`' BVH figures: how the split method shaped the tree, where the build's time went
+/// and what the tree costs the camera rays (measured in a separate counting pass, so the render
+/// itself counted nothing). `build_time` is the `build` stage of the time section: the one
+/// build figure, which the phases are printed as parts of.
+pub fn bvh_stats(scene: &Scene, settings: &RenderSettings, build_time: Duration) -> String {
     let bvh = scene.bvh_stats();
     let walk = glint_render::measure_traversal(scene, settings);
-    let ms = |d: std::time::Duration| d.as_secs_f64() * 1e3;
-    // Where the largest tree's build spent its time: the root node's splits run before any
-    // subtree can run apart, so they are what more threads shorten least.
-    let phases = bvh.largest.map_or_else(String::new, |(primitives, p)| {
-        format!(
-            "BVH build phases, largest tree ({primitives} primitives): boxes {:.1} ms, root \
-             splits {:.1} ms, subtrees {:.1} ms, blocks {:.1} ms\n",
-            ms(p.boxes),
-            ms(p.top_splits),
-            ms(p.subtrees),
-            ms(p.pack),
-        )
-    });
     format!(
-        "BVH ({}): built in {:.1} ms; {} tree{}, {} nodes, {} leaves, depth {}, SAH cost {:.2}\n\
-         {phases}\
+        "BVH ({}): {} tree{}, {} nodes, {} leaves, depth {}, SAH cost {:.2}\n{}\
          BVH traversal: {:.2} nodes and {:.2} triangle blocks per camera ray ({} rays through \
          pixel centres, {:.0}% hit)\n",
         bvh.split.name(),
-        ms(bvh.build_time),
         bvh.trees,
         plural(bvh.trees as u64),
         bvh.nodes,
         bvh.leaves,
         bvh.depth,
         bvh.sah_cost,
+        build_parts(build_time, bvh.largest),
         walk.nodes_per_ray(),
         walk.blocks_per_ray(),
         walk.rays,
         100.0 * walk.hits as f64 / walk.rays.max(1) as f64,
+    )
+}
+
+/// The build stage's time in parts that add up to it, in tenths of a millisecond so that the
+/// printed figures add up exactly: the largest tree's phases (its root node's splits run
+/// before any subtree can run apart, so they are what more threads shorten least), and the
+/// rest (the other trees, the top level, moving the scene into place).
+fn build_parts(build_time: Duration, largest: Option<(usize, BuildPhases)>) -> String {
+    let tenths = |d: Duration| (d.as_secs_f64() * 1e4).round() as u64;
+    let ms = |tenths: u64| format!("{}.{} ms", tenths / 10, tenths % 10);
+    let total = tenths(build_time);
+    let Some((primitives, p)) = largest else {
+        return format!("BVH build: {}, no wide tree\n", ms(total));
+    };
+    let phases = [
+        ("boxes", tenths(p.boxes)),
+        ("root splits", tenths(p.top_splits)),
+        ("subtrees", tenths(p.subtrees)),
+        ("blocks", tenths(p.pack)),
+    ];
+    let largest: u64 = phases.iter().map(|(_, t)| t).sum();
+    // The phases are timed inside the stage, so they fit in it; rounding could only tip a
+    // stage of nothing but the one tree by a tenth, which the total absorbs.
+    let total = total.max(largest);
+    let listed: Vec<String> = phases
+        .iter()
+        .map(|(name, t)| format!("{name} {}", ms(*t)))
+        .collect();
+    format!(
+        "BVH build: {} = largest tree ({primitives} primitives) {} ({}) + the rest {}\n",
+        ms(total),
+        ms(largest),
+        listed.join(" + "),
+        ms(total - largest),
     )
 }
 
@@ -154,6 +176,28 @@ mod tests {
             stats.render(),
             "stats:\n  time\n    load           0.1 s\n    render         2 s\n  memory\n    \
              peak resident  12 MiB\n"
+        );
+    }
+
+    /// The parts are rounded first and the rest is what they leave, so the printed figures add
+    /// up to the one build figure.
+    #[test]
+    fn the_build_parts_add_up_to_the_build() {
+        let us = Duration::from_micros;
+        let phases = BuildPhases {
+            boxes: us(1_040),
+            top_splits: us(2_960),
+            subtrees: us(3_060),
+            pack: us(990),
+        };
+        assert_eq!(
+            build_parts(us(10_040), Some((1000, phases))),
+            "BVH build: 10.0 ms = largest tree (1000 primitives) 8.1 ms (boxes 1.0 ms + root \
+             splits 3.0 ms + subtrees 3.1 ms + blocks 1.0 ms) + the rest 1.9 ms\n"
+        );
+        assert_eq!(
+            build_parts(us(240), None),
+            "BVH build: 0.2 ms, no wide tree\n"
         );
     }
 

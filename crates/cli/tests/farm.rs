@@ -653,7 +653,8 @@ fn logs_get_progress_lines_and_stats() {
         "total",
         "  memory",
         "peak resident",
-        "BVH build phases, largest tree (4 primitives): boxes ",
+        "BVH build: ",
+        " = largest tree (4 primitives) ",
     ] {
         assert!(stderr.contains(expected), "no '{expected}' in {stderr}");
     }

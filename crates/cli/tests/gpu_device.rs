@@ -183,3 +183,88 @@ fn gpu_refuses_cpu_only_options_with_exit_2() {
         assert!(!dir.path().join("out.png").exists());
     }
 }
+
+/// Renders the furnace on `device` (the path tracer, 16x16, 4 samples) with `env` removed
+/// from the environment; returns the exit status and stderr, or None without an adapter.
+fn render_furnace(device: &str, removed: &[&str]) -> Option<String> {
+    let dir = scene_dir();
+    let mut command = Command::new(GLINT);
+    command.current_dir(dir.path()).args([
+        "render",
+        "furnace.json",
+        "--integrator",
+        "path",
+        "--device",
+        device,
+        "-w",
+        "16",
+        "-h",
+        "16",
+        "-r",
+        "4",
+        "-o",
+        "out.png",
+    ]);
+    for name in removed {
+        command.env_remove(name);
+    }
+    let output = command.output().expect("glint runs");
+    let stderr = String::from_utf8_lossy(&output.stderr).into_owned();
+    if output.status.code() == Some(1) && stderr.contains("no GPU adapter") {
+        assert!(!ci(), "CI is set but there is no Vulkan adapter: {stderr}");
+        println!("SKIPPED (no Vulkan adapter): {stderr}");
+        return None;
+    }
+    assert_eq!(output.status.code(), Some(0), "{stderr}");
+    Some(stderr)
+}
+
+/// Headless, without XDG_RUNTIME_DIR (a container, a CI job, ssh), Mesa's device-selection
+/// layer used to look for a Wayland display and libwayland printed "error: XDG_RUNTIME_DIR is
+/// invalid or not set in the environment." twice, which read as Glint's error.
+#[test]
+fn a_headless_gpu_render_prints_no_display_errors() {
+    let headless = [
+        "XDG_RUNTIME_DIR",
+        "WAYLAND_DISPLAY",
+        "WAYLAND_SOCKET",
+        "DISPLAY",
+        "NODEVICE_SELECT",
+        "MESA_VK_DEVICE_SELECT",
+        "DRI_PRIME",
+    ];
+    let Some(stderr) = render_furnace("gpu", &headless) else {
+        return;
+    };
+    assert!(!stderr.contains("XDG_RUNTIME_DIR"), "{stderr}");
+    assert!(
+        stderr.lines().all(|line| !line.starts_with("error")),
+        "{stderr}"
+    );
+}
+
+/// Both devices' closing lines measure the render in the same unit, samples per second (the
+/// CPU adds its rays per second after it).
+#[test]
+fn both_devices_report_samples_per_second() {
+    let rate_unit = |stderr: &str| -> String {
+        let line = stderr
+            .lines()
+            .find(|line| line.starts_with("rendered "))
+            .unwrap_or_else(|| panic!("no closing line in {stderr}"))
+            .to_owned();
+        // "...: 1.0 k samples, 4.0 k samples/s..." : the first rate's unit.
+        let counts =
+            &line[line.find(": ").expect("counts") + 2..line.find(" -> ").expect("output")];
+        let rate = counts.split(", ").nth(1).expect("a rate");
+        let unit = rate.split_whitespace().last().expect("a unit").to_owned();
+        assert!(unit.ends_with("/s"), "{line}");
+        unit
+    };
+    let cpu = render_furnace("cpu", &[]).expect("the CPU renders");
+    let Some(gpu) = render_furnace("gpu", &[]) else {
+        return;
+    };
+    assert_eq!(rate_unit(&cpu), "samples/s", "{cpu}");
+    assert_eq!(rate_unit(&gpu), "samples/s", "{gpu}");
+}

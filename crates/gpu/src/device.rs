@@ -1,0 +1,382 @@
+//! The kernel on a wgpu device: `GpuRenderer` opens a Vulkan adapter, uploads the flattened
+//! scene and renders in progressive passes (the `device` feature).
+
+use std::sync::{mpsc, Arc, Mutex};
+
+use glint_render::{Color, Features, Film, RenderSettings, SceneParts, Vec3};
+use wgpu::util::DeviceExt;
+
+use crate::layout::{self, FlatScene};
+use crate::{check_supported, GpuError};
+
+/// How many path samples one dispatch traces at most (over the whole image): small enough
+/// that a dispatch on a real GPU lasts milliseconds, far from any watchdog.
+const SAMPLES_PER_DISPATCH: u64 = 1 << 20;
+
+/// What a GPU render did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuStats {
+    /// Path samples traced (pixels times samples per pixel).
+    pub samples: u64,
+    /// Samples whose radiance was NaN or infinite: dropped from the pixel's average.
+    pub nonfinite_samples: u64,
+    /// The first pixel (x, y from the top-left of the whole image) with a non-finite sample.
+    pub first_nonfinite_pixel: Option<(u32, u32)>,
+    /// Samples the driver's loop limit cut short (a render with any fails).
+    cut_samples: u64,
+}
+
+/// The accumulation buffer's bytes per pixel (three vec4: `ACCUM_STRIDE` in `path.wgsl`).
+pub(crate) const ACCUM_BYTES_PER_PIXEL: usize = 48;
+
+/// An opened GPU device with the path-tracing pipeline compiled.
+pub struct GpuRenderer {
+    device: wgpu::Device,
+    queue: wgpu::Queue,
+    info: wgpu::AdapterInfo,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    max_binding: u64,
+    samples_per_pass: Option<u32>,
+    device_error: Arc<Mutex<Option<String>>>,
+}
+
+impl std::fmt::Debug for GpuRenderer {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuRenderer")
+            .field("adapter", &self.info.name)
+            .finish()
+    }
+}
+
+fn storage_entry(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+impl GpuRenderer {
+    /// Opens the first adapter wgpu finds (high-performance preference) and compiles the
+    /// kernel. `GpuError::NoAdapter` when there is none.
+    pub fn new() -> Result<GpuRenderer, GpuError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor {
+            backends: wgpu::Backends::VULKAN,
+            ..wgpu::InstanceDescriptor::new_without_display_handle()
+        });
+        let adapter = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+            power_preference: wgpu::PowerPreference::HighPerformance,
+            ..Default::default()
+        }))
+        .map_err(|error| GpuError::NoAdapter(error.to_string()))?;
+        let info = adapter.get_info();
+        let limits = adapter.limits();
+        let required_limits = wgpu::Limits {
+            max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
+            max_buffer_size: limits.max_buffer_size,
+            ..wgpu::Limits::default()
+        };
+        let max_binding = required_limits.max_storage_buffer_binding_size as u64;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("glint"),
+            required_limits,
+            ..Default::default()
+        }))
+        .map_err(|error| GpuError::Device(error.to_string()))?;
+        // wgpu's default for errors nobody captures is a panic; keep the first one and turn
+        // it into a `GpuError::Device` at the next check instead.
+        let device_error = Arc::new(Mutex::new(None::<String>));
+        let sink = Arc::clone(&device_error);
+        device.on_uncaptured_error(Arc::new(move |error: wgpu::Error| {
+            if let Ok(mut slot) = sink.lock() {
+                slot.get_or_insert_with(|| error.to_string());
+            }
+        }));
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("path.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(include_str!("path.wgsl").into()),
+        });
+        let mut entries = vec![wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        }];
+        entries.extend((1..=6).map(|binding| storage_entry(binding, true)));
+        entries.push(storage_entry(7, false));
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("glint scene"),
+            entries: &entries,
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("glint"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("glint path"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("main"),
+            compilation_options: Default::default(),
+            cache: None,
+        });
+        let renderer = GpuRenderer {
+            device,
+            queue,
+            max_binding,
+            samples_per_pass: None,
+            info,
+            pipeline,
+            layout,
+            device_error,
+        };
+        renderer.check_device()?;
+        Ok(renderer)
+    }
+
+    /// The first error the device reported, if any (a shader the driver rejects, memory).
+    fn check_device(&self) -> Result<(), GpuError> {
+        match self.device_error.lock() {
+            Ok(slot) => match slot.as_ref() {
+                Some(error) => Err(GpuError::Device(error.clone())),
+                None => Ok(()),
+            },
+            Err(_) => Err(GpuError::Device(
+                "the device's error handler panicked".into(),
+            )),
+        }
+    }
+
+    /// Sets how many samples of each pixel one dispatch takes (`None`: the default, one on a
+    /// CPU adapter such as lavapipe, otherwise as many as keep a dispatch near 2^20 samples).
+    /// More per pass means fewer dispatches; on lavapipe more than a few run into its loop
+    /// limit, which `render` detects and reports as an error.
+    pub fn set_samples_per_pass(&mut self, samples: Option<u32>) {
+        self.samples_per_pass = samples.map(|n| n.max(1));
+    }
+
+    /// The adapter's name and backend, e.g. "llvmpipe (LLVM 15.0.6, 256 bits) (Vulkan, Cpu)".
+    pub fn adapter_name(&self) -> String {
+        format!(
+            "{} ({:?}, {:?})",
+            self.info.name, self.info.backend, self.info.device_type
+        )
+    }
+
+    /// Renders `parts` with the path tracer. `progress(done, total)` hears after every pass
+    /// (samples per pixel done and asked for) and may cancel by returning false.
+    pub fn render(
+        &self,
+        parts: &SceneParts,
+        settings: &RenderSettings,
+        progress: &dyn Fn(u32, u32) -> bool,
+    ) -> Result<(Film, GpuStats), GpuError> {
+        check_supported(parts, settings)?;
+        let flat = FlatScene::new(parts);
+        let (width, height) = (settings.width, settings.height);
+        let bounds = settings.bounds();
+        let (crop_width, crop_height) = (bounds.x1 - bounds.x0, bounds.y1 - bounds.y0);
+        let pixels = crop_width as u64 * crop_height as u64;
+        let mut params = flat.params;
+        params.width = width;
+        params.height = height;
+        params.x0 = bounds.x0;
+        params.y0 = bounds.y0;
+        params.crop_width = crop_width;
+        params.crop_height = crop_height;
+        params.seed_lo = settings.seed as u32;
+        params.seed_hi = (settings.seed >> 32) as u32;
+        params.max_depth = settings.max_depth();
+        params.camera_w[3] = settings.aspect.unwrap_or(width as f32 / height as f32);
+
+        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
+            // wgpu refuses empty bindings: an empty table is one zero word.
+            let padded: &[u8] = if bytes.is_empty() { &[0u8; 16] } else { bytes };
+            if padded.len() as u64 > self.max_binding {
+                return Err(GpuError::Unsupported(format!(
+                    "a scene whose {label} take {} bytes (the adapter binds at most {})",
+                    padded.len(),
+                    self.max_binding
+                )));
+            }
+            Ok(self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: padded,
+                    usage: wgpu::BufferUsages::STORAGE | extra,
+                }))
+        };
+        let none = wgpu::BufferUsages::empty();
+        let nodes = storage("BVH nodes", bytemuck::cast_slice(&flat.nodes), none)?;
+        let prims = storage("primitives", bytemuck::cast_slice(&flat.prims), none)?;
+        let materials = storage("materials", bytemuck::cast_slice(&flat.materials), none)?;
+        let lights = storage("lights", bytemuck::cast_slice(&flat.lights), none)?;
+        let tables = storage("tables", bytemuck::cast_slice(&flat.tables), none)?;
+        let texels = storage("texels", bytemuck::cast_slice(&flat.texels), none)?;
+        let accum_bytes = vec![0u8; pixels as usize * ACCUM_BYTES_PER_PIXEL];
+        let accum = storage("accumulation", &accum_bytes, wgpu::BufferUsages::COPY_SRC)?;
+        let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<layout::Params>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("glint scene"),
+            layout: &self.layout,
+            entries: &[
+                (0, &uniform),
+                (1, &nodes),
+                (2, &prims),
+                (3, &materials),
+                (4, &lights),
+                (5, &tables),
+                (6, &texels),
+                (7, &accum),
+            ]
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }),
+        });
+
+        let samples = settings.samples();
+        let total = samples.len() as u32;
+        // On a CPU adapter (lavapipe) one sample per invocation and pass keeps every
+        // invocation far below llvmpipe's loop limit (`path.wgsl`, `loop_limit_reached`).
+        let per_invocation = match (self.samples_per_pass, self.info.device_type) {
+            (Some(samples), _) => samples as u64,
+            (None, wgpu::DeviceType::Cpu) => 1,
+            (None, _) => SAMPLES_PER_DISPATCH / pixels,
+        };
+        let per_pass = per_invocation.clamp(1, total.max(1) as u64) as u32;
+        let mut done = 0u32;
+        while done < total {
+            let count = per_pass.min(total - done);
+            params.first_sample = samples.start + done;
+            params.samples = count;
+            self.queue
+                .write_buffer(&uniform, 0, bytemuck::bytes_of(&params));
+            let mut encoder = self
+                .device
+                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+            {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("path samples"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.pipeline);
+                pass.set_bind_group(0, &bind_group, &[]);
+                pass.dispatch_workgroups(crop_width.div_ceil(8), crop_height.div_ceil(8), 1);
+            }
+            self.queue.submit([encoder.finish()]);
+            self.device
+                .poll(wgpu::PollType::wait_indefinitely())
+                .map_err(|error| GpuError::Device(error.to_string()))?;
+            self.check_device()?;
+            done += count;
+            if !progress(done, total) {
+                return Err(GpuError::Cancelled);
+            }
+        }
+
+        self.check_device()?;
+        let sums = self.read_back(&accum, pixels * ACCUM_BYTES_PER_PIXEL as u64)?;
+        let mut film = Film::new(crop_width, crop_height);
+        film.origin = (bounds.x0, bounds.y0);
+        film.full_size = (width, height);
+        let mut features = Features {
+            albedo: Vec::with_capacity(pixels as usize),
+            normal: Vec::with_capacity(pixels as usize),
+            depth: Vec::with_capacity(pixels as usize),
+        };
+        let taken = total.max(1) as f32;
+        let mut stats = GpuStats {
+            samples: pixels * total as u64,
+            ..GpuStats::default()
+        };
+        for (index, (pixel, sum)) in film.pixels.iter_mut().zip(sums.chunks_exact(3)).enumerate() {
+            let [beauty, albedo_depth, normal] = [sum[0], sum[1], sum[2]];
+            let cut = normal[3] as u64;
+            stats.cut_samples += cut;
+            let dropped = (total as u64).saturating_sub(beauty[3] as u64 + cut);
+            if dropped > 0 {
+                stats.nonfinite_samples += dropped;
+                let (x, y) = (index as u32 % crop_width, index as u32 / crop_width);
+                stats
+                    .first_nonfinite_pixel
+                    .get_or_insert((bounds.x0 + x, bounds.y0 + y));
+            }
+            // Non-finite samples were dropped; the valid ones are averaged and the feature
+            // layers divided by every sample taken, as the CPU pipeline does.
+            *pixel = if beauty[3] > 0.0 {
+                Color::new(beauty[0], beauty[1], beauty[2]) / beauty[3]
+            } else {
+                Color::ZERO
+            };
+            features
+                .albedo
+                .push(Color::new(albedo_depth[0], albedo_depth[1], albedo_depth[2]) / taken);
+            features.depth.push(albedo_depth[3] / taken);
+            features
+                .normal
+                .push(Vec3::new(normal[0], normal[1], normal[2]) / taken);
+        }
+        if stats.cut_samples > 0 {
+            return Err(GpuError::Device(format!(
+                "the driver stopped {} path sample{} short (llvmpipe ends a shader's loops \
+                 after 65535 iterations): this scene's paths are too long for this adapter",
+                stats.cut_samples,
+                if stats.cut_samples == 1 { "" } else { "s" }
+            )));
+        }
+        film.features = settings.features.then_some(features);
+        Ok((film, stats))
+    }
+
+    fn read_back(&self, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<[f32; 4]>, GpuError> {
+        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("read back"),
+            size,
+            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, size);
+        self.queue.submit([encoder.finish()]);
+        let slice = staging.slice(..);
+        let (sender, receiver) = mpsc::channel();
+        slice.map_async(wgpu::MapMode::Read, move |result| {
+            let _ = sender.send(result);
+        });
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        receiver
+            .recv()
+            .map_err(|error| GpuError::Device(error.to_string()))?
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        let data = slice
+            .get_mapped_range()
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        let values = bytemuck::cast_slice::<u8, [f32; 4]>(&data).to_vec();
+        drop(data);
+        staging.unmap();
+        self.check_device()?;
+        Ok(values)
+    }
+}
