@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 root=$(pwd)
 
 # Suites beyond cargo, each a script with `install` and `test` subcommands.
-SUITES=(python/ci.sh web/ci.sh farm/ci.sh crates/cli/preview-ci.sh)
+SUITES=(python/ci.sh web/ci.sh farm/ci.sh crates/cli/preview-ci.sh crates/cli/minimal-ci.sh)
 # Installs only: the software Vulkan (Mesa's lavapipe) the GPU tests of `cargo test --workspace`
 # render on (under CI=1 they fail without an adapter).
 INSTALL_ONLY=(crates/gpu/ci.sh)
