@@ -129,6 +129,55 @@ fn json_syntax_error_is_located() {
 }
 
 #[test]
+fn a_missing_comma_between_members_is_an_error_where_it_belongs() {
+    let fixture = Fixture::new();
+    // jsonc-parser alone reads `"position": "0 0 0" "viewDir": ...` as two members.
+    let error = expect_error(fixture.load(
+        "comma.json",
+        "{\"scene\": {\n  \"camera\": [{\"position\": \"0 0 0\"\n    \"viewDir\": \"0 0 -1\"}]\n}}\n",
+    ));
+    assert_eq!(at(&error), (2, 34), "{error}");
+    assert!(
+        error
+            .message
+            .starts_with("malformed JSON: expected `,` or `}` here"),
+        "{error}"
+    );
+    assert!(error.message.contains("(line 3, column 5)"), "{error}");
+    assert!(
+        error
+            .to_string()
+            .ends_with(&format!("\n{}^", " ".repeat(33))),
+        "{error}"
+    );
+}
+
+#[test]
+fn a_missing_comma_between_elements_is_an_error_where_it_belongs() {
+    let fixture = Fixture::new();
+    let text = format!(
+        "{{\"scene\": {{\n  {CAMERA_JSON},\n  \"shape\": [{{\"_type\": \"sphere\", \"radius\": 1}} /* no comma */ {{\"_type\": \"sphere\", \"radius\": 2}}]\n}}}}\n"
+    );
+    let error = expect_error(fixture.load("elements.json", &text));
+    assert_eq!(at(&error), (3, 45), "{error}");
+    assert!(
+        error
+            .message
+            .starts_with("malformed JSON: expected `,` or `]` here"),
+        "{error}"
+    );
+    // A comma inside a comment is no comma, and comments and trailing commas stay allowed.
+    let commented = text.replace("/* no comma */", "/* , */");
+    assert_eq!(
+        at(&expect_error(fixture.load("commented.json", &commented))),
+        (3, 45)
+    );
+    let fine = text.replace("/* no comma */", "/* ok */ , // and a line comment\n");
+    let fine = fine.replace("2}]", "2},]");
+    expect_ok(fixture.load("fine.json", &fine));
+}
+
+#[test]
 fn a_vector_with_two_numbers_is_an_error_at_the_value() {
     let fixture = Fixture::new();
     let text = format!(
