@@ -278,8 +278,8 @@ fn a_missing_json_comma_is_a_located_error() {
     let elements = "{\"scene\": {\n  \"camera\": [{\"_type\": \"perspective\", \"position\": \"0 0 0\", \"viewDir\": \"0 0 -1\"}],\n  \"shape\": [{\"_type\": \"sphere\", \"radius\": 1}\n    {\"_type\": \"sphere\", \"radius\": 2}]\n}}\n";
     let (dir, _) = folder(&[("members.json", members), ("elements.json", elements)]);
     for (scene, at, closer) in [
-        ("members.json", "members.json:2:58: error: ", '}'),
-        ("elements.json", "elements.json:3:45: error: ", ']'),
+        ("members.json", "error: members.json:2:58: ", '}'),
+        ("elements.json", "error: elements.json:3:45: ", ']'),
     ] {
         for strict in [false, true] {
             let mut args = vec!["check", scene];
