@@ -12,6 +12,7 @@ pub fn limits() -> Limits {
         max_texture_side: 1024,
         max_texture_bytes: 64 << 20,
         max_memory: 256 << 20,
+        allow_missing_assets: false,
     }
 }
 
@@ -20,12 +21,16 @@ pub fn limits() -> Limits {
 pub fn load(text: &str, path: &str, assets: &dyn Assets) -> Option<LoadedScene> {
     match glint_io::load_scene_with_assets_limited(text, Path::new(path), assets, &limits()) {
         Ok(loaded) => Some(loaded),
-        Err(SceneError::Invalid(diagnostic)) => {
+        Err(error @ (SceneError::Invalid(_) | SceneError::Several(_))) => {
             let lines = text.lines().count() as u32 + 1;
-            assert!(
-                diagnostic.line >= 1 && diagnostic.line <= lines.max(1) && diagnostic.column >= 1,
-                "error outside the text: {diagnostic}"
-            );
+            for diagnostic in error.diagnostics() {
+                assert!(
+                    diagnostic.line >= 1
+                        && diagnostic.line <= lines.max(1)
+                        && diagnostic.column >= 1,
+                    "error outside the text: {diagnostic}"
+                );
+            }
             None
         }
         Err(error) => panic!("loading from memory gave a non-located error: {error}"),

@@ -188,6 +188,12 @@ pub struct LimitOptions {
     #[arg(long, action = ArgAction::SetTrue)]
     pub strict: bool,
 
+    /// Load a scene even when a mesh, texture or environment map it names cannot be read, as
+    /// the course renderer did: a warning, and the mesh left out, the texture's plain colour or
+    /// the background colour in its place [default: such a file is an error].
+    #[arg(long, action = ArgAction::SetTrue)]
+    pub allow_missing_assets: bool,
+
     /// Memory a load and render may plan for: parse trees, meshes, film, textures and
     /// acceleration structures, estimated before they are allocated (bytes; K, M, G suffixes)
     /// [default: half of the least of the machine's memory, its control group's limit and
@@ -281,6 +287,7 @@ impl LimitOptions {
             max_texture_side: self.max_texture_size,
             max_texture_bytes: max_memory,
             max_memory,
+            allow_missing_assets: self.allow_missing_assets,
         };
         (limits, max_memory)
     }

@@ -74,6 +74,11 @@ impl fmt::Display for Failure {
         match self {
             Failure::Usage(error) => write!(f, "{error}"),
             Failure::Scene(SceneError::Invalid(diagnostic)) => f.write_str(&located(diagnostic)),
+            // `error: ` is printed before the first; each of the others gets its own.
+            Failure::Scene(SceneError::Several(diagnostics)) => {
+                let shown: Vec<String> = diagnostics.iter().map(located).collect();
+                f.write_str(&shown.join("\nerror: "))
+            }
             Failure::Scene(error @ SceneError::Io { source, .. }) => {
                 write!(f, "{error}")?;
                 if glint_io::TooLarge::of(source).is_some() {

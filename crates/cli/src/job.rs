@@ -710,6 +710,7 @@ mod tests {
                 max_texture_side: 100,
                 max_texture_bytes: 1 << 30,
                 max_memory: 1 << 30,
+                allow_missing_assets: false,
             }
         );
         let defaults = job(&["-i", "s.xml"]).unwrap();

@@ -597,7 +597,7 @@ fn a_word_where_a_vector_belongs_fails_with_its_location() {
 }
 
 #[test]
-fn a_missing_obj_is_a_located_warning_and_the_render_goes_on() {
+fn a_missing_obj_is_a_located_error_unless_allowed() {
     let dir = scene_dir();
     let scene = SPHERE_XML.replace(
         "</scene>",
@@ -605,16 +605,28 @@ fn a_missing_obj_is_a_located_warning_and_the_render_goes_on() {
          <shape name=\"g\" type=\"instance\" id=\"ghost\">\n    <shader ref=\"blue\"/>\n  </shape>\n</scene>",
     );
     std::fs::write(dir.path().join("mesh.xml"), &scene).unwrap();
+    let args = ["-i", "mesh.xml", "-o", "mesh.png", "-w", "8", "-h", "8"];
+    let output = glint_in(dir.path(), &args);
+    assert_exit(&output, 2);
+    let text = stderr(&output);
+    assert!(text.contains("error: "), "{text}");
+    assert!(
+        text.contains("cannot read mesh `objFiles/nowhere.obj`"),
+        "{text}"
+    );
+    let (line, _) = location(&text, "mesh.xml").unwrap_or_else(|| panic!("no location:\n{text}"));
+    assert_eq!(line, line_of(&scene, "nowhere.obj"), "{text}");
+    assert!(!dir.path().join("mesh.png").exists());
+
+    // The course renderer's way, asked for: a warning, and the render goes on.
     let output = glint_in(
         dir.path(),
-        &["-i", "mesh.xml", "-o", "mesh.png", "-w", "8", "-h", "8"],
+        &[&args[..], &["--allow-missing-assets"]].concat(),
     );
     assert_exit(&output, 0);
     let text = stderr(&output);
     assert!(text.contains("warning: "), "{text}");
-    assert!(text.contains("nowhere.obj"), "{text}");
-    let (line, _) = location(&text, "mesh.xml").unwrap_or_else(|| panic!("no location:\n{text}"));
-    assert_eq!(line, line_of(&scene, "nowhere.obj"), "{text}");
+    assert!(text.contains("the mesh is omitted"), "{text}");
     assert!(dir.path().join("mesh.png").exists());
 }
 

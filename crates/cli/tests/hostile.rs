@@ -561,14 +561,14 @@ fn bad_inputs() -> Vec<(&'static str, Vec<u8>, &'static str, Vec<&'static str>)>
         ("phong.xml", xml_with("<shader name=\"blue\" type=\"Lambertian\">", "<shader name=\"blue\" type=\"BlinnPhong\">\n    <phongExp>-3</phongExp>").into(), "<phongExp>", vec![]),
         ("word.json", json_with("\"radius\": 1", "\"radius\": \"one\"").into(), "\"one\"", vec![]),
         ("faces.xml", mesh_scene("faces.obj").into(), "faces.obj", vec!["--max-triangles", "1000"]),
-        // Dangling references, a self-referencing instance, an unknown type, a missing
-        // texture, broken OBJ files: warnings that --strict makes errors.
+        // Dangling references, a self-referencing instance, an unknown type, broken OBJ
+        // files: warnings that --strict makes errors.
         ("dangling.xml", xml_with("<shader ref=\"blue\" />", "<shader ref=\"bleu\" />").into(), "ref=\"bleu\"", vec!["--strict"]),
         ("self.xml", xml_with("</scene>", "  <instance name=\"me\" type=\"instance\" id=\"me\"/>\n  <shape type=\"instance\" id=\"me\"/>\n</scene>").into(), "name=\"me\"", vec!["--strict"]),
         ("unknown.xml", xml_with("type=\"sphere\"", "type=\"spehre\"").into(), "spehre", vec!["--strict"]),
         ("nanmesh.xml", mesh_scene("nan.obj").into(), "nan.obj", vec!["--strict"]),
         ("range.xml", mesh_scene("range.obj").into(), "range.obj", vec!["--strict"]),
-        ("notex.xml", xml_with("<diffuse>0 0 1</diffuse>", "<diffuse tex=\"t\">0 0 1</diffuse>").replace("<shader name=\"blue\"", "<texture name=\"t\" type=\"image\">\n    <sourcefile>gone.png</sourcefile>\n  </texture>\n  <shader name=\"blue\"").into(), "gone.png", vec!["--strict"]),
+        ("notex.xml", xml_with("<diffuse>0 0 1</diffuse>", "<diffuse tex=\"t\">0 0 1</diffuse>").replace("<shader name=\"blue\"", "<texture name=\"t\" type=\"image\">\n    <sourcefile>gone.png</sourcefile>\n  </texture>\n  <shader name=\"blue\"").into(), "gone.png", vec![]),
     ]
 }
 

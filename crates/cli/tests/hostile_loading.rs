@@ -174,8 +174,8 @@ fn columns_on_a_long_non_ascii_line_are_counted_once() {
 }
 
 /// Class 3: a mesh that is a FIFO blocked for ever in `open`. It is now named and said to be a
-/// FIFO at once (a warning, as for a mesh that cannot be read; `--strict` makes it exit 2), and
-/// a scene file that is a FIFO is refused with exit 2.
+/// FIFO at once (an error, as for every mesh that cannot be read: exit 2 without `--strict`),
+/// and a scene file that is a FIFO is refused with exit 2.
 #[cfg(unix)]
 #[test]
 fn a_fifo_is_refused_without_waiting() {
@@ -194,10 +194,14 @@ fn a_fifo_is_refused_without_waiting() {
     )
     .unwrap();
     let limit = Duration::from_secs(20);
-    let output = run(dir.path(), &["check", "--strict", "fifo.xml"], None, limit);
+    let output = run(dir.path(), &["check", "fifo.xml"], None, limit);
     let text = stderr(&output);
     assert_eq!(output.status.code(), Some(2), "{text}");
-    assert!(text.contains("pipe.obj"), "{text}");
+    assert!(text.contains("error: fifo.xml:"), "{text}");
+    assert!(
+        text.contains("cannot read mesh `pipe.obj` (tried "),
+        "{text}"
+    );
     assert!(
         text.contains("a FIFO (named pipe), not a regular file"),
         "{text}"

@@ -14,7 +14,7 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use common::scene_files;
+use common::{load_as_the_course_did, scene_files};
 
 use std::path::PathBuf;
 
@@ -44,7 +44,8 @@ fn main() {
     );
     let files = scene_files(&dir);
     for (path, name) in &files {
-        let loaded = match glint_io::load_scene(path) {
+        // The course's images, so its leniency: two scenes name files that exist nowhere.
+        let loaded = match load_as_the_course_did(path) {
             Ok(loaded) => loaded,
             Err(error) => {
                 println!(

@@ -16,6 +16,13 @@ pub trait Assets {
 
     /// Whether a file exists at `path` (to pick among alternative names).
     fn exists(&self, path: &Path) -> bool;
+
+    /// `path` as a message shows the path it tried: the file system makes it absolute, so that
+    /// a user sees where the file was looked for whatever folder they ran from; the default
+    /// keeps it as it is.
+    fn tried(&self, path: &Path) -> PathBuf {
+        path.to_path_buf()
+    }
     /// The bytes of the file at `path`, or a [`TooLarge`] error (kind `InvalidData`) when it
     /// holds more than `limit` bytes. The loader reads every file through this. The default
     /// reads the whole file first; sources that can tell the size before reading override it.
@@ -25,6 +32,16 @@ pub trait Assets {
             return Err(TooLarge { limit }.into());
         }
         Ok(bytes)
+    }
+}
+
+/// Why a file could not be read, for a message: the system's words without their
+/// " (os error N)" suffix ("No such file or directory").
+pub(crate) fn reason(error: &io::Error) -> String {
+    let text = error.to_string();
+    match (error.raw_os_error(), text.rfind(" (os error ")) {
+        (Some(_), Some(at)) => text[..at].to_owned(),
+        _ => text,
     }
 }
 
@@ -90,6 +107,11 @@ impl Assets for FileSystem {
     fn exists(&self, path: &Path) -> bool {
         path.is_file()
     }
+
+    fn tried(&self, path: &Path) -> PathBuf {
+        std::path::absolute(path).unwrap_or_else(|_| path.to_path_buf())
+    }
+
     /// Refuses a regular file by its size before reading it, and a FIFO, socket, block device
     /// or folder before opening it; reads a character device (/dev/zero) only up to one byte
     /// past the limit.

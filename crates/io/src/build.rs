@@ -1,7 +1,9 @@
 //! `SceneDesc` into the renderer's `SceneParts`: names resolved to indices, assets loaded,
 //! transforms composed, emitters turned into lights plus visible geometry. Problems the user
-//! can live with (a dangling reference, a missing file) become warnings at the place they were
-//! written, and the scene still builds with a visible fallback.
+//! can live with (a dangling reference) become warnings at the place they were written, and the
+//! scene still builds with a visible fallback. A file that cannot be read is an error, reported
+//! with every other such file of the scene (`Limits::allow_missing_assets` makes it a warning,
+//! as the course renderer had it).
 //!
 //! Geometry layout:
 //! * every plain sphere, triangle and box of the scene (and of shape lights) goes into one
@@ -132,6 +134,14 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
             instances: Vec::new(),
             lights: Vec::new(),
         }
+    }
+
+    /// A file the scene names that cannot be read: an error, or with `allow_missing_assets`
+    /// a warning saying what is used instead.
+    fn missing_asset(&mut self, span: Span, message: String, fallback: &str) {
+        let allowed = self.limits.allow_missing_assets;
+        self.diagnostics
+            .missing_asset(span, message, fallback, allowed);
     }
 
     fn resolve_path(&self, relative: &str) -> PathBuf {
@@ -392,15 +402,13 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 ))
             }
             Err(AssetError::Failed(error)) => {
-                self.diagnostics.warn(
-                    source.span,
-                    format!(
-                        "cannot read texture image `{}` ({}): {error}; shaders using texture \
-                         `{key}` show their plain colour",
-                        source.value,
-                        path.display()
-                    ),
+                let message = format!(
+                    "cannot read texture image `{}` (tried {}): {error}",
+                    source.value,
+                    self.assets.tried(&path).display()
                 );
+                let fallback = format!("shaders using texture `{key}` show their plain colour");
+                self.missing_asset(source.span, message, &fallback);
                 None
             }
         };
@@ -552,15 +560,14 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                 ))
             }
             Err(AssetError::Failed(error)) => {
-                // FORMAT.md A17: instructor files name meshes that exist nowhere; warn and go on.
-                self.diagnostics.warn(
-                    file.span,
-                    format!(
-                        "cannot read OBJ file `{}` ({}): {error}; the mesh is omitted",
-                        file.value,
-                        path.display()
-                    ),
+                // FORMAT.md A17: instructor files name meshes that exist nowhere; the course
+                // renderer went on without them, which `allow_missing_assets` keeps.
+                let message = format!(
+                    "cannot read mesh `{}` (tried {}): {error}",
+                    file.value,
+                    self.assets.tried(&path).display()
                 );
+                self.missing_asset(file.span, message, "the mesh is omitted");
                 None
             }
         };
@@ -906,14 +913,11 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                         format!("environment map `{}` is refused: {why}", prefix.value),
                     ))
                 }
-                // FORMAT.md 2.1, A17: `data/reef_` never existed; a missing map means no map.
-                Err(AssetError::Failed(error)) => self.diagnostics.warn(
-                    prefix.span,
-                    format!(
-                        "environment map `{}`: {error}; the background colour is used instead",
-                        prefix.value
-                    ),
-                ),
+                // FORMAT.md 2.1, A17: `data/reef_` never existed; the course renderer drew
+                // the background colour instead, which `allow_missing_assets` keeps.
+                Err(AssetError::Failed(error)) => {
+                    self.missing_asset(prefix.span, error, "the background colour is used instead")
+                }
             }
         }
         if let Some(cross) = &background.env_map_vertical_cross {
@@ -931,20 +935,18 @@ impl<'desc, 'diagnostics, 'text> Builder<'desc, 'diagnostics, 'text> {
                         ),
                     ))
                 }
-                Err(AssetError::Failed(error)) => {
-                    Err(format!("cannot read ({}): {error}", path.display()))
-                }
+                Err(AssetError::Failed(error)) => Err(format!(
+                    "cannot read environment map `{}` (tried {}): {error}",
+                    cross.value,
+                    self.assets.tried(&path).display()
+                )),
                 Ok(faces) => faces,
             };
             match faces {
                 Ok(faces) => return Ok(Background::CubeMap(Box::new(CubeMap { faces }))),
-                Err(error) => self.diagnostics.warn(
-                    cross.span,
-                    format!(
-                        "environment map `{}`: {error}; the background colour is used instead",
-                        cross.value
-                    ),
-                ),
+                Err(error) => {
+                    self.missing_asset(cross.span, error, "the background colour is used instead")
+                }
             }
         }
         Ok(Background::Color(color))

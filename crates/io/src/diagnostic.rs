@@ -201,14 +201,48 @@ pub enum SceneError {
     /// A syntax error or an invalid value, with its location.
     #[error("{0}")]
     Invalid(Diagnostic),
+    /// Several located errors of one load, in the order they were met (at least two): the
+    /// files a scene names that cannot be read are all reported, not only the first.
+    #[error("{}", display_all(.0))]
+    Several(Vec<Diagnostic>),
+}
+
+/// The diagnostics one after the other, a line break between them.
+fn display_all(diagnostics: &[Diagnostic]) -> String {
+    let shown: Vec<String> = diagnostics.iter().map(ToString::to_string).collect();
+    shown.join("\n")
 }
 
 impl SceneError {
-    /// The located diagnostic, when the error has one.
+    /// The located diagnostic, when the error has one (the first, when it has several).
     pub fn diagnostic(&self) -> Option<&Diagnostic> {
+        self.diagnostics().first()
+    }
+
+    /// Every located diagnostic of the error, in order: none for a scene file that could not
+    /// be read, one for a syntax error, one for each file that could not be read.
+    pub fn diagnostics(&self) -> &[Diagnostic] {
         match self {
-            SceneError::Io { .. } => None,
-            SceneError::Invalid(diagnostic) => Some(diagnostic),
+            SceneError::Io { .. } => &[],
+            SceneError::Invalid(diagnostic) => std::slice::from_ref(diagnostic),
+            SceneError::Several(diagnostics) => diagnostics,
+        }
+    }
+
+    /// The error of a load that met `errors` (at least one) before `stop`, the error that
+    /// ended it, if any: one diagnostic alone is `Invalid`, more are `Several`.
+    pub(crate) fn gathered(mut errors: Vec<Diagnostic>, stop: Option<SceneError>) -> SceneError {
+        match stop {
+            None => {}
+            Some(SceneError::Invalid(diagnostic)) => errors.push(diagnostic),
+            Some(SceneError::Several(more)) => errors.extend(more),
+            // The scene file itself is unreadable: nothing else about it matters.
+            Some(io @ SceneError::Io { .. }) => return io,
+        }
+        if errors.len() == 1 {
+            SceneError::Invalid(errors.remove(0))
+        } else {
+            SceneError::Several(errors)
         }
     }
 }
@@ -364,6 +398,9 @@ pub(crate) struct Diagnostics<'text> {
     /// The text, copied once when the first diagnostic needs it, shared by all of them.
     shared_text: OnceCell<Arc<str>>,
     warnings: Vec<Diagnostic>,
+    /// Errors that did not stop the load at once (files that cannot be read), so that one
+    /// load reports all of them; `finish` fails with them.
+    errors: Vec<Diagnostic>,
     /// (line, column, message) of every warning kept: a repeated warning is dropped in O(1).
     seen: HashSet<(u32, u32, String)>,
     /// Warnings past `MAX_KEPT_WARNINGS`, counted only.
@@ -392,6 +429,7 @@ impl<'text> Diagnostics<'text> {
             lines: LineIndex::new(text),
             shared_text: OnceCell::new(),
             warnings: Vec::new(),
+            errors: Vec::new(),
             seen: HashSet::new(),
             dropped: 0,
             last_dropped: Span::default(),
@@ -450,6 +488,40 @@ impl<'text> Diagnostics<'text> {
 
     pub fn error(&self, span: Span, message: impl Into<String>) -> SceneError {
         SceneError::Invalid(self.diagnostic(Severity::Error, span, message.into()))
+    }
+
+    /// An error that does not stop the load at once: the load goes on, to find the others,
+    /// and `finish` fails with all of them.
+    pub fn error_later(&mut self, span: Span, message: impl Into<String>) {
+        let diagnostic = self.diagnostic(Severity::Error, span, message.into());
+        self.errors.push(diagnostic);
+    }
+
+    /// A file the scene names that cannot be read (`message` says which and why): an error
+    /// unless `allowed` (`Limits::allow_missing_assets`), then a warning that ends with what
+    /// is used instead (`fallback`).
+    pub fn missing_asset(&mut self, span: Span, message: String, fallback: &str, allowed: bool) {
+        if allowed {
+            self.warn(span, format!("{message}; {fallback}"));
+        } else {
+            self.error_later(span, message);
+        }
+    }
+
+    /// `error`, the one that stopped the load, after the errors met before it.
+    pub fn stopped(&mut self, error: SceneError) -> SceneError {
+        if self.errors.is_empty() {
+            return error;
+        }
+        SceneError::gathered(std::mem::take(&mut self.errors), Some(error))
+    }
+
+    /// The warnings, or the errors met along the way when there were any.
+    pub fn finish(self) -> Result<Vec<Diagnostic>, SceneError> {
+        if !self.errors.is_empty() {
+            return Err(SceneError::gathered(self.errors, None));
+        }
+        Ok(self.into_warnings())
     }
 
     pub fn into_warnings(mut self) -> Vec<Diagnostic> {

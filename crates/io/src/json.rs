@@ -36,12 +36,89 @@ pub(crate) fn parse<'text>(
                     format!("malformed JSON: {}", error.kind()),
                 )
             })?;
-    result.value.ok_or_else(|| {
+    let value = result.value.ok_or_else(|| {
         diagnostics.error(
             diagnostics.span_at(text.len()),
             "malformed JSON: the file holds no value",
         )
-    })
+    })?;
+    check_commas(&value, text, diagnostics)?;
+    Ok(value)
+}
+
+/// Refuses two members of an object, or two elements of an array, with no comma between
+/// them, which jsonc-parser lets through: RFC 8259 requires it, and a missing comma is the
+/// commonest slip in a hand-edited file. The error is at the end of the value the comma
+/// should follow. The recursion is as deep as the nesting, which `check_nesting` bounds.
+fn check_commas(
+    value: &ast::Value<'_>,
+    text: &str,
+    diagnostics: &Diagnostics,
+) -> Result<(), SceneError> {
+    let missing = |before: usize, after: usize, closer: char, what: &str| {
+        let next = diagnostics.span_at(after);
+        diagnostics.error(
+            diagnostics.span_at(before),
+            format!(
+                "malformed JSON: expected `,` or `{closer}` here: a comma is missing before the \
+                 next {what} (line {}, column {})",
+                next.line, next.column
+            ),
+        )
+    };
+    match value {
+        ast::Value::Object(object) => {
+            for pair in object.properties.windows(2) {
+                let (end, start) = (pair[0].range.end, pair[1].range.start);
+                if !has_comma(&text[end..start]) {
+                    return Err(missing(end, start, '}', "member"));
+                }
+            }
+            for property in &object.properties {
+                check_commas(&property.value, text, diagnostics)?;
+            }
+        }
+        ast::Value::Array(array) => {
+            for pair in array.elements.windows(2) {
+                let (end, start) = (pair[0].end(), pair[1].start());
+                if !has_comma(&text[end..start]) {
+                    return Err(missing(end, start, ']', "element"));
+                }
+            }
+            for element in &array.elements {
+                check_commas(element, text, diagnostics)?;
+            }
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+/// Whether `between`, the text between two values that jsonc-parser read one after the other
+/// (white space, comments and commas only), holds a comma outside its comments.
+fn has_comma(between: &str) -> bool {
+    let bytes = between.as_bytes();
+    let mut index = 0;
+    while index < bytes.len() {
+        match bytes[index] {
+            b',' => return true,
+            b'/' if bytes.get(index + 1) == Some(&b'/') => {
+                while index < bytes.len() && bytes[index] != b'\n' {
+                    index += 1;
+                }
+            }
+            b'/' if bytes.get(index + 1) == Some(&b'*') => {
+                index += 2;
+                while index < bytes.len() && !bytes[index..].starts_with(b"*/") {
+                    index += 1;
+                }
+                index += 1;
+            }
+            _ => {}
+        }
+        index += 1;
+    }
+    false
 }
 
 /// The top-level value as a node with an empty key.

@@ -11,8 +11,10 @@
 //!    composing transforms (`build.rs`).
 //!
 //! Errors stop the load with a `Diagnostic` naming `file:line:col`; everything the loader can
-//! work around (unknown keys, dangling references, missing files) is returned as warnings next
-//! to the scene.
+//! work around (unknown keys, dangling references) is returned as warnings next to the scene.
+//! A file the scene names that cannot be read (a mesh, a texture, an environment map) is an
+//! error, all such files of a load reported together (`SceneError::Several`), unless
+//! `Limits::allow_missing_assets` asks for the course renderer's warning and fallback.
 //!
 //! ```
 //! use std::path::Path;
@@ -337,10 +339,11 @@ pub fn load_scene_with_defines(
     };
     let desc = read::read_document(&root, format, &mut diagnostics)?;
     let base_directory = path.parent().unwrap_or(Path::new(""));
-    let parts = build::build(&desc, base_directory, assets, limits, &mut diagnostics)?;
+    let parts = build::build(&desc, base_directory, assets, limits, &mut diagnostics)
+        .map_err(|error| diagnostics.stopped(error))?;
     Ok(LoadedScene {
         parts,
-        warnings: diagnostics.into_warnings(),
+        warnings: diagnostics.finish()?,
     })
 }
 

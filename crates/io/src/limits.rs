@@ -3,7 +3,7 @@
 //! so that a hostile or mistaken file is refused with a located error instead of growing until
 //! the kernel kills the process.
 
-/// The limits a load runs under. The defaults are far above what any course scene needs (its
+/// The limits a load runs under, and how it treats a file it cannot read. The defaults are far above what any course scene needs (its
 /// largest file is 3.7 MB, its largest texture 2048 x 1024) and far below what would take the
 /// machine down; front ends let a user raise them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,6 +21,15 @@ pub struct Limits {
     /// and a mesh's buffers are estimated against it while they load, from upper bounds of
     /// what each element, value or triangle holds, and refused where they would pass it.
     pub max_memory: u64,
+    /// Whether a file the scene names that cannot be read (missing, unreadable, not a file,
+    /// or not a mesh or image) is only a warning, as the course renderer had it: a course
+    /// scene then loads without it (the mesh left out, the texture's plain colour, the
+    /// background colour for an environment map), and so does a Mitsuba scene's mesh (the
+    /// shape left out). By default (false) each such file is an error, all of them reported
+    /// together, and the scene does not load. A glTF model's buffers and images, and a
+    /// Mitsuba scene's textures and volume grids, are errors either way: there is nothing to
+    /// render in their place. (The CLI's `--allow-missing-assets`.)
+    pub allow_missing_assets: bool,
 }
 
 /// 256 MiB.
@@ -48,6 +57,7 @@ impl Default for Limits {
             max_texture_side: DEFAULT_MAX_TEXTURE_SIDE,
             max_texture_bytes: DEFAULT_MAX_TEXTURE_BYTES,
             max_memory: DEFAULT_MAX_MEMORY,
+            allow_missing_assets: false,
         }
     }
 }
@@ -61,6 +71,7 @@ impl Limits {
             max_texture_side: u32::MAX,
             max_texture_bytes: u64::MAX,
             max_memory: u64::MAX,
+            allow_missing_assets: false,
         }
     }
 }

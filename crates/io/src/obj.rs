@@ -30,7 +30,7 @@ pub(crate) fn load_triangles(
                 Some(too_large) => {
                     AssetError::Refused(format!("{too_large} (--max-file-size raises it)"))
                 }
-                None => AssetError::Failed(error.to_string()),
+                None => AssetError::Failed(crate::assets::reason(&error)),
             })?;
     // Counted first, so that a face of millions of corners is refused before any of it is
     // parsed (the parser's corner list alone takes up to four times the file's size).

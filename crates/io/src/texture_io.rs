@@ -53,7 +53,7 @@ pub(crate) fn read_image(
             Some(too_large) => {
                 AssetError::Refused(format!("{too_large} (--max-file-size raises it)"))
             }
-            None => AssetError::Failed(error.to_string()),
+            None => AssetError::Failed(crate::assets::reason(&error)),
         })?;
     check_image(bytes, budget)
 }
@@ -371,30 +371,36 @@ pub(crate) fn load_cube_map(
     budget: &mut TextureBudget,
 ) -> Result<CubeMap, AssetError> {
     let extension = cube_face_extension(directory, prefix, assets);
-    let in_face = |name: &str, path: &Path, error: AssetError| {
-        let in_face = |error: String| format!("face `{name}` ({}): {error}", path.display());
-        match error {
-            AssetError::Refused(message) => AssetError::Refused(in_face(message)),
-            AssetError::Failed(message) => {
-                AssetError::Failed(format!("cannot read {}", in_face(message)))
-            }
+    // `tried` is the path as messages show it (`Assets::tried`), found before the decodes
+    // run on other threads, which `assets` may not be shared with.
+    let in_face = |name: &str, path: &Path, tried: &Path, error: AssetError| match error {
+        AssetError::Refused(message) => {
+            AssetError::Refused(format!("face `{name}` ({}): {message}", path.display()))
         }
+        AssetError::Failed(message) => AssetError::Failed(format!(
+            "cannot read environment-map face `{name}` (tried {}): {message}",
+            tried.display()
+        )),
     };
     let mut checked = Vec::with_capacity(6);
     let mut unread = None;
     for name in cube_face_paths(prefix, extension) {
         let path = directory.join(&name);
+        let tried = assets.tried(&path);
         match read_image(&path, assets, budget) {
-            Ok(face) => checked.push((name, path, face)),
+            Ok(face) => checked.push((name, path, tried, face)),
             Err(error) => {
-                unread = Some(in_face(&name, &path, error));
+                unread = Some(in_face(&name, &path, &tried, error));
                 break;
             }
         }
     }
     let decoded: Vec<Result<Image, AssetError>> = checked
         .into_par_iter()
-        .map(|(name, path, face)| face.decode().map_err(|error| in_face(&name, &path, error)))
+        .map(|(name, path, tried, face)| {
+            face.decode()
+                .map_err(|error| in_face(&name, &path, &tried, error))
+        })
         .collect();
     // The first error in face order.
     let faces = decoded.into_iter().collect::<Result<Vec<Image>, _>>()?;

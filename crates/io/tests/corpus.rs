@@ -4,9 +4,9 @@
 
 mod common;
 
-use common::{corpus, scene_files};
+use common::{corpus, load_as_the_course_did, scene_files};
 
-use glint_io::{load_scene, Diagnostic, LoadedScene, Severity};
+use glint_io::{load_scene, Diagnostic, LoadedScene, SceneError, Severity};
 use glint_render::{
     Background, ColorSource, Light, Material, Matrix4, Projection, SceneParts, Shape, Vec3,
 };
@@ -15,6 +15,29 @@ fn load(relative: &str) -> Option<LoadedScene> {
     let path = corpus()?.join(relative);
     Some(load_scene(&path).unwrap_or_else(|error| panic!("{relative} failed to load:\n{error}")))
 }
+
+/// `load` as the course renderer loaded: files that cannot be read are warnings.
+fn load_as_the_course(relative: &str) -> Option<LoadedScene> {
+    let path = corpus()?.join(relative);
+    Some(
+        load_as_the_course_did(&path)
+            .unwrap_or_else(|error| panic!("{relative} failed to load:\n{error}")),
+    )
+}
+
+/// The corpus files that name a file existing nowhere (FORMAT.md A17), with the start of the
+/// one error each gets by default. With `allow_missing_assets` they load, with the warnings
+/// `EXPECTED_WARNINGS` lists.
+const MISSING_ASSETS: &[(&str, &str)] = &[
+    (
+        "willemsen/scenes_B/dielectric_Test00.xml",
+        "cannot read environment-map face `data/reef_posX.png` (tried ",
+    ),
+    (
+        "willemsen/scenes_B/solarSystem.json",
+        "cannot read texture image `images/jupiter_map_css_plus_juno_bj.png` (tried ",
+    ),
+];
 
 /// Warnings each corpus file must produce: (file, part of the message, how many). Files not
 /// listed must load without any warning.
@@ -45,8 +68,8 @@ const EXPECTED_WARNINGS: &[(&str, &str, usize)] = &[
     ("students/kvatsaas__renderer/scenes_custom/monsterSphereScene01.json", "`monster` is not used in a sphere shape", 2),
     // A comment closed twice leaves `-->` as text in the scene.
     ("willemsen/scenes_A/CornellRoom_wMirroredSpheres.xml", "text `-->` is not used in the scene", 1),
-    // FORMAT.md A17: missing assets.
-    ("willemsen/scenes_B/dielectric_Test00.xml", "environment map `data/reef_`: cannot read face `data/reef_posX.png`", 1),
+    // FORMAT.md A17: missing assets (`MISSING_ASSETS`), with `allow_missing_assets`.
+    ("willemsen/scenes_B/dielectric_Test00.xml", "cannot read environment-map face `data/reef_posX.png`", 1),
     ("willemsen/scenes_B/solarSystem.json", "cannot read texture image `images/jupiter_map_css_plus_juno_bj.png`", 1),
     // FORMAT.md 4.2: Mirror shaders carrying other shaders' parameters.
     ("willemsen/scenes_B/glossyReflection.json", "is not used in a `Mirror` shader", 20),
@@ -63,8 +86,24 @@ fn every_corpus_scene_loads_with_the_expected_warnings() {
     assert!(files.len() >= 80, "only {} scene files found", files.len());
     let mut failures = Vec::new();
     let mut checked_expectations = 0;
+    let mut checked_missing = 0;
     for (path, relative) in &files {
-        let loaded = match load_scene(path) {
+        let missing = MISSING_ASSETS.iter().find(|(file, _)| file == relative);
+        if let Some((_, start)) = missing {
+            checked_missing += 1;
+            match load_scene(path) {
+                Err(SceneError::Invalid(error))
+                    if error.message.starts_with(start) && error.path == *path => {}
+                Err(error) => failures.push(format!("{relative}: not the error expected: {error}")),
+                Ok(_) => failures.push(format!("{relative}: loaded despite its missing file")),
+            }
+        }
+        let loaded = if missing.is_some() {
+            load_as_the_course_did(path)
+        } else {
+            load_scene(path)
+        };
+        let loaded = match loaded {
             Ok(loaded) => loaded,
             Err(error) => {
                 failures.push(format!("{relative}: {error}"));
@@ -100,6 +139,11 @@ fn every_corpus_scene_loads_with_the_expected_warnings() {
     assert_eq!(
         checked_expectations,
         EXPECTED_WARNINGS.len(),
+        "a listed file was not found"
+    );
+    assert_eq!(
+        checked_missing,
+        MISSING_ASSETS.len(),
         "a listed file was not found"
     );
     assert!(failures.is_empty(), "{}", failures.join("\n"));
@@ -359,8 +403,38 @@ fn warning_containing<'a>(loaded: &'a LoadedScene, fragment: &str) -> &'a Diagno
 }
 
 #[test]
-fn missing_assets_are_warnings_at_their_location() {
-    let Some(solar) = load("willemsen/scenes_B/solarSystem.json") else {
+fn missing_assets_are_errors_at_their_location() {
+    let Some(corpus) = corpus() else { return };
+    for (relative, at, shown) in [
+        (
+            "willemsen/scenes_B/solarSystem.json",
+            (56, 17),
+            "solarSystem.json:56:17: error: cannot read texture image \
+             `images/jupiter_map_css_plus_juno_bj.png` (tried /",
+        ),
+        (
+            "willemsen/scenes_B/dielectric_Test00.xml",
+            (7, 19),
+            "dielectric_Test00.xml:7:19: error: cannot read environment-map face \
+             `data/reef_posX.png` (tried /",
+        ),
+    ] {
+        let error = load_scene(&corpus.join(relative)).expect_err("a file is missing");
+        let [error] = error.diagnostics() else {
+            panic!("{relative}: one error expected:\n{error}");
+        };
+        assert_eq!((error.line, error.column), at);
+        assert!(error.to_string().contains(shown), "{error}");
+        assert!(
+            error.message.ends_with(": No such file or directory"),
+            "{error}"
+        );
+    }
+}
+
+#[test]
+fn missing_assets_allowed_are_warnings_at_their_location() {
+    let Some(solar) = load_as_the_course("willemsen/scenes_B/solarSystem.json") else {
         return;
     };
     let warning = warning_containing(&solar, "jupiter_map_css_plus_juno_bj.png");
@@ -389,7 +463,7 @@ fn missing_assets_are_warnings_at_their_location() {
         .count();
     assert_eq!(untextured, 1);
 
-    let Some(dielectric) = load("willemsen/scenes_B/dielectric_Test00.xml") else {
+    let Some(dielectric) = load_as_the_course("willemsen/scenes_B/dielectric_Test00.xml") else {
         return;
     };
     let warning = warning_containing(&dielectric, "data/reef_");

@@ -4,7 +4,10 @@
 
 use std::path::{Path, PathBuf};
 
-use glint_io::{load_scene, load_scene_from_text, Diagnostic, LoadedScene, SceneError, Severity};
+use glint_io::{
+    load_scene, load_scene_from_text, load_scene_limited, Diagnostic, Limits, LoadedScene,
+    SceneError, Severity,
+};
 use glint_render::{Background, ColorSource, Light, Material, Shape, Vec3};
 
 struct Fixture {
@@ -29,6 +32,15 @@ impl Fixture {
 
     fn load(&self, name: &str, contents: &str) -> Result<LoadedScene, SceneError> {
         load_scene(&self.write(name, contents))
+    }
+
+    /// `load` with the course renderer's leniency: files that cannot be read are warnings.
+    fn load_allowing_missing(&self, name: &str, contents: &str) -> Result<LoadedScene, SceneError> {
+        let limits = Limits {
+            allow_missing_assets: true,
+            ..Limits::default()
+        };
+        load_scene_limited(&self.write(name, contents), &limits)
     }
 }
 
@@ -126,6 +138,55 @@ fn json_syntax_error_is_located() {
         shown.ends_with(&format!("\n{}^", " ".repeat(47))),
         "{shown}"
     );
+}
+
+#[test]
+fn a_missing_comma_between_members_is_an_error_where_it_belongs() {
+    let fixture = Fixture::new();
+    // jsonc-parser alone reads `"position": "0 0 0" "viewDir": ...` as two members.
+    let error = expect_error(fixture.load(
+        "comma.json",
+        "{\"scene\": {\n  \"camera\": [{\"position\": \"0 0 0\"\n    \"viewDir\": \"0 0 -1\"}]\n}}\n",
+    ));
+    assert_eq!(at(&error), (2, 34), "{error}");
+    assert!(
+        error
+            .message
+            .starts_with("malformed JSON: expected `,` or `}` here"),
+        "{error}"
+    );
+    assert!(error.message.contains("(line 3, column 5)"), "{error}");
+    assert!(
+        error
+            .to_string()
+            .ends_with(&format!("\n{}^", " ".repeat(33))),
+        "{error}"
+    );
+}
+
+#[test]
+fn a_missing_comma_between_elements_is_an_error_where_it_belongs() {
+    let fixture = Fixture::new();
+    let text = format!(
+        "{{\"scene\": {{\n  {CAMERA_JSON},\n  \"shape\": [{{\"_type\": \"sphere\", \"radius\": 1}} /* no comma */ {{\"_type\": \"sphere\", \"radius\": 2}}]\n}}}}\n"
+    );
+    let error = expect_error(fixture.load("elements.json", &text));
+    assert_eq!(at(&error), (3, 45), "{error}");
+    assert!(
+        error
+            .message
+            .starts_with("malformed JSON: expected `,` or `]` here"),
+        "{error}"
+    );
+    // A comma inside a comment is no comma, and comments and trailing commas stay allowed.
+    let commented = text.replace("/* no comma */", "/* , */");
+    assert_eq!(
+        at(&expect_error(fixture.load("commented.json", &commented))),
+        (3, 45)
+    );
+    let fine = text.replace("/* no comma */", "/* ok */ , // and a line comment\n");
+    let fine = fine.replace("2}]", "2},]");
+    expect_ok(fixture.load("fine.json", &fine));
 }
 
 #[test]
@@ -246,13 +307,71 @@ fn non_utf8_text_is_located() {
 // ---- warnings ------------------------------------------------------------------------------
 
 #[test]
-fn a_missing_obj_is_a_warning_and_the_mesh_is_omitted() {
+fn a_missing_obj_is_an_error_naming_the_path_tried() {
     let fixture = Fixture::new();
     let text = format!(
         "{{\"scene\": {{\n  {CAMERA_JSON},\n  \"shader\": [{{\"_name\": \"grey\", \"_type\": \"Lambertian\", \"diffuse\": \"0.5 0.5 0.5\"}}],\n  \"shape\": [\n    {{\"_type\": \"mesh\", \"shader\": {{\"_ref\": \"grey\"}},\n      \"file\": \"objFiles/missing.obj\"}}\n  ]\n}}}}\n"
     );
-    let loaded = expect_ok(fixture.load("scenes/mesh.json", &text));
-    let warning = warning(&loaded, "cannot read OBJ file `objFiles/missing.obj`");
+    let error = expect_error(fixture.load("scenes/mesh.json", &text));
+    let tried = fixture.directory.path().join("scenes/objFiles/missing.obj");
+    assert_eq!(
+        error.message,
+        format!(
+            "cannot read mesh `objFiles/missing.obj` (tried {}): No such file or directory",
+            tried.display()
+        )
+    );
+    assert_eq!(
+        error.path,
+        fixture.directory.path().join("scenes/mesh.json")
+    );
+    assert_eq!(at(&error), (6, 15));
+}
+
+#[test]
+fn every_unreadable_file_of_a_load_is_reported_together() {
+    let fixture = Fixture::new();
+    let text = format!(
+        "{{\"scene\": {{\n  {CAMERA_JSON},\n  \"texture\": [{{\"_name\": \"wood\", \"_type\": \"image\", \"sourcefile\": \"images/wood.png\"}}],\n  \"shader\": [{{\"_name\": \"grey\", \"_type\": \"Lambertian\", \"diffuse\": {{\"tex\": \"wood\"}}}}],\n  \"shape\": [{{\"_type\": \"mesh\", \"shader\": {{\"_ref\": \"grey\"}}, \"file\": \"a.obj\"}}],\n  \"envMapPrefix\": \"sky/reef_\"\n}}}}\n"
+    );
+    let error = fixture
+        .load("all.json", &text)
+        .expect_err("three files are missing");
+    let found: Vec<(u32, u32, &str)> = error
+        .diagnostics()
+        .iter()
+        .map(|d| (d.line, d.column, d.message.split(" (tried").next().unwrap()))
+        .collect();
+    assert_eq!(
+        found,
+        vec![
+            (3, 65, "cannot read texture image `images/wood.png`"),
+            (5, 67, "cannot read mesh `a.obj`"),
+            (
+                6,
+                19,
+                "cannot read environment-map face `sky/reef_posX.png`"
+            ),
+        ],
+        "{error}"
+    );
+    assert!(error
+        .diagnostics()
+        .iter()
+        .all(|d| d.severity == Severity::Error));
+    // Shown one after the other, each located.
+    let shown = error.to_string();
+    assert_eq!(shown.matches(": error: cannot read").count(), 3, "{shown}");
+}
+
+#[test]
+fn allowing_missing_files_warns_and_omits_the_mesh() {
+    let fixture = Fixture::new();
+    let text = format!(
+        "{{\"scene\": {{\n  {CAMERA_JSON},\n  \"shader\": [{{\"_name\": \"grey\", \"_type\": \"Lambertian\", \"diffuse\": \"0.5 0.5 0.5\"}}],\n  \"shape\": [\n    {{\"_type\": \"mesh\", \"shader\": {{\"_ref\": \"grey\"}},\n      \"file\": \"objFiles/missing.obj\"}}\n  ]\n}}}}\n"
+    );
+    let loaded = expect_ok(fixture.load_allowing_missing("scenes/mesh.json", &text));
+    let warning = warning(&loaded, "cannot read mesh `objFiles/missing.obj`");
     assert_eq!(warning.severity, Severity::Warning);
     assert_eq!(
         warning.path,
@@ -330,12 +449,21 @@ fn dangling_references_fall_back_visibly() {
 }
 
 #[test]
-fn a_missing_texture_leaves_the_plain_colour() {
+fn a_missing_texture_is_an_error_or_if_allowed_leaves_the_plain_colour() {
     let fixture = Fixture::new();
     let text = format!(
         "{{\"scene\": {{\n  {CAMERA_JSON},\n  \"texture\": [{{\"_name\": \"wood\", \"_type\": \"image\",\n    \"sourcefile\": \"images/wood.png\"}}],\n  \"shader\": [\n    {{\"_name\": \"a\", \"_type\": \"Lambertian\", \"diffuse\": {{\"tex\": \"wood\", \"data\": \"0.5 0.5 0.5\"}}}},\n    {{\"_name\": \"b\", \"_type\": \"Lambertian\", \"diffuse\": {{\"tex\": \"stone\"}}}}\n  ]\n}}}}\n"
     );
-    let loaded = expect_ok(fixture.load("texture.json", &text));
+    let error = expect_error(fixture.load("texture.json", &text));
+    assert_eq!(at(&error), (4, 19));
+    assert!(
+        error.message.starts_with(&format!(
+            "cannot read texture image `images/wood.png` (tried {}): ",
+            fixture.directory.path().join("images/wood.png").display()
+        )),
+        "{error}"
+    );
+    let loaded = expect_ok(fixture.load_allowing_missing("texture.json", &text));
     assert_eq!(
         at(warning(
             &loaded,
@@ -625,10 +753,23 @@ fn truncated_scenes_never_panic() {
   "shape": [{{"_type": "instance", "_id": "e", "transform": {{"translate": "1 1 1", "rotate": [{{"_axis": "X", "_angle": 5}}]}}}}]
 }}}}"#
     );
+    // `x.png` is not there: the fallback's path is walked too.
+    let limits = Limits {
+        allow_missing_assets: true,
+        ..Limits::default()
+    };
+    let load = |text: &str, name: &str| {
+        glint_io::load_scene_with_assets_limited(
+            text,
+            Path::new(name),
+            &glint_io::FileSystem,
+            &limits,
+        )
+    };
     for (text, name) in [(xml.as_str(), "cut.xml"), (json.as_str(), "cut.json")] {
-        expect_ok(load_scene_from_text(text, Path::new(name)));
+        expect_ok(load(text, name));
         for end in (0..text.len()).filter(|&end| text.is_char_boundary(end)) {
-            if let Err(error) = load_scene_from_text(&text[..end], Path::new(name)) {
+            if let Err(error) = load(&text[..end], name) {
                 let diagnostic = error.diagnostic().expect("a located error");
                 assert!(diagnostic.line >= 1 && diagnostic.column >= 1);
             }

@@ -21,14 +21,16 @@ fn loads_or_is_located(text: &str, name: &str) {
         &Limits::default(),
     ) {
         Ok(_) => {}
-        Err(SceneError::Invalid(diagnostic)) => {
+        Err(error @ (SceneError::Invalid(_) | SceneError::Several(_))) => {
             let lines = text.lines().count() as u32 + 1;
-            assert!(
-                diagnostic.line >= 1 && diagnostic.line <= lines && diagnostic.column >= 1,
-                "error outside the text: {diagnostic}"
-            );
-            // Rendering the message walks to the column in its line: the panic was there.
-            assert!(!diagnostic.to_string().is_empty());
+            for diagnostic in error.diagnostics() {
+                assert!(
+                    diagnostic.line >= 1 && diagnostic.line <= lines && diagnostic.column >= 1,
+                    "error outside the text: {diagnostic}"
+                );
+                // Rendering the message walks to the column in its line: the panic was there.
+                assert!(!diagnostic.to_string().is_empty());
+            }
         }
         Err(error) => panic!("a non-located error: {error}"),
     }

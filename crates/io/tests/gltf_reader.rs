@@ -659,6 +659,7 @@ fn mutated_models_never_panic_and_errors_stay_located() {
         max_texture_side: 1024,
         max_texture_bytes: 64 << 20,
         max_memory: 256 << 20,
+        allow_missing_assets: false,
     };
     let mut state = 0x9e37_79b9_7f4a_7c15u64;
     let mut next = || {
@@ -703,7 +704,11 @@ fn mutated_models_never_panic_and_errors_stay_located() {
                     loaded += 1;
                     let _ = glint_render::Scene::new(l.parts);
                 }
-                Err(SceneError::Invalid(d)) => assert!(d.line >= 1 && d.column >= 1),
+                Err(e @ (SceneError::Invalid(_) | SceneError::Several(_))) => {
+                    for d in e.diagnostics() {
+                        assert!(d.line >= 1 && d.column >= 1);
+                    }
+                }
                 Err(e) => panic!("{file}: unlocated error {e}"),
             }
         }

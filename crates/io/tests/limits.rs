@@ -232,8 +232,8 @@ fn spoilt_png(width: u32, height: u32) -> Vec<u8> {
 }
 
 /// The texture images are read ahead and decoded in parallel; what the load reports is what
-/// reading and decoding each one when a shader first names it gives: the warnings in that
-/// order (a failed decode's before those of the shaders after it), the images numbered in that
+/// reading and decoding each one when a shader first names it gives: the errors (or, allowed,
+/// the warnings) in that order (a failed decode's before those of the shaders after it), the images numbered in that
 /// order without the failed ones, each colour with its own texture.
 #[test]
 fn textures_are_reported_and_numbered_in_the_order_shaders_name_them() {
@@ -255,7 +255,22 @@ fn textures_are_reported_and_numbered_in_the_order_shaders_name_them() {
          <specular tex=\"td\">1 1 1</specular></shader>\n\
          <shape type=\"sphere\"><shader ref=\"s0\"/></shape>\n</scene>\n"
     );
-    let loaded = load(&scene, &assets, &Limits::default()).unwrap();
+    // By default the two images that cannot be read are errors, reported in that order.
+    let error = load(&scene, &assets, &Limits::default()).unwrap_err();
+    let errors: Vec<(u32, &str)> = error
+        .diagnostics()
+        .iter()
+        .map(|d| (d.line, d.message.as_str()))
+        .collect();
+    assert_eq!(errors.len(), 2, "{error}");
+    assert!(errors[0].0 == 5 && errors[0].1.contains("b.png"), "{error}");
+    assert!(errors[1].0 == 4 && errors[1].1.contains("c.png"), "{error}");
+    // Allowed, as the course renderer had it: warnings, and the plain colours.
+    let lenient = Limits {
+        allow_missing_assets: true,
+        ..Limits::default()
+    };
+    let loaded = load(&scene, &assets, &lenient).unwrap();
     let warnings: Vec<(u32, &str)> = loaded
         .warnings
         .iter()

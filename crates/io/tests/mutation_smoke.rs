@@ -176,15 +176,17 @@ fn try_mutant(
     .map_err(|_| "loading panicked".to_owned())?;
     let loaded = match result {
         Ok(loaded) => loaded,
-        Err(SceneError::Invalid(diagnostic)) => {
+        Err(error @ (SceneError::Invalid(_) | SceneError::Several(_))) => {
             outcome.refused += 1;
             let lines = text.lines().count() as u32 + 1;
-            if diagnostic.path != path
-                || diagnostic.line == 0
-                || diagnostic.line > lines
-                || diagnostic.column == 0
-            {
-                return Err(format!("error outside the file: {diagnostic}"));
+            for diagnostic in error.diagnostics() {
+                if diagnostic.path != path
+                    || diagnostic.line == 0
+                    || diagnostic.line > lines
+                    || diagnostic.column == 0
+                {
+                    return Err(format!("error outside the file: {diagnostic}"));
+                }
             }
             return Ok(());
         }

@@ -958,7 +958,7 @@ impl<'a, 't> Builder<'a, 't> {
                 }
             }
             gltf::image::Source::Uri { uri, .. } => {
-                super::read_uri(uri, self.folder, self.assets, self.limits)
+                super::read_uri(uri, self.folder, self.assets, self.limits, "image")
                     .map_err(|message| self.error(&format!("{at}.uri"), message))?
             }
         };

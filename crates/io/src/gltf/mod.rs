@@ -18,7 +18,7 @@ use base64::Engine as _;
 
 use crate::assets::{Assets, TooLarge};
 use crate::desc::Span;
-use crate::diagnostic::{Diagnostics, SceneError};
+use crate::diagnostic::{Diagnostic, Diagnostics, SceneError};
 use crate::limits::{format_bytes, Limits};
 use crate::LoadedScene;
 
@@ -350,6 +350,8 @@ fn load_buffers(
     diagnostics: &Diagnostics,
 ) -> Result<Vec<Vec<u8>>, SceneError> {
     let mut buffers = Vec::with_capacity(document.buffers().len());
+    // Every buffer file that cannot be read is reported, not only the first.
+    let mut unread: Vec<Diagnostic> = Vec::new();
     for buffer in document.buffers() {
         let at = format!("buffers[{}]", buffer.index());
         let error = |field: &str, message: String| {
@@ -373,9 +375,15 @@ fn load_buffers(
                 })?
                 .to_vec()
             }
-            gltf::buffer::Source::Uri(uri) => {
-                read_uri(uri, folder, assets, limits).map_err(|message| error(".uri", message))?
-            }
+            gltf::buffer::Source::Uri(uri) => match read_uri(uri, folder, assets, limits, "buffer")
+            {
+                Ok(bytes) => bytes,
+                Err(message) => {
+                    unread.extend_from_slice(error(".uri", message).diagnostics());
+                    buffers.push(Vec::new());
+                    continue;
+                }
+            },
         };
         if bytes.len() < buffer.length() {
             return Err(error(
@@ -389,16 +397,21 @@ fn load_buffers(
         }
         buffers.push(bytes);
     }
+    if !unread.is_empty() {
+        return Err(SceneError::gathered(unread, None));
+    }
     Ok(buffers)
 }
 
 /// The bytes a buffer's or an image's `uri` names: a base64 `data:` URI, or a file beside
-/// the model or below its folder (never above it, never absolute, never another scheme).
+/// the model or below its folder (never above it, never absolute, never another scheme);
+/// `what` it is ("buffer", "image") names it in messages.
 pub(crate) fn read_uri(
     uri: &str,
     folder: &Path,
     assets: &dyn Assets,
     limits: &Limits,
+    what: &str,
 ) -> Result<Vec<u8>, String> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let Some((header, payload)) = rest.split_once(',') else {
@@ -432,7 +445,11 @@ pub(crate) fn read_uri(
             Some(too_large) => {
                 format!("{} {too_large} (--max-file-size raises it)", path.display())
             }
-            None => format!("cannot read {}: {error}", path.display()),
+            None => format!(
+                "cannot read {what} `{uri}` (tried {}): {}",
+                assets.tried(&path).display(),
+                crate::assets::reason(&error)
+            ),
         })
 }
 
@@ -521,6 +538,7 @@ mod tests {
             folder,
             &assets,
             &limits,
+            "buffer",
         )
         .unwrap();
         assert_eq!(bytes, [0, 1, 2, 3]);
@@ -528,9 +546,10 @@ mod tests {
             max_file_bytes: 2,
             ..Limits::default()
         };
-        let error = read_uri("data:;base64,AAECAwQF", folder, &assets, &small).unwrap_err();
+        let error =
+            read_uri("data:;base64,AAECAwQF", folder, &assets, &small, "buffer").unwrap_err();
         assert!(error.contains("more than the limit"), "{error}");
-        assert!(read_uri("data:text/plain,hello", folder, &assets, &limits).is_err());
-        assert!(read_uri("data:;base64,@@@@", folder, &assets, &limits).is_err());
+        assert!(read_uri("data:text/plain,hello", folder, &assets, &limits, "buffer").is_err());
+        assert!(read_uri("data:;base64,@@@@", folder, &assets, &limits, "buffer").is_err());
     }
 }

@@ -853,7 +853,7 @@ impl<'a> Builder<'a> {
             } => color(spectrum::spectrum_to_rgb(wavelengths, values, role)),
             Spectrum::File(name) => {
                 let path = self.find(name);
-                let bytes = self.read(&path, file, span, name)?;
+                let bytes = self.read(&path, file, span, name, "spectrum file")?;
                 let text = String::from_utf8(bytes)
                     .map_err(|_| self.error(file, span, format!("\"{name}\" is not text")))?;
                 let (wavelengths, values) = spectrum::parse_spd(&text)
@@ -877,26 +877,64 @@ impl<'a> Builder<'a> {
             .unwrap_or_else(|| self.files.folder(0).join(name))
     }
 
+    /// The bytes of the file `name` (found at `path`), a `what` ("a spectrum file") of the
+    /// element at `span`: an error naming both when it cannot be read.
     fn read(
         &self,
         path: &Path,
         file: usize,
         span: Span,
         name: &str,
+        what: &str,
     ) -> Result<Vec<u8>, SceneError> {
         self.assets
             .read_at_most(path, self.limits.max_file_bytes)
-            .map_err(|error| {
-                let why = match TooLarge::of(&error) {
-                    Some(too_large) => format!("{too_large} (--max-file-size raises it)"),
-                    None => error.to_string(),
-                };
-                self.error(
-                    file,
-                    span,
-                    format!("cannot read \"{name}\" ({}): {why}", path.display()),
-                )
-            })
+            .map_err(|error| self.error(file, span, self.unread(path, name, what, &error)))
+    }
+
+    /// Why `name` (a `what`, tried at `path`) could not be read, for a message.
+    fn unread(&self, path: &Path, name: &str, what: &str, error: &std::io::Error) -> String {
+        let tried = self.assets.tried(path);
+        match TooLarge::of(error) {
+            Some(too_large) => format!(
+                "cannot read {what} `{name}` (tried {}): {too_large} (--max-file-size raises it)",
+                tried.display()
+            ),
+            None => format!(
+                "cannot read {what} `{name}` (tried {}): {}",
+                tried.display(),
+                crate::assets::reason(error)
+            ),
+        }
+    }
+
+    /// The bytes of a shape's mesh file, or `None` when it cannot be read: an error that lets
+    /// the load go on to find the others (`Files::error_later`), or with
+    /// `allow_missing_assets` a warning, the shape left out. A file over the size limit stops
+    /// the load.
+    fn read_mesh(
+        &mut self,
+        path: &Path,
+        file: usize,
+        span: Span,
+        name: &str,
+    ) -> Result<Option<Vec<u8>>, SceneError> {
+        match self.assets.read_at_most(path, self.limits.max_file_bytes) {
+            Ok(bytes) => Ok(Some(bytes)),
+            Err(error) if TooLarge::of(&error).is_some() => {
+                Err(self.error(file, span, self.unread(path, name, "mesh", &error)))
+            }
+            Err(error) => {
+                let message = self.unread(path, name, "mesh", &error);
+                if self.limits.allow_missing_assets {
+                    self.files
+                        .warn(file, span, format!("{message}; the shape is omitted"));
+                } else {
+                    self.files.error_later(file, span, message);
+                }
+                Ok(None)
+            }
+        }
     }
 
     /// An image file as linear RGB, loaded once per path (and `raw`), in
@@ -906,37 +944,53 @@ impl<'a> Builder<'a> {
         if let Some(&index) = self.images.get(&(path.clone(), raw)) {
             return Ok(index);
         }
-        let image = self.load_linear(name, raw, file, span)?;
+        let image = self.load_linear(name, raw, file, span, "texture image")?;
         self.parts.textures.push(image);
         let index = (self.parts.textures.len() - 1) as u32;
         self.images.insert((path, raw), index);
         Ok(index)
     }
 
-    /// An image file as linear RGB: 8-bit images sRGB-decoded unless `raw`.
+    /// An image file as linear RGB: 8-bit images sRGB-decoded unless `raw`; `what` it is
+    /// ("texture image") names it in messages.
     fn load_linear(
         &mut self,
         name: &str,
         raw: bool,
         file: usize,
         span: Span,
+        what: &str,
     ) -> Result<Image, SceneError> {
         let path = self.find(name);
-        read_image(&path, self.assets, &mut self.budget)
+        let tried = self.assets.tried(&path);
+        match read_image(&path, self.assets, &mut self.budget)
             .and_then(|checked| checked.decode_srgb(raw))
-            .map_err(|error| {
-                let why = match error {
-                    AssetError::Refused(why) | AssetError::Failed(why) => why,
-                };
-                self.error(
+        {
+            Ok(image) => Ok(image),
+            Err(AssetError::Refused(why)) => Err(self.error(
+                file,
+                span,
+                format!("{what} `{name}` ({}) is refused: {why}", tried.display()),
+            )),
+            // An error, whatever `allow_missing_assets` says: a texture may be a normal map
+            // or a mask, and no stand-in is right for every role. The load goes on, with a
+            // black texel in its place, to report every file it cannot read.
+            Err(AssetError::Failed(why)) => {
+                self.files.error_later(
                     file,
                     span,
                     format!(
-                        "cannot load the image \"{name}\" ({}): {why}",
-                        path.display()
+                        "cannot read {what} `{name}` (tried {}): {why}",
+                        tried.display()
                     ),
-                )
-            })
+                );
+                Ok(Image {
+                    width: 1,
+                    height: 1,
+                    texels: vec![Color::splat(0.0)],
+                })
+            }
+        }
     }
 
     // ---- textures ----------------------------------------------------------------------
@@ -1739,7 +1793,9 @@ impl<'a> Builder<'a> {
                 let face_normals = props.boolean(self.files, "face_normals", false)?;
                 let flip_tex = props.boolean(self.files, "flip_tex_coords", plugin == "obj")?;
                 let path = self.find(&name);
-                let bytes = self.read(&path, file, span, &name)?;
+                let Some(bytes) = self.read_mesh(&path, file, span, &name)? else {
+                    return Ok(Vec::new());
+                };
                 let mut mesh = if plugin == "obj" {
                     meshes::read_obj(&bytes, self.limits.max_triangles)
                 } else {
@@ -1853,7 +1909,9 @@ impl<'a> Builder<'a> {
                 })?;
                 let face_normals = props.boolean(self.files, "face_normals", false)?;
                 let path = self.find(&name);
-                let bytes = self.read(&path, file, span, &name)?;
+                let Some(bytes) = self.read_mesh(&path, file, span, &name)? else {
+                    return Ok(Vec::new());
+                };
                 let shape = serialized::read_serialized(&bytes, index, self.limits)
                     .map_err(|e| self.shape_file_error(element, &name, &path, &e))?;
                 // Mitsuba 3 skips the file's colours and ignores its face-normals flag: the
@@ -1886,7 +1944,7 @@ impl<'a> Builder<'a> {
                     }
                 }
                 let path = self.find(&name);
-                let bytes = self.read(&path, file, span, &name)?;
+                let bytes = self.read(&path, file, span, &name, "SDF grid")?;
                 let mesh = sdfgrid::read_sdfgrid(&bytes, self.limits)
                     .map_err(|e| self.shape_file_error(element, &name, &path, &e))?;
                 (None, Some(TriMesh::from_shape(mesh)), to_world)
@@ -2261,7 +2319,7 @@ impl<'a> Builder<'a> {
                     let (file, span) = (p.file, p.span);
                     self.files.warn(file, span, "`mis_compensation` is ignored");
                 }
-                let image = self.load_linear(&name, false, file, span)?;
+                let image = self.load_linear(&name, false, file, span, "environment map")?;
                 let m = to_world.unwrap_or(Matrix4::IDENTITY);
                 let background = Background::Environment {
                     image: Box::new(image),

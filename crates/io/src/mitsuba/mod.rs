@@ -36,6 +36,9 @@ pub(crate) struct Files {
     /// Warnings past `MAX_KEPT_WARNINGS`, counted only, and where the last was.
     dropped: usize,
     last_dropped: (usize, Span),
+    /// Errors that did not stop the load at once (files that cannot be read), so that one
+    /// load reports all of them.
+    errors: Vec<Diagnostic>,
 }
 
 impl Files {
@@ -46,6 +49,7 @@ impl Files {
             seen: HashSet::new(),
             dropped: 0,
             last_dropped: (0, Span::default()),
+            errors: Vec::new(),
         }
     }
 
@@ -74,6 +78,22 @@ impl Files {
     pub fn error(&self, file: usize, span: Span, message: impl Into<String>) -> SceneError {
         let (path, text) = &self.files[file];
         Diagnostics::new(path, text).error(span, message)
+    }
+
+    /// An error that does not stop the load at once: the load goes on, to find the others,
+    /// and fails with all of them at its end.
+    pub fn error_later(&mut self, file: usize, span: Span, message: impl Into<String>) {
+        if let SceneError::Invalid(diagnostic) = self.error(file, span, message) {
+            self.errors.push(diagnostic);
+        }
+    }
+
+    /// `error`, the one that stopped the load, after the errors met before it.
+    fn stopped(&mut self, error: SceneError) -> SceneError {
+        if self.errors.is_empty() {
+            return error;
+        }
+        SceneError::gathered(std::mem::take(&mut self.errors), Some(error))
     }
 
     pub fn warn(&mut self, file: usize, span: Span, message: impl Into<String>) {
@@ -159,7 +179,11 @@ pub(crate) fn load(
 ) -> Result<LoadedScene, SceneError> {
     let mut files = Files::new(path, text);
     let parsed = parse::parse(&mut files, defines, assets, limits)?;
-    let parts = build::build(&parsed, &mut files, assets, limits)?;
+    let parts =
+        build::build(&parsed, &mut files, assets, limits).map_err(|error| files.stopped(error))?;
+    if !files.errors.is_empty() {
+        return Err(SceneError::gathered(files.errors, None));
+    }
     Ok(LoadedScene {
         parts,
         warnings: files.into_warnings(),

@@ -336,7 +336,7 @@ impl<'a> super::Builder<'a> {
                 }
                 props.check_all_used(self.files)?;
                 let path = self.find(&name);
-                let bytes = self.read(&path, file, span, &name)?;
+                let bytes = self.read(&path, file, span, &name, "volume grid")?;
                 let cannot = |why: String| {
                     self.error(
                         file,
