@@ -517,7 +517,16 @@ fn located_exception<'py, T: pyo3::PyTypeInfo>(
     py: Python<'py>,
     diagnostic: &Diagnostic,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let exception = py.get_type::<T>().call1((located(diagnostic),))?;
+    located_exception_with_text::<T>(py, diagnostic, located(diagnostic))
+}
+
+/// `located_exception` with its own text: several diagnostics' at once, located at the first.
+fn located_exception_with_text<'py, T: pyo3::PyTypeInfo>(
+    py: Python<'py>,
+    diagnostic: &Diagnostic,
+    text: String,
+) -> PyResult<Bound<'py, PyAny>> {
+    let exception = py.get_type::<T>().call1((text,))?;
     exception.setattr("file", diagnostic.path.display().to_string())?;
     exception.setattr("line", diagnostic.line)?;
     exception.setattr("column", diagnostic.column)?;
@@ -549,6 +558,14 @@ fn scene_error(py: Python<'_>, error: glint_io::SceneError) -> PyErr {
         glint_io::SceneError::Io { path, source } => os_error(py, source, path, error.to_string()),
         glint_io::SceneError::Invalid(diagnostic) => {
             match located_exception::<SceneError>(py, diagnostic) {
+                Ok(exception) => PyErr::from_value(exception),
+                Err(failure) => failure,
+            }
+        }
+        // Every file the scene could not read: located at the first, the text names them all.
+        glint_io::SceneError::Several(diagnostics) => {
+            let all: Vec<String> = diagnostics.iter().map(located).collect();
+            match located_exception_with_text::<SceneError>(py, &diagnostics[0], all.join("\n")) {
                 Ok(exception) => PyErr::from_value(exception),
                 Err(failure) => failure,
             }

@@ -129,6 +129,25 @@ def test_scene_errors_carry_file_line_column_and_the_cli_message(tmp_path):
     )
 
 
+def test_every_missing_asset_is_named_at_once(tmp_path):
+    path = tmp_path / "two.xml"
+    path.write_text(
+        "<scene>\n"
+        '  <shape type="mesh"><file>a.obj</file></shape>\n'
+        '  <shape type="mesh"><file>b.obj</file></shape>\n'
+        "</scene>\n"
+    )
+    with pytest.raises(glint.SceneError) as caught:
+        glint.load_scene(path)
+    error = caught.value
+    # Located at the first; the text names both, each with the path tried.
+    assert (error.file, error.line) == (str(path), 2)
+    text = str(error)
+    assert f"(tried {tmp_path / 'a.obj'})" in text
+    assert f"(tried {tmp_path / 'b.obj'})" in text
+    assert str(pickle.loads(pickle.dumps(error))) == text
+
+
 def test_text_and_dict_errors_point_into_the_text():
     with pytest.raises(glint.SceneError) as caught:
         glint.load_scene_text('{"scene": {\n  "bgColor": "1 2"\n}}', base_dir="assets")

@@ -359,9 +359,14 @@ impl Loaded {
                     original: None,
                 }
             }
-            Err(SceneError::Invalid(diagnostic)) => Loaded {
+            // One located error, or every file the scene could not read, each located.
+            Err(error @ (SceneError::Invalid(_) | SceneError::Several(_))) => Loaded {
                 scene: None,
-                messages: vec![Message::from_diagnostic(&diagnostic)],
+                messages: error
+                    .diagnostics()
+                    .iter()
+                    .map(Message::from_diagnostic)
+                    .collect(),
                 defaults: RenderDefaults::default(),
                 id: next_load(),
                 original: None,
