@@ -419,7 +419,7 @@ fn loose_files_are_found_by_their_base_name_with_a_note_and_two_are_an_error() {
     let tile = |loaded: &glint_wasm::Loaded| loaded.render_tile(&settings, 0, 0, 24, 18).unwrap();
     assert_eq!(tile(&loaded).pixels, tile(&whole).pixels);
 
-    // Two of that name and none at the path: an error naming both.
+    // Two of that name and none at the path: an error at the mesh's element naming both.
     let mut two = Files::new();
     two.add("a/pyramid.obj", read("objFiles/pyramid.obj"));
     two.add("b/pyramid.obj", read("objFiles/pyramid.obj"));
@@ -428,7 +428,8 @@ fn loose_files_are_found_by_their_base_name_with_a_note_and_two_are_an_error() {
     assert!(!ambiguous.ok());
     let error = &ambiguous.messages()[0].text;
     assert!(
-        error.starts_with("error: textured.xml: objFiles/pyramid.obj: 2 files named pyramid.obj")
+        error.starts_with("error: textured.xml:50:11: cannot read mesh `objFiles/pyramid.obj`")
+            && error.contains("2 files named pyramid.obj among the files given")
             && error.contains("(a/pyramid.obj, b/pyramid.obj)"),
         "{error}"
     );
