@@ -1128,7 +1128,7 @@ fn denoiser(pyoidn_library: Option<&Path>) -> Result<&'static Denoiser, DenoiseE
         return Ok(denoiser);
     }
     let variable = std::env::var_os(glint_denoise::LIBRARY_VARIABLE);
-    let pyoidn_library = pyoidn_library.filter(|_| !variable.is_some_and(|v| !v.is_empty()));
+    let pyoidn_library = pyoidn_library.filter(|_| variable.is_none_or(|v| v.is_empty()));
     let opened = match (Denoiser::open(), pyoidn_library) {
         (Err(DenoiseError::Unavailable(mut unavailable)), Some(library)) => {
             Denoiser::open_path(library).map_err(|error| match error {

@@ -132,7 +132,7 @@ def test_scene_errors_carry_file_line_column_and_the_cli_message(tmp_path):
 def test_every_missing_asset_is_named_at_once(tmp_path):
     path = tmp_path / "two.xml"
     path.write_text(
-        "<scene>\n"
+        '<scene><camera name="main" type="perspective"><position>0 0 5</position></camera>\n'
         '  <shape type="mesh"><file>a.obj</file></shape>\n'
         '  <shape type="mesh"><file>b.obj</file></shape>\n'
         "</scene>\n"
