@@ -5,7 +5,7 @@
 //! the CPU (the GPU kernel does not count rays).
 //!
 //! A `glint` built without the `gpu` feature has no wgpu: `--device gpu` is refused (exit 2)
-//! before the scene is read (`features::refuse_missing`).
+//! before the scene is read (`run::refuse_missing`).
 //!
 //! Exit statuses: 2 when the GPU path does not support what was asked (another integrator,
 //! or a scene whose buffers exceed what the adapter can bind), like any other unusable
@@ -56,7 +56,16 @@ fn quiet_display_probe_in(
     set("NODEVICE_SELECT", "1");
 }
 
-/// Without the `gpu` feature: never reached, since `features::refuse_missing` refuses
+/// The refusal of `--device gpu` without the `gpu` feature.
+pub fn missing_gpu() -> Failure {
+    Failure::Usage(crate::job::UsageError(crate::features::missing(
+        "the GPU back end",
+        "gpu",
+        "--device gpu needs",
+    )))
+}
+
+/// Without the `gpu` feature: never reached, since `run::refuse_missing` refuses
 /// `--device gpu` before the scene is read; refused the same way all the same.
 #[cfg(not(feature = "gpu"))]
 pub fn run(
@@ -66,7 +75,7 @@ pub fn run(
     _err: &mut dyn Write,
     _progress_bar: bool,
 ) -> Result<Summary, Failure> {
-    Err(crate::features::missing_gpu())
+    Err(missing_gpu())
 }
 
 /// Renders `parts` on the GPU and writes the image.

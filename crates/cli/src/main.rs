@@ -92,7 +92,7 @@ fn main() -> ExitCode {
         Ok(job) => job,
         Err(error) => return fail(&Failure::Usage(error)),
     };
-    if let Err(failure) = features::refuse_missing(&job) {
+    if let Err(failure) = run::refuse_missing(&job) {
         return fail(&failure);
     }
     if job.device == crate::args::DeviceArg::Gpu {

@@ -11,7 +11,7 @@
 //! the written PNG.
 //!
 //! Without the `preview` feature there is no window (no minifb): `-x`/`-y` are refused before
-//! the render (`features::refuse_missing`), and `Preview` cannot be made.
+//! the render (`run::refuse_missing`), and `Preview` cannot be made.
 
 // Without a window nothing reads the tiles the sink would carry.
 #![cfg_attr(not(feature = "preview"), allow(dead_code))]

@@ -583,3 +583,19 @@ fn tile_count(bounds: PixelBounds) -> u64 {
     let tile = glint_render::TILE_SIZE;
     u64::from(bounds.width().div_ceil(tile)) * u64::from(bounds.height().div_ceil(tile))
 }
+
+/// Refuses a render that asks for a part this build lacks: `--device gpu` without `gpu`,
+/// `-x`/`-y` without `preview`.
+pub fn refuse_missing(job: &Job) -> Result<(), Failure> {
+    if !cfg!(feature = "gpu") && job.device == DeviceArg::Gpu {
+        return Err(crate::gpu::missing_gpu());
+    }
+    if !cfg!(feature = "preview") && job.preview.is_some() {
+        return Err(Failure::Usage(UsageError(crate::features::missing(
+            "the preview window",
+            "preview",
+            "-x/-y need",
+        ))));
+    }
+    Ok(())
+}
