@@ -18,8 +18,8 @@ use std::time::Duration;
 use glint_denoise::{DenoiseError, Denoiser, Images, Options as DenoiseOptions};
 use glint_gpu::{GpuError, GpuRenderer};
 use glint_io::{
-    Diagnostic, DisplayTransform, FileSystem, ImageWriteError, Limits, LoadedScene, ModelOptions,
-    PngEncoding, ToneMap, Transfer, WriteOptions,
+    Diagnostic, FileSystem, ImageWriteError, Limits, LoadedScene, ModelOptions, PngEncoding,
+    ToneMap, Transfer, WriteOptions,
 };
 use glint_render::{
     Background, Color, Features, Film, IntegratorKind, PixelBounds, Progress, RenderDefaults,
@@ -1006,44 +1006,34 @@ fn png_encoding(
     tonemap: Option<&str>,
     transfer: Option<&str>,
 ) -> PyResult<PngEncoding> {
-    if exposure.is_none() && tonemap.is_none() && transfer.is_none() {
-        return Ok(match integrator {
-            Some(name) => PngEncoding::default_for(integrator_named(name)?),
-            None => PngEncoding::Course,
-        });
-    }
-    let defaults = DisplayTransform::default();
     if let Some(exposure) = exposure.filter(|ev| !(ev.is_finite() && ev.abs() <= 64.0)) {
         return Err(PyValueError::new_err(format!(
             "exposure must be between -64 and 64, got {exposure}"
         )));
     }
     let tone_map = match tonemap {
-        None => defaults.tone_map,
-        Some("clamp" | "none") => ToneMap::Clamp,
-        Some("aces") => ToneMap::Aces,
-        Some("agx") => ToneMap::Agx,
-        Some(other) => {
-            return Err(PyValueError::new_err(format!(
-                "tonemap must be one of clamp, none, aces, agx, got {other:?}"
-            )))
-        }
+        None => None,
+        Some(name) => Some(ToneMap::from_name(name).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "tonemap must be one of clamp, none, aces, agx, got {name:?}"
+            ))
+        })?),
     };
     let transfer = match transfer {
-        None => defaults.transfer,
-        Some("srgb") => Transfer::Srgb,
-        Some("linear") => Transfer::Linear,
-        Some(other) => {
-            return Err(PyValueError::new_err(format!(
-                "transfer must be one of srgb, linear, got {other:?}"
-            )))
-        }
+        None => None,
+        Some(name) => Some(Transfer::from_name(name).ok_or_else(|| {
+            PyValueError::new_err(format!(
+                "transfer must be one of srgb, linear, got {name:?}"
+            ))
+        })?),
     };
-    Ok(PngEncoding::Display(DisplayTransform {
-        exposure: exposure.unwrap_or(defaults.exposure),
-        tone_map,
-        transfer,
-    }))
+    let default = match integrator {
+        Some(name) => PngEncoding::default_for(integrator_named(name)?),
+        None => PngEncoding::Course,
+    };
+    Ok(PngEncoding::from_options(
+        default, exposure, tone_map, transfer,
+    ))
 }
 
 /// Writes an image with `glint_io::write_image_with`: `.png` (8-bit, encoded by

@@ -6,7 +6,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 use std::time::Duration;
 
-use glint_io::{DisplayTransform, PngEncoding, ToneMap, Transfer};
+use glint_io::{PngEncoding, ToneMap, Transfer};
 use glint_render::{
     AdaptiveSampling, Color, IntegratorKind, RenderDefaults, RenderSettings, RequestedSettings,
     SplitMethod,
@@ -401,22 +401,19 @@ pub fn png_encoding(
     tonemap: Option<ToneMapArg>,
     transfer: Option<TransferArg>,
 ) -> PngEncoding {
-    if exposure.is_none() && tonemap.is_none() && transfer.is_none() {
-        return PngEncoding::default_for(integrator);
-    }
-    let defaults = DisplayTransform::default();
-    PngEncoding::Display(DisplayTransform {
-        exposure: exposure.unwrap_or(defaults.exposure),
-        tone_map: tonemap.map_or(defaults.tone_map, |tonemap| match tonemap {
+    PngEncoding::from_options(
+        PngEncoding::default_for(integrator),
+        exposure,
+        tonemap.map(|tonemap| match tonemap {
             ToneMapArg::Clamp => ToneMap::Clamp,
             ToneMapArg::Aces => ToneMap::Aces,
             ToneMapArg::Agx => ToneMap::Agx,
         }),
-        transfer: transfer.map_or(defaults.transfer, |transfer| match transfer {
+        transfer.map(|transfer| match transfer {
             TransferArg::Srgb => Transfer::Srgb,
             TransferArg::Linear => Transfer::Linear,
         }),
-    })
+    )
 }
 
 /// Why `settings` cannot be rendered, if they cannot, in the flags' words: adaptive sampling
@@ -489,6 +486,7 @@ fn check_output_extension(output: &Path) -> Result<(), UsageError> {
 mod tests {
     use super::*;
     use clap::Parser;
+    use glint_io::DisplayTransform;
 
     use crate::machine::default_max_memory;
 

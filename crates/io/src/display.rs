@@ -34,6 +34,27 @@ impl PngEncoding {
             }
         }
     }
+
+    /// The PNG the user's display options ask for, the one rule of every front end (the CLI's
+    /// `--exposure`, `--tonemap`, `--transfer`, the page's and Python's): none given keeps
+    /// `default` (the integrator's own, `default_for`); any given turns the display transform
+    /// on, the others at `DisplayTransform`'s defaults.
+    pub fn from_options(
+        default: PngEncoding,
+        exposure: Option<f32>,
+        tone_map: Option<ToneMap>,
+        transfer: Option<Transfer>,
+    ) -> PngEncoding {
+        if exposure.is_none() && tone_map.is_none() && transfer.is_none() {
+            return default;
+        }
+        let defaults = DisplayTransform::default();
+        PngEncoding::Display(DisplayTransform {
+            exposure: exposure.unwrap_or(defaults.exposure),
+            tone_map: tone_map.unwrap_or(defaults.tone_map),
+            transfer: transfer.unwrap_or(defaults.transfer),
+        })
+    }
 }
 
 /// Exposure, tone curve and transfer function, applied in that order.
@@ -74,6 +95,21 @@ pub enum ToneMap {
     Agx,
 }
 
+impl ToneMap {
+    /// The names a front end accepts, as `--tonemap` takes them (`none` is `clamp`).
+    pub const NAMES: [&'static str; 4] = ["clamp", "none", "aces", "agx"];
+
+    /// The curve `name` stands for (one of `NAMES`).
+    pub fn from_name(name: &str) -> Option<ToneMap> {
+        match name {
+            "clamp" | "none" => Some(ToneMap::Clamp),
+            "aces" => Some(ToneMap::Aces),
+            "agx" => Some(ToneMap::Agx),
+            _ => None,
+        }
+    }
+}
+
 /// The transfer function (opto-electronic) from linear display values to code values.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Transfer {
@@ -82,6 +118,20 @@ pub enum Transfer {
     Srgb,
     /// None: code value = linear value (as the course writes its images).
     Linear,
+}
+
+impl Transfer {
+    /// The names a front end accepts, as `--transfer` takes them.
+    pub const NAMES: [&'static str; 2] = ["srgb", "linear"];
+
+    /// The function `name` stands for (one of `NAMES`).
+    pub fn from_name(name: &str) -> Option<Transfer> {
+        match name {
+            "srgb" => Some(Transfer::Srgb),
+            "linear" => Some(Transfer::Linear),
+            _ => None,
+        }
+    }
 }
 
 /// The tEXt keyword under which a PNG names its transform in words.
@@ -295,6 +345,46 @@ fn agx(color: Color) -> Color {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn display_options_turn_the_transform_on_with_defaults_for_the_rest() {
+        let course = PngEncoding::Course;
+        assert_eq!(PngEncoding::from_options(course, None, None, None), course);
+        let only_agx = PngEncoding::from_options(course, None, Some(ToneMap::Agx), None);
+        assert_eq!(
+            only_agx,
+            PngEncoding::Display(DisplayTransform {
+                tone_map: ToneMap::Agx,
+                ..DisplayTransform::default()
+            })
+        );
+        let exposed = PngEncoding::from_options(course, Some(1.5), None, Some(Transfer::Linear));
+        assert_eq!(
+            exposed,
+            PngEncoding::Display(DisplayTransform {
+                exposure: 1.5,
+                tone_map: ToneMap::Clamp,
+                transfer: Transfer::Linear,
+            })
+        );
+    }
+
+    #[test]
+    fn every_name_is_read_and_others_are_not() {
+        let curves: Vec<_> = ToneMap::NAMES
+            .iter()
+            .map(|n| ToneMap::from_name(n))
+            .collect();
+        let expected = [ToneMap::Clamp, ToneMap::Clamp, ToneMap::Aces, ToneMap::Agx];
+        assert_eq!(curves, expected.map(Some));
+        let functions: Vec<_> = Transfer::NAMES
+            .iter()
+            .map(|n| Transfer::from_name(n))
+            .collect();
+        assert_eq!(functions, [Some(Transfer::Srgb), Some(Transfer::Linear)]);
+        assert_eq!(ToneMap::from_name("ACES"), None);
+        assert_eq!(Transfer::from_name("gamma"), None);
+    }
 
     fn grey(v: f32) -> Color {
         Color::splat(v)

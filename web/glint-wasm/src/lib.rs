@@ -33,8 +33,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use glint_io::{
-    Assets, Diagnostic, DisplayTransform, Limits, LoadedScene, MemoryAssets, ModelOptions,
-    OutputFormat, PngEncoding, SceneError, Severity, ToneMap, Transfer, WriteOptions,
+    Assets, Diagnostic, Limits, LoadedScene, MemoryAssets, ModelOptions, OutputFormat, PngEncoding,
+    SceneError, Severity, ToneMap, Transfer, WriteOptions,
 };
 use glint_render::{
     Background, Camera, Color, Features, Film, IntegratorKind, PixelBounds, ProgressiveRender,
@@ -502,46 +502,31 @@ impl Settings {
         tonemap: Option<String>,
         transfer: Option<String>,
     ) -> Result<(), String> {
-        if exposure.is_none() && tonemap.is_none() && transfer.is_none() {
-            self.png = PngEncoding::default_for(self.render.integrator);
-            return Ok(());
+        if let Some(ev) = exposure.filter(|ev| !ev.is_finite() || ev.abs() > 64.0) {
+            return Err(format!(
+                "exposure: the exposure must be a number of stops between -64 and 64, got {ev}"
+            ));
         }
-        let defaults = DisplayTransform::default();
-        let exposure = match exposure {
-            Some(ev) if !ev.is_finite() || ev.abs() > 64.0 => {
-                return Err(format!(
-                    "exposure: the exposure must be a number of stops between -64 and 64, got {ev}"
-                ))
-            }
-            Some(ev) => ev,
-            None => defaults.exposure,
-        };
-        let tone_map = match tonemap.as_deref() {
-            None => defaults.tone_map,
-            Some("clamp" | "none") => ToneMap::Clamp,
-            Some("aces") => ToneMap::Aces,
-            Some("agx") => ToneMap::Agx,
-            Some(other) => {
-                return Err(format!(
-                    "tone map: unknown curve `{other}` (clamp, aces or agx)"
-                ))
-            }
-        };
-        let transfer = match transfer.as_deref() {
-            None => defaults.transfer,
-            Some("srgb") => Transfer::Srgb,
-            Some("linear") => Transfer::Linear,
-            Some(other) => {
-                return Err(format!(
-                    "transfer: unknown function `{other}` (srgb or linear)"
-                ))
-            }
-        };
-        self.png = PngEncoding::Display(DisplayTransform {
+        let tone_map =
+            match tonemap.as_deref() {
+                None => None,
+                Some(name) => Some(ToneMap::from_name(name).ok_or_else(|| {
+                    format!("tone map: unknown curve `{name}` (clamp, aces or agx)")
+                })?),
+            };
+        let transfer =
+            match transfer.as_deref() {
+                None => None,
+                Some(name) => Some(Transfer::from_name(name).ok_or_else(|| {
+                    format!("transfer: unknown function `{name}` (srgb or linear)")
+                })?),
+            };
+        self.png = PngEncoding::from_options(
+            PngEncoding::default_for(self.render.integrator),
             exposure,
             tone_map,
             transfer,
-        });
+        );
         Ok(())
     }
 
