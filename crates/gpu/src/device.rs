@@ -114,6 +114,7 @@ impl GpuRenderer {
         }];
         entries.extend((1..=6).map(|binding| storage_entry(binding, true)));
         entries.push(storage_entry(7, false));
+        entries.push(storage_entry(8, true));
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("glint scene"),
             entries: &entries,
@@ -225,6 +226,7 @@ impl GpuRenderer {
         let lights = storage("lights", bytemuck::cast_slice(&flat.lights), none)?;
         let tables = storage("tables", bytemuck::cast_slice(&flat.tables), none)?;
         let texels = storage("texels", bytemuck::cast_slice(&flat.texels), none)?;
+        let physical = storage("physical", bytemuck::cast_slice(&flat.physical), none)?;
         let accum_bytes = vec![0u8; pixels as usize * ACCUM_BYTES_PER_PIXEL];
         let accum = storage("accumulation", &accum_bytes, wgpu::BufferUsages::COPY_SRC)?;
         let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
@@ -245,6 +247,7 @@ impl GpuRenderer {
                 (5, &tables),
                 (6, &texels),
                 (7, &accum),
+                (8, &physical),
             ]
             .map(|(binding, buffer)| wgpu::BindGroupEntry {
                 binding,

@@ -113,11 +113,21 @@ pub struct Params {
     /// The top-level BVH's root node.
     pub tlas_root: u32,
     pub pad: u32,
+    pub bsdf_index: u32,
+    pub texture_nodes: u32,
+    /// Bit 0: `RENDER_HIDE_EMITTERS`.
+    pub render_flags: u32,
+    /// `FILTER_*`, and its radius or standard deviation (f32 bits).
+    pub filter_kind: u32,
+    pub filter_param: u32,
+    pub pad2: [u32; 3],
     pub camera_position: [f32; 4],
     pub camera_u: [f32; 4],
     pub camera_v: [f32; 4],
     pub camera_w: [f32; 4],
     pub background: [f32; 4],
+    /// The thin lens: aperture radius, focus distance (zero: a pinhole).
+    pub lens: [f32; 4],
 }
 
 /// The flattened scene: the buffers' contents and the scene-dependent part of `Params`
@@ -130,6 +140,8 @@ pub struct FlatScene {
     pub lights: Vec<[f32; 4]>,
     pub tables: Vec<f32>,
     pub texels: Vec<[f32; 4]>,
+    /// Physically based materials: BSDF nodes, texture nodes, mesh attributes.
+    pub physical: Vec<[f32; 4]>,
     pub params: Params,
 }
 
@@ -343,11 +355,18 @@ impl FlatScene {
             canary: 2,
             tlas_root: tlas_root as u32,
             pad: 0,
+            bsdf_index: 0,
+            texture_nodes: 0,
+            render_flags: 0,
+            filter_kind: 0,
+            filter_param: 0,
+            pad2: [0; 3],
             camera_position: v4(camera.position, 0.0),
             camera_u: v4(camera.basis.u, camera.focal_length),
             camera_v: v4(camera.basis.v, camera.image_plane_width),
             camera_w: v4(camera.basis.w, 1.0),
             background,
+            lens: [0.0; 4],
         };
         FlatScene {
             nodes,
@@ -356,6 +375,7 @@ impl FlatScene {
             lights: lights.words,
             tables,
             texels,
+            physical: Vec::new(),
             params,
         }
     }

@@ -89,12 +89,27 @@ struct Params {
     // The top-level BVH (over the instances) starts here.
     tlas_root: u32,
     _pad1: u32,
+    // Physically based materials (layout.rs, the `physical` buffer): where the BSDF nodes'
+    // offsets start, where the texture nodes start.
+    bsdf_index: u32,
+    texture_nodes: u32,
+    // Bit 0: emitters are hidden from camera rays (Mitsuba's `hide_emitters`).
+    render_flags: u32,
+    // The reconstruction filter: 0 box, 1 tent, 2 gaussian; its radius or standard
+    // deviation in pixels (f32 bits).
+    filter_kind: u32,
+    filter_param: u32,
+    _pad2: u32,
+    _pad3: u32,
+    _pad4: u32,
     camera_position: vec4<f32>,
     // xyz: the basis vectors; w of u: focal length, of v: image-plane width, of w: aspect.
     camera_u: vec4<f32>,
     camera_v: vec4<f32>,
     camera_w: vec4<f32>,
     background: vec4<f32>,
+    // A thin lens: x its aperture radius, y its focus distance; x = 0 for a pinhole.
+    lens: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> params: Params;
@@ -105,6 +120,8 @@ struct Params {
 @group(0) @binding(5) var<storage, read> tables: array<f32>;
 @group(0) @binding(6) var<storage, read> texels: array<vec4<f32>>;
 @group(0) @binding(7) var<storage, read_write> accum: array<vec4<f32>>;
+// Physically based materials: BSDF nodes, texture nodes and mesh attributes (layout.rs).
+@group(0) @binding(8) var<storage, read> physical: array<vec4<f32>>;
 
 // ---------------------------------------------------------------------------------------
 // Random numbers: counter-based. Each draw hashes (seed, pixel, sample, draw index) with
