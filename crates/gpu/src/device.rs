@@ -13,6 +13,74 @@ use crate::{check_supported, GpuError};
 /// that a dispatch on a real GPU lasts milliseconds, far from any watchdog.
 const SAMPLES_PER_DISPATCH: u64 = 1 << 20;
 
+/// vec4s per case of the BSDF probe (`physical.wgsl` PROBE_STRIDE).
+pub(crate) const PROBE_STRIDE: usize = 17;
+
+/// One input of `GpuRenderer::probe_bsdfs`: BSDF tree `bsdf` of the scene, the shading data
+/// of a hit (as `PhysicalSurface` has them: the geometric normal, the shading frame's u, v,
+/// w, ∂p/∂u, ∂p/∂v, what textures read), the world directions towards the viewer (`wo`) and
+/// the light (`wi`), and the random numbers of one sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ProbeCase {
+    pub bsdf: u32,
+    pub u_lobe: f32,
+    pub u: [f32; 2],
+    pub normal: [f32; 3],
+    pub frame: [[f32; 3]; 3],
+    pub dp_du: [f32; 3],
+    pub dp_dv: [f32; 3],
+    pub uv: [f32; 2],
+    pub uv1: [f32; 2],
+    pub vertex_color: [f32; 3],
+    pub face_color: [f32; 3],
+    pub bitangent_sign: f32,
+    pub wo: [f32; 3],
+    pub wi: [f32; 3],
+}
+
+/// What the GPU's resolved BSDF gives for a `ProbeCase`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeResult {
+    /// f·|cos θi| and the density at (`wo`, `wi`).
+    pub f: [f32; 3],
+    pub pdf: f32,
+    /// The sample drawn with the case's numbers, if any.
+    pub sample: Option<ProbeSample>,
+    pub albedo: [f32; 3],
+    /// How many leaves the tree resolved to.
+    pub leaves: u32,
+    pub has_non_delta: bool,
+}
+
+/// A BSDF sample in world space (`BsdfSample`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeSample {
+    pub wi: [f32; 3],
+    pub weight: [f32; 3],
+    pub pdf: f32,
+    pub is_specular: bool,
+    pub eta: f32,
+}
+
+/// What `GpuRenderer::bind` makes: the buffers a dispatch writes or sets, and the bind group.
+struct Bound {
+    uniform: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+/// The kernel, one WGSL module: the path loop, the physically based materials, then each
+/// family of them.
+pub(crate) const KERNEL: &str = concat!(
+    include_str!("path.wgsl"),
+    include_str!("physical.wgsl"),
+    include_str!("conductor.wgsl"),
+    include_str!("dielectric.wgsl"),
+    include_str!("plastic.wgsl"),
+    include_str!("principled.wgsl"),
+    include_str!("gltf.wgsl"),
+);
+
 /// What a GPU render did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct GpuStats {
@@ -36,6 +104,9 @@ pub struct GpuRenderer {
     info: wgpu::AdapterInfo,
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
+    /// For the BSDF probe's pipeline (`probe_bsdfs`), made when first asked for.
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
     max_binding: u64,
     samples_per_pass: Option<u32>,
     device_error: Arc<Mutex<Option<String>>>,
@@ -100,7 +171,7 @@ impl GpuRenderer {
         }));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("path.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("path.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(KERNEL.into()),
         });
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
             binding: 0,
@@ -140,6 +211,8 @@ impl GpuRenderer {
             info,
             pipeline,
             layout,
+            module,
+            pipeline_layout,
             device_error,
         };
         renderer.check_device()?;
@@ -201,59 +274,12 @@ impl GpuRenderer {
         params.max_depth = settings.max_depth();
         params.camera_w[3] = settings.aspect.unwrap_or(width as f32 / height as f32);
 
-        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
-            // wgpu refuses empty bindings: an empty table is one zero word.
-            let padded: &[u8] = if bytes.is_empty() { &[0u8; 16] } else { bytes };
-            if padded.len() as u64 > self.max_binding {
-                return Err(GpuError::Unsupported(format!(
-                    "a scene whose {label} take {} bytes (the adapter binds at most {})",
-                    padded.len(),
-                    self.max_binding
-                )));
-            }
-            Ok(self
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents: padded,
-                    usage: wgpu::BufferUsages::STORAGE | extra,
-                }))
-        };
-        let none = wgpu::BufferUsages::empty();
-        let nodes = storage("BVH nodes", bytemuck::cast_slice(&flat.nodes), none)?;
-        let prims = storage("primitives", bytemuck::cast_slice(&flat.prims), none)?;
-        let materials = storage("materials", bytemuck::cast_slice(&flat.materials), none)?;
-        let lights = storage("lights", bytemuck::cast_slice(&flat.lights), none)?;
-        let tables = storage("tables", bytemuck::cast_slice(&flat.tables), none)?;
-        let texels = storage("texels", bytemuck::cast_slice(&flat.texels), none)?;
-        let physical = storage("physical", bytemuck::cast_slice(&flat.physical), none)?;
         let accum_bytes = vec![0u8; pixels as usize * ACCUM_BYTES_PER_PIXEL];
-        let accum = storage("accumulation", &accum_bytes, wgpu::BufferUsages::COPY_SRC)?;
-        let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("params"),
-            size: std::mem::size_of::<layout::Params>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("glint scene"),
-            layout: &self.layout,
-            entries: &[
-                (0, &uniform),
-                (1, &nodes),
-                (2, &prims),
-                (3, &materials),
-                (4, &lights),
-                (5, &tables),
-                (6, &texels),
-                (7, &accum),
-                (8, &physical),
-            ]
-            .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }),
-        });
+        let Bound {
+            uniform,
+            accum,
+            bind_group,
+        } = self.bind(&flat, &accum_bytes)?;
 
         let samples = settings.samples();
         let total = samples.len() as u32;
@@ -347,6 +373,158 @@ impl GpuRenderer {
         }
         film.features = settings.features.then_some(features);
         Ok((film, stats))
+    }
+
+    /// The scene's buffers, an accumulation buffer holding `accum_bytes`, a uniform block
+    /// for `Params`, and their bind group.
+    fn bind(&self, flat: &FlatScene, accum_bytes: &[u8]) -> Result<Bound, GpuError> {
+        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
+            // wgpu refuses empty bindings: an empty table is one zero word.
+            let padded: &[u8] = if bytes.is_empty() { &[0u8; 16] } else { bytes };
+            if padded.len() as u64 > self.max_binding {
+                return Err(GpuError::Unsupported(format!(
+                    "a scene whose {label} take {} bytes (the adapter binds at most {})",
+                    padded.len(),
+                    self.max_binding
+                )));
+            }
+            Ok(self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: padded,
+                    usage: wgpu::BufferUsages::STORAGE | extra,
+                }))
+        };
+        let none = wgpu::BufferUsages::empty();
+        let nodes = storage("BVH nodes", bytemuck::cast_slice(&flat.nodes), none)?;
+        let prims = storage("primitives", bytemuck::cast_slice(&flat.prims), none)?;
+        let materials = storage("materials", bytemuck::cast_slice(&flat.materials), none)?;
+        let lights = storage("lights", bytemuck::cast_slice(&flat.lights), none)?;
+        let tables = storage("tables", bytemuck::cast_slice(&flat.tables), none)?;
+        let texels = storage("texels", bytemuck::cast_slice(&flat.texels), none)?;
+        let physical = storage("physical", bytemuck::cast_slice(&flat.physical), none)?;
+        let accum = storage("accumulation", accum_bytes, wgpu::BufferUsages::COPY_SRC)?;
+        let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<layout::Params>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("glint scene"),
+            layout: &self.layout,
+            entries: &[
+                (0, &uniform),
+                (1, &nodes),
+                (2, &prims),
+                (3, &materials),
+                (4, &lights),
+                (5, &tables),
+                (6, &texels),
+                (7, &accum),
+                (8, &physical),
+            ]
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }),
+        });
+        Ok(Bound {
+            uniform,
+            accum,
+            bind_group,
+        })
+    }
+
+    /// Resolves BSDF trees of `parts` on the GPU at given shading data and evaluates and
+    /// samples them (`physical.wgsl`, `probe`): what the CPU's `SurfaceBsdf` gives for the
+    /// same inputs, for tests that hold the two to each other.
+    pub fn probe_bsdfs(
+        &self,
+        parts: &SceneParts,
+        cases: &[ProbeCase],
+    ) -> Result<Vec<ProbeResult>, GpuError> {
+        let flat = FlatScene::new(parts);
+        let mut words: Vec<[f32; 4]> = Vec::with_capacity(cases.len() * PROBE_STRIDE);
+        for c in cases {
+            let v = |a: [f32; 3], w: f32| [a[0], a[1], a[2], w];
+            words.extend([
+                [layout::bits(c.bsdf), c.u_lobe, c.u[0], c.u[1]],
+                v(c.normal, 0.0),
+                v(c.frame[0], 0.0),
+                v(c.frame[1], 0.0),
+                v(c.frame[2], 0.0),
+                v(c.dp_du, 0.0),
+                v(c.dp_dv, 0.0),
+                [c.uv[0], c.uv[1], c.uv1[0], c.uv1[1]],
+                v(c.vertex_color, c.bitangent_sign),
+                v(c.face_color, 0.0),
+                v(c.wo, 0.0),
+                v(c.wi, 0.0),
+            ]);
+            words.extend([[0.0; 4]; PROBE_STRIDE - 12]);
+        }
+        let Bound {
+            uniform,
+            accum,
+            bind_group,
+        } = self.bind(&flat, bytemuck::cast_slice(&words))?;
+        let mut params = flat.params;
+        params.width = cases.len() as u32;
+        params.height = 1;
+        self.queue
+            .write_buffer(&uniform, 0, bytemuck::bytes_of(&params));
+        let pipeline = self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("glint BSDF probe"),
+                layout: Some(&self.pipeline_layout),
+                module: &self.module,
+                entry_point: Some("probe"),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("BSDF probe"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
+        }
+        self.queue.submit([encoder.finish()]);
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        self.check_device()?;
+        let out = self.read_back(&accum, (words.len() * 16) as u64)?;
+        Ok(out
+            .chunks_exact(PROBE_STRIDE)
+            .map(|w| {
+                let xyz = |a: [f32; 4]| [a[0], a[1], a[2]];
+                let flags = w[14][3].to_bits();
+                let counts = w[15][3].to_bits();
+                ProbeResult {
+                    f: xyz(w[12]),
+                    pdf: w[12][3],
+                    sample: (flags & 1 != 0).then(|| ProbeSample {
+                        wi: xyz(w[13]),
+                        pdf: w[13][3],
+                        weight: xyz(w[14]),
+                        is_specular: flags & 2 != 0,
+                        eta: w[16][0],
+                    }),
+                    albedo: xyz(w[15]),
+                    leaves: counts & 255,
+                    has_non_delta: counts & 256 != 0,
+                }
+            })
+            .collect())
     }
 
     fn read_back(&self, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<[f32; 4]>, GpuError> {

@@ -14,6 +14,8 @@
 use std::f32::consts::PI;
 
 use bytemuck::{Pod, Zeroable};
+
+use crate::physical::{PhysicalBuffer, SPHERE_MITSUBA_UV};
 use glint_render::{
     Background, Camera, Color, ColorSource, CubeDistribution, Image, Light, LightSelection,
     Material, Projection, SceneParts, Shape, Transform, Vec3,
@@ -25,11 +27,14 @@ pub const PRIM_TRIANGLE: u32 = 0;
 pub const PRIM_SPHERE: u32 = 1;
 pub const PRIM_BOX: u32 = 2;
 /// vec4s per primitive, in its geometry's object space: [v0 | centre | min, kind],
-/// [v1 | (radius, ..) | max, material], [v2, 0], [unit normal of a triangle, 0].
+/// [v1 | (radius, ..) | max, material], [v2, a triangle's attribute record in `physical`
+/// (`NONE` without) | a sphere's flags (`physical::SPHERE_MITSUBA_UV`), ..], [unit normal of
+/// a triangle, 0].
 pub const PRIM_STRIDE: usize = 4;
 /// vec4s per instance, stored after the primitives: three rows of object_from_world (the
-/// identity without a transform), then [geometry's root node, material override, flags, 0].
-pub const INSTANCE_STRIDE: usize = 4;
+/// identity without a transform), then [geometry's root node, material override, flags, 0],
+/// then three rows of world_from_object.
+pub const INSTANCE_STRIDE: usize = 7;
 /// An instance's flags: it blocks shadow rays; it has a transform.
 pub const FLAG_CASTS_SHADOW: u32 = 1;
 pub const FLAG_TRANSFORMED: u32 = 2;
@@ -42,6 +47,8 @@ pub const BSDF_MIRROR: u32 = 4;
 pub const BSDF_GLAZE: u32 = 5;
 pub const BSDF_BLINN_PHONG_MIRRORED: u32 = 6;
 pub const BSDF_DIELECTRIC: u32 = 7;
+/// A physically based material; its BSDF tree's id is in the exponent's place.
+pub const BSDF_PHYSICAL: u32 = 8;
 /// vec4s per material: [kd, kd texture], [ks, ks texture], [bsdf kind, exponent, km,
 /// roughness], [η, emitter kind, light index, has attenuation], [attenuation],
 /// [unsampled emitter radiance].
@@ -115,12 +122,13 @@ pub struct Params {
     pub pad: u32,
     pub bsdf_index: u32,
     pub texture_nodes: u32,
+    pub bsdf_count: u32,
     /// Bit 0: `RENDER_HIDE_EMITTERS`.
     pub render_flags: u32,
     /// `FILTER_*`, and its radius or standard deviation (f32 bits).
     pub filter_kind: u32,
     pub filter_param: u32,
-    pub pad2: [u32; 3],
+    pub pad2: [u32; 2],
     pub camera_position: [f32; 4],
     pub camera_u: [f32; 4],
     pub camera_v: [f32; 4],
@@ -187,15 +195,25 @@ impl FlatScene {
         let mut nodes: Vec<[f32; 4]> = Vec::new();
         let mut prims: Vec<[f32; 4]> = Vec::new();
         let mut roots = Vec::with_capacity(parts.geometries.len());
-        for geometry in &parts.geometries {
+        let mut physical = PhysicalBuffer::new(&parts.physical, parts.textures.len());
+        for (g, geometry) in parts.geometries.iter().enumerate() {
+            let attributes = parts.physical.attributes.get(g).and_then(Option::as_ref);
             let primitives: Vec<Primitive> = geometry
                 .shapes
                 .iter()
                 .enumerate()
                 .map(|(index, shape)| {
+                    let extra = match shape {
+                        Shape::Triangle { .. } => physical.triangle_attributes(attributes, index),
+                        Shape::Sphere { .. } if attributes.is_some_and(|a| a.mitsuba_sphere_uv) => {
+                            SPHERE_MITSUBA_UV
+                        }
+                        _ => 0,
+                    };
                     primitive(
                         shape,
                         geometry.materials.get(index).copied().unwrap_or(NONE),
+                        extra,
                     )
                 })
                 .collect();
@@ -228,16 +246,17 @@ impl FlatScene {
             if instance.casts_shadow {
                 flags |= FLAG_CASTS_SHADOW;
             }
-            let rows = match &instance.transform {
+            const IDENTITY: [[f32; 4]; 3] = [
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+            ];
+            let (rows, inverse) = match &instance.transform {
                 Some(t) => {
                     flags |= FLAG_TRANSFORMED;
-                    t.object_from_world
+                    (t.object_from_world, t.world_from_object)
                 }
-                None => [
-                    [1.0, 0.0, 0.0, 0.0],
-                    [0.0, 1.0, 0.0, 0.0],
-                    [0.0, 0.0, 1.0, 0.0],
-                ],
+                None => (IDENTITY, IDENTITY),
             };
             instance_words.push([
                 rows[0],
@@ -249,6 +268,9 @@ impl FlatScene {
                     bits(flags),
                     0.0,
                 ],
+                inverse[0],
+                inverse[1],
+                inverse[2],
             ]);
             let placed = placed_bounds(instance.transform.as_ref(), bounds);
             scene_lo = scene_lo.min(placed.0);
@@ -355,12 +377,13 @@ impl FlatScene {
             canary: 2,
             tlas_root: tlas_root as u32,
             pad: 0,
-            bsdf_index: 0,
-            texture_nodes: 0,
+            bsdf_index: physical.bsdf_index,
+            texture_nodes: physical.texture_nodes,
+            bsdf_count: physical.bsdf_count,
             render_flags: 0,
             filter_kind: 0,
             filter_param: 0,
-            pad2: [0; 3],
+            pad2: [0; 2],
             camera_position: v4(camera.position, 0.0),
             camera_u: v4(camera.basis.u, camera.focal_length),
             camera_v: v4(camera.basis.v, camera.image_plane_width),
@@ -375,14 +398,15 @@ impl FlatScene {
             lights: lights.words,
             tables,
             texels,
-            physical: Vec::new(),
+            physical: physical.words,
             params,
         }
     }
 }
 
-/// One shape in its geometry's object space, with `material` (the instance may override it).
-fn primitive(shape: &Shape, material: u32) -> Primitive {
+/// One shape in its geometry's object space, with `material` (the instance may override it)
+/// and `extra`: a triangle's attribute record, a sphere's flags.
+fn primitive(shape: &Shape, material: u32, extra: u32) -> Primitive {
     let material = bits(material);
     match *shape {
         Shape::Triangle { vertices } => {
@@ -393,7 +417,7 @@ fn primitive(shape: &Shape, material: u32) -> Primitive {
                 words: [
                     v4(vertices[0], bits(PRIM_TRIANGLE)),
                     v4(vertices[1], material),
-                    v4(vertices[2], 0.0),
+                    v4(vertices[2], bits(extra)),
                     v4(normal, 0.0),
                 ],
                 bounds: shape_bounds(shape),
@@ -403,7 +427,7 @@ fn primitive(shape: &Shape, material: u32) -> Primitive {
             words: [
                 v4(center, bits(PRIM_SPHERE)),
                 [radius, 0.0, 0.0, material],
-                [0.0; 4],
+                [bits(extra), 0.0, 0.0, 0.0],
                 [0.0; 4],
             ],
             bounds: shape_bounds(shape),
@@ -475,10 +499,8 @@ fn material_words(parts: &SceneParts, material: &Material) -> [[f32; 4]; MATERIA
     };
     // [kind, exponent, km, roughness] and η.
     let (kind, exponent, km, roughness, eta) = match plain {
-        // Physical materials are refused by `check_supported`.
-        None | Some(Material::Emissive { .. }) | Some(Material::Physical(_)) => {
-            (BSDF_BLACK, 0.0, 0.0, 0.0, 1.0)
-        }
+        Some(Material::Physical(tree)) => (BSDF_PHYSICAL, bits(*tree), 0.0, 0.0, 1.0),
+        None | Some(Material::Emissive { .. }) => (BSDF_BLACK, 0.0, 0.0, 0.0, 1.0),
         Some(
             Material::Lambertian { diffuse }
             | Material::Diffuse { diffuse }
