@@ -257,7 +257,8 @@ impl GpuRenderer {
         progress: &dyn Fn(u32, u32) -> bool,
     ) -> Result<(Film, GpuStats), GpuError> {
         check_supported(parts, settings)?;
-        let flat = FlatScene::new(parts);
+        let mut flat = FlatScene::new(parts);
+        flat.pack_texels_half(self.max_binding);
         let (width, height) = (settings.width, settings.height);
         let bounds = settings.bounds();
         let (crop_width, crop_height) = (bounds.x1 - bounds.x0, bounds.y1 - bounds.y0);
@@ -445,7 +446,8 @@ impl GpuRenderer {
         parts: &SceneParts,
         cases: &[ProbeCase],
     ) -> Result<Vec<ProbeResult>, GpuError> {
-        let flat = FlatScene::new(parts);
+        let mut flat = FlatScene::new(parts);
+        flat.pack_texels_half(self.max_binding);
         let mut words: Vec<[f32; 4]> = Vec::with_capacity(cases.len() * PROBE_STRIDE);
         for c in cases {
             let v = |a: [f32; 3], w: f32| [a[0], a[1], a[2], w];

@@ -153,6 +153,40 @@ pub struct FlatScene {
     pub params: Params,
 }
 
+/// `Params::render_flags`: the texels are packed as halves (`FlatScene::pack_texels_half`).
+pub const RENDER_TEXELS_HALF: u32 = 2;
+
+impl FlatScene {
+    /// Packs the texels two to a vec4, each RGB as three IEEE halves (rounded to nearest), when
+    /// one vec4 a texel would take more than `max_bytes`: large images then still fit the
+    /// adapter's storage-binding limit (lavapipe's is 128 MiB, four 2048² images), at a
+    /// relative precision of 2^-11 and a largest value of 65504. The flag tells the kernel.
+    pub fn pack_texels_half(&mut self, max_bytes: u64) {
+        if (self.texels.len() as u64) * 16 <= max_bytes {
+            return;
+        }
+        let pack = |a: f32, b: f32| {
+            let (a, b) = (half::f16::from_f32(a), half::f16::from_f32(b));
+            f32::from_bits(u32::from(a.to_bits()) | (u32::from(b.to_bits()) << 16))
+        };
+        self.texels = self
+            .texels
+            .chunks(2)
+            .map(|pair| {
+                let t0 = pair[0];
+                let t1 = pair.get(1).copied().unwrap_or([0.0; 4]);
+                [
+                    pack(t0[0], t0[1]),
+                    pack(t0[2], 0.0),
+                    pack(t1[0], t1[1]),
+                    pack(t1[2], 0.0),
+                ]
+            })
+            .collect();
+        self.params.render_flags |= RENDER_TEXELS_HALF;
+    }
+}
+
 /// One primitive in its geometry's object space, before the BVH orders them.
 struct Primitive {
     words: [[f32; 4]; PRIM_STRIDE],

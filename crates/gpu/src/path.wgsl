@@ -279,6 +279,20 @@ fn table_u32(index: u32) -> u32 {
     return bitcast<u32>(tables[index]);
 }
 
+// Texel `index` of the texels buffer: one vec4 each, or, where the scene's images would not
+// fit the adapter's binding otherwise (render_flags bit 1, layout.rs `pack_texels_half`), two
+// texels to a vec4, each RGB as three halves.
+fn texel_at(index: u32) -> vec3<f32> {
+    if ((params.render_flags & 2u) == 0u) {
+        return texels[index].xyz;
+    }
+    let word = texels[index >> 1u];
+    let pair = select(word.xy, word.zw, (index & 1u) != 0u);
+    let rg = unpack2x16float(bitcast<u32>(pair.x));
+    let b = unpack2x16float(bitcast<u32>(pair.y));
+    return vec3<f32>(rg, b.x);
+}
+
 fn texel(texture: u32, x: u32, y: u32) -> vec3<f32> {
     let info = params.texture_info + 3u * texture;
     let offset = table_u32(info);
@@ -286,7 +300,7 @@ fn texel(texture: u32, x: u32, y: u32) -> vec3<f32> {
     let height = table_u32(info + 2u);
     let cx = min(x, max(width, 1u) - 1u);
     let cy = min(y, max(height, 1u) - 1u);
-    return texels[offset + cy * width + cx].xyz;
+    return texel_at(offset + cy * width + cx);
 }
 
 fn texture_lookup(texture: u32, uv: vec2<f32>) -> vec3<f32> {

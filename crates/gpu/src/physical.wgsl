@@ -115,7 +115,7 @@ fn image_texel(image: u32, x: i32, y: i32, wraps: u32) -> vec3<f32> {
     let height = table_u32(info + 2u);
     let cx = wrap_texel(x, width, wraps & 15u);
     let cy = wrap_texel(y, height, wraps >> 4u);
-    return texels[offset + cy * width + cx].xyz;
+    return texel_at(offset + cy * width + cx);
 }
 
 // The node's uv: the surface's set it reads, through `to_uv`.
