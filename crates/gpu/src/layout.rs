@@ -21,7 +21,7 @@ use glint_render::{
     Material, Projection, SceneParts, Shape, Transform, Vec3,
 };
 
-pub const NONE: u32 = u32::MAX;
+pub use crate::words::{bits, NONE};
 
 pub const PRIM_TRIANGLE: u32 = 0;
 pub const PRIM_SPHERE: u32 = 1;
@@ -75,12 +75,6 @@ const MAX_LEAF: usize = 4;
 /// holds 64 entries, and a deeper tree could overflow it.
 const MAX_DEPTH: u32 = 48;
 const BINS: usize = 12;
-
-/// An integer carried in an f32 slot.
-#[inline]
-pub fn bits(value: u32) -> f32 {
-    f32::from_bits(value)
-}
 
 fn v4(v: Vec3, w: f32) -> [f32; 4] {
     [v.x, v.y, v.z, w]

@@ -36,6 +36,8 @@ mod device;
 mod layout;
 #[cfg(feature = "device")]
 mod physical;
+#[cfg(feature = "device")]
+mod words;
 
 use glint_render::{IntegratorKind, RenderSettings, SceneParts};
 

@@ -13,7 +13,7 @@ use glint_render::{
     Roughness, TexelFilter, TextureKind, TextureNode, Vec3, Wrap,
 };
 
-use crate::layout::{bits, NONE};
+use crate::words::{bits, NONE};
 
 pub const NODE_NULL: u32 = 0;
 pub const NODE_DIFFUSE: u32 = 1;
