@@ -1,7 +1,7 @@
 //! The kernel on a wgpu device: `GpuRenderer` opens a Vulkan adapter, uploads the flattened
 //! scene and renders in progressive passes (the `device` feature).
 
-use std::sync::{mpsc, Arc, Mutex};
+use std::sync::{mpsc, Arc, Mutex, OnceLock};
 
 use glint_render::{Color, Features, Film, RenderSettings, SceneParts, Vec3};
 use wgpu::util::DeviceExt;
@@ -97,12 +97,15 @@ pub struct GpuStats {
 /// The accumulation buffer's bytes per pixel (three vec4: `ACCUM_STRIDE` in `path.wgsl`).
 pub(crate) const ACCUM_BYTES_PER_PIXEL: usize = 48;
 
-/// An opened GPU device with the path-tracing pipeline compiled.
+/// An opened GPU device with the kernel's module validated; its pipelines are compiled
+/// when first used.
 pub struct GpuRenderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
-    pipeline: wgpu::ComputePipeline,
+    /// The path tracer without (0) and with (1) physically based materials: a course scene
+    /// runs a kernel whose physical code the compiler removed (`physical_materials`).
+    pipelines: [OnceLock<wgpu::ComputePipeline>; 2],
     layout: wgpu::BindGroupLayout,
     /// For the BSDF probe's pipeline (`probe_bsdfs`), made when first asked for.
     module: wgpu::ShaderModule,
@@ -195,21 +198,13 @@ impl GpuRenderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("glint path"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
         let renderer = GpuRenderer {
             device,
             queue,
             max_binding,
             samples_per_pass: None,
             info,
-            pipeline,
+            pipelines: [OnceLock::new(), OnceLock::new()],
             layout,
             module,
             pipeline_layout,
@@ -292,6 +287,7 @@ impl GpuRenderer {
             (None, _) => SAMPLES_PER_DISPATCH / pixels,
         };
         let per_pass = per_invocation.clamp(1, total.max(1) as u64) as u32;
+        let pipeline = self.path_pipeline(!parts.physical.bsdfs.is_empty());
         let mut done = 0u32;
         while done < total {
             let count = per_pass.min(total - done);
@@ -307,7 +303,7 @@ impl GpuRenderer {
                     label: Some("path samples"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &bind_group, &[]);
                 pass.dispatch_workgroups(crop_width.div_ceil(8), crop_height.div_ceil(8), 1);
             }
@@ -435,6 +431,32 @@ impl GpuRenderer {
             uniform,
             accum,
             bind_group,
+        })
+    }
+
+    /// Compiles the pipeline `parts` needs (which `render` would otherwise do first), so
+    /// that a caller can keep the driver's compilation out of its render time.
+    pub fn prepare(&self, parts: &SceneParts) -> Result<(), GpuError> {
+        self.path_pipeline(!parts.physical.bsdfs.is_empty());
+        self.check_device()
+    }
+
+    /// The path-tracing pipeline, with or without the physically based materials.
+    fn path_pipeline(&self, physical: bool) -> &wgpu::ComputePipeline {
+        self.pipelines[usize::from(physical)].get_or_init(|| {
+            let constants = [("physical_materials", if physical { 1.0 } else { 0.0 })];
+            self.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("glint path"),
+                    layout: Some(&self.pipeline_layout),
+                    module: &self.module,
+                    entry_point: Some("main"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    cache: None,
+                })
         })
     }
 

@@ -114,6 +114,10 @@ struct Params {
     lens: vec4<f32>,
 }
 
+// Whether the scene has physically based materials. The host makes one pipeline of each:
+// for a course scene the physical code, and its per-invocation leaves, fall away.
+override physical_materials: bool = true;
+
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> nodes: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> prims: array<vec4<f32>>;
@@ -1591,7 +1595,7 @@ fn trace(camera: Ray) -> vec3<f32> {
         var point = si.point;
         var next: BsdfSample;
         let tree = physical_tree(material);
-        if (tree != NONE && !behind_emitter) {
+        if (physical_materials && tree != NONE && !behind_emitter) {
             let ps = physical_surface(ray, hit);
             let wo_world = -ray.direction;
             resolve_bsdf(tree, ps, wo_world);
