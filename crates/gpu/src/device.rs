@@ -62,6 +62,35 @@ pub struct ProbeSample {
     pub eta: f32,
 }
 
+/// vec4s per case of the microfacet probe (`physical.wgsl` MICROFACET_STRIDE).
+pub(crate) const MICROFACET_STRIDE: usize = 6;
+
+/// One input of `GpuRenderer::probe_microfacets`: a distribution (GGX or Beckmann), its
+/// roughness, whether it samples visible normals, a direction `wo`, a microfacet normal `m`
+/// and the two numbers of one sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MicrofacetCase {
+    pub ggx: bool,
+    pub alpha_u: f32,
+    pub alpha_v: f32,
+    pub sample_visible: bool,
+    pub wo: [f32; 3],
+    pub m: [f32; 3],
+    pub u: [f32; 2],
+}
+
+/// The GPU's D(m), G1(wo, m), G(wo, wo', m) with wo' the mirror of wo about m, pdf(wo, m),
+/// and the normal sampled for wo with its density.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MicrofacetResult {
+    pub d: f32,
+    pub g1: f32,
+    pub g: f32,
+    pub pdf: f32,
+    pub sampled: [f32; 3],
+    pub sampled_pdf: f32,
+}
+
 /// What `GpuRenderer::bind` makes: the buffers a dispatch writes or sets, and the bind group.
 struct Bound {
     uniform: wgpu::Buffer,
@@ -489,44 +518,7 @@ impl GpuRenderer {
             ]);
             words.extend([[0.0; 4]; PROBE_STRIDE - 12]);
         }
-        let Bound {
-            uniform,
-            accum,
-            bind_group,
-        } = self.bind(&flat, bytemuck::cast_slice(&words))?;
-        let mut params = flat.params;
-        params.width = cases.len() as u32;
-        params.height = 1;
-        self.queue
-            .write_buffer(&uniform, 0, bytemuck::bytes_of(&params));
-        let pipeline = self
-            .device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("glint BSDF probe"),
-                layout: Some(&self.pipeline_layout),
-                module: &self.module,
-                entry_point: Some("probe"),
-                compilation_options: Default::default(),
-                cache: None,
-            });
-        let mut encoder = self
-            .device
-            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
-        {
-            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                label: Some("BSDF probe"),
-                timestamp_writes: None,
-            });
-            pass.set_pipeline(&pipeline);
-            pass.set_bind_group(0, &bind_group, &[]);
-            pass.dispatch_workgroups((cases.len() as u32).div_ceil(64), 1, 1);
-        }
-        self.queue.submit([encoder.finish()]);
-        self.device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|error| GpuError::Device(error.to_string()))?;
-        self.check_device()?;
-        let out = self.read_back(&accum, (words.len() * 16) as u64)?;
+        let out = self.run_probe(&flat, "probe", &words, cases.len())?;
         Ok(out
             .chunks_exact(PROBE_STRIDE)
             .map(|w| {
@@ -549,6 +541,112 @@ impl GpuRenderer {
                 }
             })
             .collect())
+    }
+
+    /// Evaluates and samples microfacet distributions on the GPU (`physical.wgsl`,
+    /// `probe_microfacet`): the kernel's port of `microfacet.rs`, for tests that hold it to
+    /// the CPU's on the same inputs.
+    pub fn probe_microfacets(
+        &self,
+        cases: &[MicrofacetCase],
+    ) -> Result<Vec<MicrofacetResult>, GpuError> {
+        let parts = SceneParts {
+            camera: glint_render::Camera::new(
+                glint_render::Projection::Perspective,
+                Vec3::Z,
+                -Vec3::Z,
+                1.0,
+                1.0,
+            ),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            lights: Vec::new(),
+            background: glint_render::Background::Color(Color::ZERO),
+            geometries: Vec::new(),
+            instances: Vec::new(),
+            physical: Default::default(),
+        };
+        let flat = FlatScene::new(&parts);
+        let mut words: Vec<[f32; 4]> = Vec::with_capacity(cases.len() * MICROFACET_STRIDE);
+        for c in cases {
+            let v = |a: [f32; 3]| [a[0], a[1], a[2], 0.0];
+            words.extend([
+                [
+                    layout::bits(u32::from(c.ggx)),
+                    c.alpha_u,
+                    c.alpha_v,
+                    layout::bits(u32::from(c.sample_visible)),
+                ],
+                v(c.wo),
+                v(c.m),
+                [c.u[0], c.u[1], 0.0, 0.0],
+                [0.0; 4],
+                [0.0; 4],
+            ]);
+        }
+        let out = self.run_probe(&flat, "probe_microfacet", &words, cases.len())?;
+        Ok(out
+            .chunks_exact(MICROFACET_STRIDE)
+            .map(|w| MicrofacetResult {
+                d: w[4][0],
+                g1: w[4][1],
+                g: w[4][2],
+                pdf: w[4][3],
+                sampled: [w[5][0], w[5][1], w[5][2]],
+                sampled_pdf: w[5][3],
+            })
+            .collect())
+    }
+
+    /// Runs probe entry point `entry` of the kernel over `count` cases written in `words`
+    /// (in the accumulation buffer, which the probe overwrites with its results), with the
+    /// scene `flat` bound, and returns the buffer.
+    fn run_probe(
+        &self,
+        flat: &FlatScene,
+        entry: &str,
+        words: &[[f32; 4]],
+        count: usize,
+    ) -> Result<Vec<[f32; 4]>, GpuError> {
+        let Bound {
+            uniform,
+            accum,
+            bind_group,
+        } = self.bind(flat, bytemuck::cast_slice(&words))?;
+        let mut params = flat.params;
+        params.width = count as u32;
+        params.height = 1;
+        self.queue
+            .write_buffer(&uniform, 0, bytemuck::bytes_of(&params));
+        let pipeline = self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&self.pipeline_layout),
+                module: &self.module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(entry),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups((count as u32).div_ceil(64), 1, 1);
+        }
+        self.queue.submit([encoder.finish()]);
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        self.check_device()?;
+        let out = self.read_back(&accum, (words.len() * 16) as u64)?;
+        Ok(out)
     }
 
     fn read_back(&self, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<[f32; 4]>, GpuError> {

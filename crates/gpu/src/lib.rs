@@ -42,7 +42,9 @@ mod words;
 use glint_render::{IntegratorKind, RenderSettings, SceneParts};
 
 #[cfg(feature = "device")]
-pub use device::{GpuRenderer, GpuStats, ProbeCase, ProbeResult, ProbeSample};
+pub use device::{
+    GpuRenderer, GpuStats, MicrofacetCase, MicrofacetResult, ProbeCase, ProbeResult, ProbeSample,
+};
 
 /// Why the GPU back end did not render.
 #[derive(Debug, thiserror::Error)]
@@ -304,6 +306,7 @@ mod tests {
             ("DIST_BECKMANN", DIST_BECKMANN),
             ("DIST_GGX", DIST_GGX),
             ("PROBE_STRIDE", crate::device::PROBE_STRIDE as u32),
+            ("MICROFACET_STRIDE", crate::device::MICROFACET_STRIDE as u32),
         ];
         for &(name, value) in constants.iter().chain(physical) {
             assert_eq!(kernel_constant(name), value, "{name}");

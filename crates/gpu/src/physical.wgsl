@@ -1239,3 +1239,25 @@ fn probe(@builtin(global_invocation_id) id: vec3<u32>) {
     accum[b + 15u] = vec4<f32>(phys_albedo(), bitcast<f32>(counts));
     accum[b + 16u] = vec4<f32>(s.eta, 0.0, 0.0, 0.0);
 }
+
+// The microfacet probe: tests/microfacet_agreement.rs writes cases (MICROFACET_STRIDE vec4
+// each): [GGX?, alpha_u, alpha_v, sample visible?], [wo], [m], [u]; out: [D(m), G1(wo, m),
+// G(wo, reflect(wo, m), m), pdf(wo, m)], [sampled m, its pdf].
+const MICROFACET_STRIDE: u32 = 6u;
+
+@compute @workgroup_size(64, 1, 1)
+fn probe_microfacet(@builtin(global_invocation_id) id: vec3<u32>) {
+    let index = id.x;
+    if (index >= params.width) {
+        return;
+    }
+    let b = index * MICROFACET_STRIDE;
+    let head = accum[b];
+    let mf = mf_new(select(DIST_BECKMANN, DIST_GGX, bitcast<u32>(head.x) != 0u), head.y, head.z, bitcast<u32>(head.w) != 0u);
+    let wo = accum[b + 1u].xyz;
+    let m = accum[b + 2u].xyz;
+    let u = accum[b + 3u].xy;
+    let wi = reflect_about(wo, m);
+    accum[b + 4u] = vec4<f32>(mf_d(mf, m), mf_smith_g1(mf, wo, m), mf_g(mf, wi, wo, m), mf_pdf(mf, wo, m));
+    accum[b + 5u] = mf_sample(mf, wo, u);
+}

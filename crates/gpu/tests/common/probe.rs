@@ -10,6 +10,9 @@
 //! negative control: the same cases against a CPU tree with one parameter changed by a few
 //! percent must fail the rule.
 
+// Each test file uses part of it.
+#![allow(dead_code)]
+
 use glint_gpu::{GpuRenderer, ProbeCase, ProbeResult};
 use glint_render::bench::{prepare_rough_plastics, Frame, PhysicalSurface, SurfaceBsdf};
 use glint_render::{
@@ -125,9 +128,10 @@ pub fn cases(trees: &[u32], count: usize, seed: u64) -> Vec<(ProbeCase, Physical
     out
 }
 
-fn close(a: f32, b: f32) -> bool {
-    if a.is_nan() || b.is_nan() {
-        return a.is_nan() && b.is_nan();
+/// Whether two values agree by the rule (NaN only with NaN, infinities only with themselves).
+pub fn close(a: f32, b: f32) -> bool {
+    if !a.is_finite() || !b.is_finite() {
+        return a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
     }
     (a - b).abs() <= ABS + REL * a.abs().max(b.abs())
 }

@@ -13,6 +13,7 @@ pub use crate::accel::instances::{AccelKind, Hit};
 pub use crate::accel::wide::WalkCounts;
 pub use crate::accel::{Isa, LocalHit, WideBvh, ALL_LANES, PACKET};
 pub use crate::material::bsdf::BsdfSample;
+pub use crate::material::microfacet::{Distribution, Microfacet};
 pub use crate::material::surface::{prepare_rough_plastics, SurfaceBsdf};
 pub use crate::math::Frame;
 pub use crate::scene::physical::PhysicalSurface;
