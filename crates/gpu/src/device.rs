@@ -612,7 +612,7 @@ impl GpuRenderer {
             uniform,
             accum,
             bind_group,
-        } = self.bind(flat, bytemuck::cast_slice(&words))?;
+        } = self.bind(flat, bytemuck::cast_slice(words))?;
         let mut params = flat.params;
         params.width = count as u32;
         params.height = 1;
