@@ -18,7 +18,7 @@ use glint_render::Vec3;
 use probe::{close, Numbers, MAX_MISMATCH};
 
 fn cases(count: usize) -> Vec<MicrofacetCase> {
-    let mut n = Numbers::new(0x0fac_e7);
+    let mut n = Numbers::new(0x000f_ace7);
     let alphas = [0.01f32, 0.05, 0.2, 0.5, 1.0];
     let mut out = Vec::with_capacity(count);
     for i in 0..count {
