@@ -1123,7 +1123,10 @@ fn intersect_triangle(ray: Ray, v0: vec3<f32>, v1: vec3<f32>, v2: vec3<f32>) -> 
         return miss;
     }
     let t = dot(e2, q) * inv;
-    if (t >= ray.t_min && t <= ray.t_max) {
+    // A ray that starts on the triangle's plane meets it at t = 0 exactly here, where the
+    // CPU's watertight test rounds to either side: a camera in the plane of a visible area
+    // light (scenes_B/threeEggs_SoftShadows) must not see only the light's back.
+    if (t > ray.t_min && t <= ray.t_max) {
         return vec3<f32>(t, b1, b2);
     }
     return miss;
