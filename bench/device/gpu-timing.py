@@ -246,12 +246,16 @@ def run_mitsuba(args, variant, scene, env):
     return times["first_end"] - start, times["render"]
 
 
+NOTED = set()
+
+
 def note(scene, renderer, stderr):
+    """A failed render's last line, once per scene and renderer (not every round)."""
     lines = [line for line in stderr.strip().splitlines() if line.strip()]
-    print(
-        f"  {scene.name}, {renderer}: {lines[-1] if lines else 'no message'}",
-        flush=True,
-    )
+    line = f"  {scene.name}, {renderer}: {lines[-1] if lines else 'no message'}"
+    if line not in NOTED:
+        NOTED.add(line)
+        print(line, flush=True)
 
 
 def cell(value, baseline):
