@@ -4,6 +4,11 @@
 # scene, a summary line, exit 1 when a scene fails. A failing scene leaves its render, the
 # reference and the map of rejected pixels in target/mitsuba-suite/.
 #   scripts/mitsuba-suite.sh [filter]   only the scenes whose path contains `filter`
+#   scripts/mitsuba-suite.sh --device gpu [filter]
+#                                       the surface scenes on the GPU kernel (glint-gpu), by
+#                                       the same rule; the volumetric ones are listed as not on
+#                                       the GPU, a scene the kernel refuses fails. Failures go
+#                                       to target/mitsuba-suite-gpu/.
 # Runs in the dev profile, whose glint-render is optimised (Cargo.toml), so that it reuses
 # the build of `cargo test --workspace`.
 set -euo pipefail
@@ -17,5 +22,27 @@ if [ ! -d "$suite" ]; then
   echo "SKIPPED: Mitsuba's suite $suite is absent"
   exit 0
 fi
-rm -rf target/mitsuba-suite
-exec cargo run --quiet --locked -p glint-io --example mitsuba_suite -- "$suite" target/mitsuba-suite "$@"
+device=cpu
+args=()
+while [ $# -gt 0 ]; do
+  case $1 in
+    --device) device=${2:-}; shift $(($# > 1 ? 2 : 1)) ;;
+    --device=*) device=${1#--device=}; shift ;;
+    *) args+=("$1"); shift ;;
+  esac
+done
+case $device in
+  cpu) out=target/mitsuba-suite ;;
+  gpu)
+    out=target/mitsuba-suite-gpu
+    # Mesa's software Vulkan warns without a private runtime folder (as scripts/test-all.sh).
+    if [ -z "${XDG_RUNTIME_DIR:-}" ] || [ ! -d "$XDG_RUNTIME_DIR" ]; then
+      XDG_RUNTIME_DIR=$(mktemp -d)
+      chmod 700 "$XDG_RUNTIME_DIR"
+      export XDG_RUNTIME_DIR
+    fi
+    ;;
+  *) echo "error: --device '$device': expected cpu or gpu" >&2; exit 2 ;;
+esac
+rm -rf "$out"
+exec cargo run --quiet --locked -p glint-io --example mitsuba_suite -- "$suite" "$out" "${args[@]}" --device "$device"

@@ -6,7 +6,8 @@
 #                                    under CI=1 and says SKIPPED otherwise)
 # Suites: the Rust workspace (`cargo test --workspace`: unit, reference-image, corpus, Mitsuba,
 # software-Vulkan GPU tests), the course images bit for bit (scripts/same-images.sh),
-# Mitsuba's own test scenes by its rule (scripts/mitsuba-suite.sh), the release binary's SIMD intrinsics inlined (scripts/inlined-intrinsics.sh), every
+# Mitsuba's own test scenes by its rule (scripts/mitsuba-suite.sh), their surface scenes on
+# the GPU kernel in software Vulkan (scripts/mitsuba-suite.sh --device gpu), the release binary's SIMD intrinsics inlined (scripts/inlined-intrinsics.sh), every
 # README command in a fresh clone (scripts/readme-examples.sh), again as a newcomer without
 # ../shared (--newcomer), and each
 # front end's own script (`ci.sh install|test`, listed in SUITES below).
@@ -93,6 +94,12 @@ scripts/mitsuba-suite.sh 2>&1 | tee "$logs/mitsuba.log" || status=$?
 result[mitsuba-suite]=$(tail -n 1 "$logs/mitsuba.log")
 [ "$status" = 0 ] || failed=1
 
+echo "== Mitsuba's test suite on the GPU by its rule (scripts/mitsuba-suite.sh --device gpu)"
+status=0
+scripts/mitsuba-suite.sh --device gpu 2>&1 | tee "$logs/mitsuba-gpu.log" || status=$?
+result[mitsuba-suite-gpu]=$(tail -n 1 "$logs/mitsuba-gpu.log")
+[ "$status" = 0 ] || failed=1
+
 echo "== SIMD intrinsics inlined in the release glint (scripts/inlined-intrinsics.sh)"
 status=0
 scripts/inlined-intrinsics.sh 2>&1 | tee "$logs/intrinsics.log" || status=$?
@@ -121,7 +128,7 @@ done
 
 echo
 echo "== summary"
-for name in cargo same-images mitsuba-suite intrinsics readme newcomer "${SUITES[@]}"; do
+for name in cargo same-images mitsuba-suite mitsuba-suite-gpu intrinsics readme newcomer "${SUITES[@]}"; do
   printf '%-26s %s\n' "$name" "${result[$name]}"
 done
 if [ "$failed" != 0 ]; then

@@ -9,14 +9,20 @@
 //! scene leaves its render, the reference and the map of rejected pixels (red where any
 //! channel was rejected) in the output folder. The exit status is 1 when a scene fails.
 //!
+//! `--device gpu` renders the surface scenes (integrator `path`, `direct` or `ptracer`) with
+//! glint-gpu's kernel instead, by the same settings and the same rule; the volumetric scenes
+//! (`volpath`, `volpathmis`) are listed as not on the GPU, and a scene the kernel refuses
+//! (`glint_gpu::check_supported`) fails, naming what it refused.
+//!
 //! ```sh
-//! cargo run -p glint-io --example mitsuba_suite -- ../shared/mitsuba/tests/scenes [out] [filter]
+//! cargo run -p glint-io --example mitsuba_suite -- ../shared/mitsuba/tests/scenes [out] [filter] [--device cpu|gpu]
 //! ```
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::Instant;
 
+use glint_gpu::{GpuError, GpuRenderer};
 use glint_render::testing::mitsuba_rule::{judge, Verdict};
 use glint_render::{render, Film, IntegratorKind, RenderSettings, Scene, SceneIntegrator};
 
@@ -71,6 +77,20 @@ fn scenes(root: &Path, filter: Option<&str>) -> Vec<PathBuf> {
     found
 }
 
+/// Where the scenes are rendered.
+enum Device {
+    Cpu,
+    /// The GPU kernel, its device opened once for the whole suite.
+    Gpu(Box<GpuRenderer>),
+}
+
+/// What became of one scene.
+enum Ran {
+    Judged(Box<Outcome>),
+    /// A volumetric scene under `--device gpu`: the CPU's alone, neither passed nor failed.
+    NotOnGpu,
+}
+
 /// One scene rendered and judged.
 struct Outcome {
     verdict: Verdict,
@@ -80,13 +100,16 @@ struct Outcome {
     seconds: f64,
 }
 
-/// Renders one scene by the rule, or says why it could not.
-fn run(scene_path: &Path) -> Result<Outcome, String> {
+/// Renders one scene by the rule on `device`, or says why it could not.
+fn run(scene_path: &Path, device: &Device) -> Result<Ran, String> {
     let (reference_path, variance_path) = reference_paths(scene_path).ok_or("no reference name")?;
     let (width, height, reference) = read_exr(&reference_path)?;
     let (_, _, variance) = read_exr(&variance_path)?;
     let loaded = glint_io::load_scene(scene_path).map_err(|e| e.to_string())?;
     let defaults = loaded.parts.physical.defaults;
+    if matches!(device, Device::Gpu(_)) && defaults.integrator == Some(SceneIntegrator::VolPath) {
+        return Ok(Ran::NotOnGpu);
+    }
     let max_depth = match defaults.integrator {
         Some(SceneIntegrator::Direct) => Some(1),
         _ => defaults.max_depth,
@@ -111,8 +134,21 @@ fn run(scene_path: &Path) -> Result<Outcome, String> {
         ..RenderSettings::default()
     };
     let start = Instant::now();
-    let scene = Scene::new(loaded.parts);
-    let (film, _) = render(&scene, &settings, &|_| true).map_err(|e| e.to_string())?;
+    let film = match device {
+        Device::Cpu => {
+            let scene = Scene::new(loaded.parts);
+            render(&scene, &settings, &|_| true)
+                .map_err(|e| e.to_string())?
+                .0
+        }
+        Device::Gpu(gpu) => {
+            // Refused before the render, in the kernel's own words.
+            glint_gpu::check_supported(&loaded.parts, &settings).map_err(gpu_error)?;
+            gpu.render(&loaded.parts, &settings, &|_, _| true)
+                .map_err(gpu_error)?
+                .0
+        }
+    };
     let seconds = start.elapsed().as_secs_f64();
     let rendered: Vec<[f64; 3]> = film
         .pixels
@@ -125,13 +161,39 @@ fn run(scene_path: &Path) -> Result<Outcome, String> {
             film.width, film.height
         ));
     }
-    Ok(Outcome {
+    Ok(Ran::Judged(Box::new(Outcome {
         verdict: judge(&rendered, &reference, &variance, spp),
         film,
         reference,
         spp,
         seconds,
-    })
+    })))
+}
+
+/// A GPU failure as a scene's line: what the kernel refused, or what went wrong.
+fn gpu_error(error: GpuError) -> String {
+    match error {
+        GpuError::Unsupported(what) => format!("refused by the GPU: {what}"),
+        other => other.to_string(),
+    }
+}
+
+/// `--device cpu|gpu` (or `--device=…`) taken out of `args`, the rest left in order.
+fn take_device(args: &mut Vec<String>) -> Result<Option<String>, String> {
+    let mut device = None;
+    let mut rest = Vec::new();
+    let mut iter = std::mem::take(args).into_iter();
+    while let Some(arg) = iter.next() {
+        if arg == "--device" {
+            device = Some(iter.next().ok_or("--device needs cpu or gpu")?);
+        } else if let Some(value) = arg.strip_prefix("--device=") {
+            device = Some(value.to_owned());
+        } else {
+            rest.push(arg);
+        }
+    }
+    *args = rest;
+    Ok(device)
 }
 
 fn write_failure(out: &Path, name: &str, film: &Film, reference: &[[f64; 3]], verdict: &Verdict) {
@@ -158,7 +220,28 @@ fn write_failure(out: &Path, name: &str, film: &Film, reference: &[[f64; 3]], ve
 }
 
 fn main() -> ExitCode {
-    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut args: Vec<String> = std::env::args().skip(1).collect();
+    let device = match take_device(&mut args).as_ref().map(Option::as_deref) {
+        Ok(None | Some("cpu")) => Device::Cpu,
+        Ok(Some("gpu")) => match GpuRenderer::new() {
+            Ok(gpu) => {
+                println!("device: {}", gpu.adapter_name());
+                Device::Gpu(Box::new(gpu))
+            }
+            Err(error) => {
+                println!("mitsuba suite on the GPU: no scene rendered: {error}");
+                return ExitCode::FAILURE;
+            }
+        },
+        Ok(Some(other)) => {
+            eprintln!("error: --device {other}: expected cpu or gpu");
+            return ExitCode::from(2);
+        }
+        Err(error) => {
+            eprintln!("error: {error}");
+            return ExitCode::from(2);
+        }
+    };
     let root = PathBuf::from(
         args.first()
             .cloned()
@@ -176,6 +259,7 @@ fn main() -> ExitCode {
         return ExitCode::FAILURE;
     }
     let mut passed = 0;
+    let mut volumetric = 0;
     for path in &list {
         let name = path
             .strip_prefix(&root)
@@ -183,14 +267,19 @@ fn main() -> ExitCode {
             .with_extension("")
             .to_string_lossy()
             .replace('/', "__");
-        match run(path) {
-            Ok(Outcome {
-                verdict,
-                film,
-                reference,
-                spp,
-                seconds,
-            }) => {
+        match run(path, &device) {
+            Ok(Ran::NotOnGpu) => {
+                volumetric += 1;
+                println!("CPU-ONLY {name}: not on the GPU (volumetric)");
+            }
+            Ok(Ran::Judged(outcome)) => {
+                let Outcome {
+                    verdict,
+                    film,
+                    reference,
+                    spp,
+                    seconds,
+                } = *outcome;
                 let ok = verdict.passes();
                 passed += ok as usize;
                 println!(
@@ -208,11 +297,18 @@ fn main() -> ExitCode {
             Err(error) => println!("FAIL {name}: {error}"),
         }
     }
-    println!(
-        "mitsuba suite: {passed} of {} scenes passed (rule: >= 99.75 % of pixel-channels accepted)",
-        list.len()
-    );
-    if passed == list.len() {
+    let judged = list.len() - volumetric;
+    match device {
+        Device::Cpu => println!(
+            "mitsuba suite: {passed} of {} scenes passed (rule: >= 99.75 % of pixel-channels accepted)",
+            list.len()
+        ),
+        Device::Gpu(_) => println!(
+            "mitsuba suite on the GPU: {passed} of {judged} surface scenes passed, {volumetric} not on the GPU (volumetric) (rule: >= 99.75 % of pixel-channels accepted)"
+        ),
+    }
+    // A GPU run of volumetric scenes only has tested nothing: a failure, not a pass.
+    if passed == judged && judged > 0 {
         ExitCode::SUCCESS
     } else {
         ExitCode::FAILURE
