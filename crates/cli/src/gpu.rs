@@ -114,6 +114,7 @@ pub fn run(
     glint_gpu::check_supported(parts, settings).map_err(unsupported)?;
     let gpu = GpuRenderer::new().map_err(Failure::Gpu)?;
     let _ = writeln!(err, "device: {}", gpu.adapter_name());
+    gpu.prepare(parts).map_err(Failure::Gpu)?;
     if job.verbose {
         let lens = parts.camera.lens.as_ref();
         let _ = writeln!(err, "{}", rendering_line(job, Device::Gpu, lens));

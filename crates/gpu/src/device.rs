@@ -1,7 +1,7 @@
 //! The kernel on a wgpu device: `GpuRenderer` opens a Vulkan adapter, uploads the flattened
 //! scene and renders in progressive passes (the `device` feature).
 
-use std::sync::{mpsc, Arc, Mutex};
+use std::sync::{mpsc, Arc, Mutex, OnceLock};
 
 use glint_render::{Color, Features, Film, RenderSettings, SceneParts, Vec3};
 use wgpu::util::DeviceExt;
@@ -12,6 +12,103 @@ use crate::{check_supported, GpuError};
 /// How many path samples one dispatch traces at most (over the whole image): small enough
 /// that a dispatch on a real GPU lasts milliseconds, far from any watchdog.
 const SAMPLES_PER_DISPATCH: u64 = 1 << 20;
+
+/// vec4s per case of the BSDF probe (`physical.wgsl` PROBE_STRIDE).
+pub(crate) const PROBE_STRIDE: usize = 17;
+
+/// One input of `GpuRenderer::probe_bsdfs`: BSDF tree `bsdf` of the scene, the shading data
+/// of a hit (as `PhysicalSurface` has them: the geometric normal, the shading frame's u, v,
+/// w, ∂p/∂u, ∂p/∂v, what textures read), the world directions towards the viewer (`wo`) and
+/// the light (`wi`), and the random numbers of one sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ProbeCase {
+    pub bsdf: u32,
+    pub u_lobe: f32,
+    pub u: [f32; 2],
+    pub normal: [f32; 3],
+    pub frame: [[f32; 3]; 3],
+    pub dp_du: [f32; 3],
+    pub dp_dv: [f32; 3],
+    pub uv: [f32; 2],
+    pub uv1: [f32; 2],
+    pub vertex_color: [f32; 3],
+    pub face_color: [f32; 3],
+    pub bitangent_sign: f32,
+    pub wo: [f32; 3],
+    pub wi: [f32; 3],
+}
+
+/// What the GPU's resolved BSDF gives for a `ProbeCase`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeResult {
+    /// f·|cos θi| and the density at (`wo`, `wi`).
+    pub f: [f32; 3],
+    pub pdf: f32,
+    /// The sample drawn with the case's numbers, if any.
+    pub sample: Option<ProbeSample>,
+    pub albedo: [f32; 3],
+    /// How many leaves the tree resolved to.
+    pub leaves: u32,
+    pub has_non_delta: bool,
+}
+
+/// A BSDF sample in world space (`BsdfSample`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ProbeSample {
+    pub wi: [f32; 3],
+    pub weight: [f32; 3],
+    pub pdf: f32,
+    pub is_specular: bool,
+    pub eta: f32,
+}
+
+/// vec4s per case of the microfacet probe (`physical.wgsl` MICROFACET_STRIDE).
+pub(crate) const MICROFACET_STRIDE: usize = 6;
+
+/// One input of `GpuRenderer::probe_microfacets`: a distribution (GGX or Beckmann), its
+/// roughness, whether it samples visible normals, a direction `wo`, a microfacet normal `m`
+/// and the two numbers of one sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MicrofacetCase {
+    pub ggx: bool,
+    pub alpha_u: f32,
+    pub alpha_v: f32,
+    pub sample_visible: bool,
+    pub wo: [f32; 3],
+    pub m: [f32; 3],
+    pub u: [f32; 2],
+}
+
+/// The GPU's D(m), G1(wo, m), G(wo, wo', m) with wo' the mirror of wo about m, pdf(wo, m),
+/// and the normal sampled for wo with its density.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MicrofacetResult {
+    pub d: f32,
+    pub g1: f32,
+    pub g: f32,
+    pub pdf: f32,
+    pub sampled: [f32; 3],
+    pub sampled_pdf: f32,
+}
+
+/// What `GpuRenderer::bind` makes: the buffers a dispatch writes or sets, and the bind group.
+struct Bound {
+    uniform: wgpu::Buffer,
+    accum: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+/// The kernel, one WGSL module: the path loop, the physically based materials, then each
+/// family of them.
+pub(crate) const KERNEL: &str = concat!(
+    include_str!("path.wgsl"),
+    include_str!("physical.wgsl"),
+    include_str!("conductor.wgsl"),
+    include_str!("dielectric.wgsl"),
+    include_str!("plastic.wgsl"),
+    include_str!("principled.wgsl"),
+    include_str!("gltf.wgsl"),
+);
 
 /// What a GPU render did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -29,13 +126,19 @@ pub struct GpuStats {
 /// The accumulation buffer's bytes per pixel (three vec4: `ACCUM_STRIDE` in `path.wgsl`).
 pub(crate) const ACCUM_BYTES_PER_PIXEL: usize = 48;
 
-/// An opened GPU device with the path-tracing pipeline compiled.
+/// An opened GPU device with the kernel's module validated; its pipelines are compiled
+/// when first used.
 pub struct GpuRenderer {
     device: wgpu::Device,
     queue: wgpu::Queue,
     info: wgpu::AdapterInfo,
-    pipeline: wgpu::ComputePipeline,
+    /// The path tracer without (0) and with (1) physically based materials: a course scene
+    /// runs a kernel whose physical code the compiler removed (`physical_materials`).
+    pipelines: [OnceLock<wgpu::ComputePipeline>; 2],
     layout: wgpu::BindGroupLayout,
+    /// For the BSDF probe's pipeline (`probe_bsdfs`), made when first asked for.
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
     max_binding: u64,
     samples_per_pass: Option<u32>,
     device_error: Arc<Mutex<Option<String>>>,
@@ -100,7 +203,7 @@ impl GpuRenderer {
         }));
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("path.wgsl"),
-            source: wgpu::ShaderSource::Wgsl(include_str!("path.wgsl").into()),
+            source: wgpu::ShaderSource::Wgsl(KERNEL.into()),
         });
         let mut entries = vec![wgpu::BindGroupLayoutEntry {
             binding: 0,
@@ -124,22 +227,16 @@ impl GpuRenderer {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("glint path"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
         let renderer = GpuRenderer {
             device,
             queue,
             max_binding,
             samples_per_pass: None,
             info,
-            pipeline,
+            pipelines: [OnceLock::new(), OnceLock::new()],
             layout,
+            module,
+            pipeline_layout,
             device_error,
         };
         renderer.check_device()?;
@@ -184,7 +281,8 @@ impl GpuRenderer {
         progress: &dyn Fn(u32, u32) -> bool,
     ) -> Result<(Film, GpuStats), GpuError> {
         check_supported(parts, settings)?;
-        let flat = FlatScene::new(parts);
+        let mut flat = FlatScene::new(parts);
+        flat.pack_texels_half(self.max_binding);
         let (width, height) = (settings.width, settings.height);
         let bounds = settings.bounds();
         let (crop_width, crop_height) = (bounds.x1 - bounds.x0, bounds.y1 - bounds.y0);
@@ -201,59 +299,12 @@ impl GpuRenderer {
         params.max_depth = settings.max_depth();
         params.camera_w[3] = settings.aspect.unwrap_or(width as f32 / height as f32);
 
-        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
-            // wgpu refuses empty bindings: an empty table is one zero word.
-            let padded: &[u8] = if bytes.is_empty() { &[0u8; 16] } else { bytes };
-            if padded.len() as u64 > self.max_binding {
-                return Err(GpuError::Unsupported(format!(
-                    "a scene whose {label} take {} bytes (the adapter binds at most {})",
-                    padded.len(),
-                    self.max_binding
-                )));
-            }
-            Ok(self
-                .device
-                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                    label: Some(label),
-                    contents: padded,
-                    usage: wgpu::BufferUsages::STORAGE | extra,
-                }))
-        };
-        let none = wgpu::BufferUsages::empty();
-        let nodes = storage("BVH nodes", bytemuck::cast_slice(&flat.nodes), none)?;
-        let prims = storage("primitives", bytemuck::cast_slice(&flat.prims), none)?;
-        let materials = storage("materials", bytemuck::cast_slice(&flat.materials), none)?;
-        let lights = storage("lights", bytemuck::cast_slice(&flat.lights), none)?;
-        let tables = storage("tables", bytemuck::cast_slice(&flat.tables), none)?;
-        let texels = storage("texels", bytemuck::cast_slice(&flat.texels), none)?;
-        let physical = storage("physical", bytemuck::cast_slice(&flat.physical), none)?;
         let accum_bytes = vec![0u8; pixels as usize * ACCUM_BYTES_PER_PIXEL];
-        let accum = storage("accumulation", &accum_bytes, wgpu::BufferUsages::COPY_SRC)?;
-        let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("params"),
-            size: std::mem::size_of::<layout::Params>() as u64,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
-        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("glint scene"),
-            layout: &self.layout,
-            entries: &[
-                (0, &uniform),
-                (1, &nodes),
-                (2, &prims),
-                (3, &materials),
-                (4, &lights),
-                (5, &tables),
-                (6, &texels),
-                (7, &accum),
-                (8, &physical),
-            ]
-            .map(|(binding, buffer)| wgpu::BindGroupEntry {
-                binding,
-                resource: buffer.as_entire_binding(),
-            }),
-        });
+        let Bound {
+            uniform,
+            accum,
+            bind_group,
+        } = self.bind(&flat, &accum_bytes)?;
 
         let samples = settings.samples();
         let total = samples.len() as u32;
@@ -265,6 +316,7 @@ impl GpuRenderer {
             (None, _) => SAMPLES_PER_DISPATCH / pixels,
         };
         let per_pass = per_invocation.clamp(1, total.max(1) as u64) as u32;
+        let pipeline = self.path_pipeline(!parts.physical.bsdfs.is_empty());
         let mut done = 0u32;
         while done < total {
             let count = per_pass.min(total - done);
@@ -280,7 +332,7 @@ impl GpuRenderer {
                     label: Some("path samples"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&self.pipeline);
+                pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &bind_group, &[]);
                 pass.dispatch_workgroups(crop_width.div_ceil(8), crop_height.div_ceil(8), 1);
             }
@@ -347,6 +399,254 @@ impl GpuRenderer {
         }
         film.features = settings.features.then_some(features);
         Ok((film, stats))
+    }
+
+    /// The scene's buffers, an accumulation buffer holding `accum_bytes`, a uniform block
+    /// for `Params`, and their bind group.
+    fn bind(&self, flat: &FlatScene, accum_bytes: &[u8]) -> Result<Bound, GpuError> {
+        let storage = |label: &str, bytes: &[u8], extra: wgpu::BufferUsages| {
+            // wgpu refuses empty bindings: an empty table is one zero word.
+            let padded: &[u8] = if bytes.is_empty() { &[0u8; 16] } else { bytes };
+            if padded.len() as u64 > self.max_binding {
+                return Err(GpuError::Unsupported(format!(
+                    "a scene whose {label} take {} bytes (the adapter binds at most {})",
+                    padded.len(),
+                    self.max_binding
+                )));
+            }
+            Ok(self
+                .device
+                .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                    label: Some(label),
+                    contents: padded,
+                    usage: wgpu::BufferUsages::STORAGE | extra,
+                }))
+        };
+        let none = wgpu::BufferUsages::empty();
+        let nodes = storage("BVH nodes", bytemuck::cast_slice(&flat.nodes), none)?;
+        let prims = storage("primitives", bytemuck::cast_slice(&flat.prims), none)?;
+        let materials = storage("materials", bytemuck::cast_slice(&flat.materials), none)?;
+        let lights = storage("lights", bytemuck::cast_slice(&flat.lights), none)?;
+        let tables = storage("tables", bytemuck::cast_slice(&flat.tables), none)?;
+        let texels = storage("texels", bytemuck::cast_slice(&flat.texels), none)?;
+        let physical = storage("physical", bytemuck::cast_slice(&flat.physical), none)?;
+        let accum = storage("accumulation", accum_bytes, wgpu::BufferUsages::COPY_SRC)?;
+        let uniform = self.device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("params"),
+            size: std::mem::size_of::<layout::Params>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = self.device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("glint scene"),
+            layout: &self.layout,
+            entries: &[
+                (0, &uniform),
+                (1, &nodes),
+                (2, &prims),
+                (3, &materials),
+                (4, &lights),
+                (5, &tables),
+                (6, &texels),
+                (7, &accum),
+                (8, &physical),
+            ]
+            .map(|(binding, buffer)| wgpu::BindGroupEntry {
+                binding,
+                resource: buffer.as_entire_binding(),
+            }),
+        });
+        Ok(Bound {
+            uniform,
+            accum,
+            bind_group,
+        })
+    }
+
+    /// Compiles the pipeline `parts` needs (which `render` would otherwise do first), so
+    /// that a caller can keep the driver's compilation out of its render time.
+    pub fn prepare(&self, parts: &SceneParts) -> Result<(), GpuError> {
+        self.path_pipeline(!parts.physical.bsdfs.is_empty());
+        self.check_device()
+    }
+
+    /// The path-tracing pipeline, with or without the physically based materials.
+    fn path_pipeline(&self, physical: bool) -> &wgpu::ComputePipeline {
+        self.pipelines[usize::from(physical)].get_or_init(|| {
+            let constants = [("physical_materials", if physical { 1.0 } else { 0.0 })];
+            self.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("glint path"),
+                    layout: Some(&self.pipeline_layout),
+                    module: &self.module,
+                    entry_point: Some("main"),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    cache: None,
+                })
+        })
+    }
+
+    /// Resolves BSDF trees of `parts` on the GPU at given shading data and evaluates and
+    /// samples them (`physical.wgsl`, `probe`): what the CPU's `SurfaceBsdf` gives for the
+    /// same inputs, for tests that hold the two to each other.
+    pub fn probe_bsdfs(
+        &self,
+        parts: &SceneParts,
+        cases: &[ProbeCase],
+    ) -> Result<Vec<ProbeResult>, GpuError> {
+        let mut flat = FlatScene::new(parts);
+        flat.pack_texels_half(self.max_binding);
+        let mut words: Vec<[f32; 4]> = Vec::with_capacity(cases.len() * PROBE_STRIDE);
+        for c in cases {
+            let v = |a: [f32; 3], w: f32| [a[0], a[1], a[2], w];
+            words.extend([
+                [layout::bits(c.bsdf), c.u_lobe, c.u[0], c.u[1]],
+                v(c.normal, 0.0),
+                v(c.frame[0], 0.0),
+                v(c.frame[1], 0.0),
+                v(c.frame[2], 0.0),
+                v(c.dp_du, 0.0),
+                v(c.dp_dv, 0.0),
+                [c.uv[0], c.uv[1], c.uv1[0], c.uv1[1]],
+                v(c.vertex_color, c.bitangent_sign),
+                v(c.face_color, 0.0),
+                v(c.wo, 0.0),
+                v(c.wi, 0.0),
+            ]);
+            words.extend([[0.0; 4]; PROBE_STRIDE - 12]);
+        }
+        let out = self.run_probe(&flat, "probe", &words, cases.len())?;
+        Ok(out
+            .chunks_exact(PROBE_STRIDE)
+            .map(|w| {
+                let xyz = |a: [f32; 4]| [a[0], a[1], a[2]];
+                let flags = w[14][3].to_bits();
+                let counts = w[15][3].to_bits();
+                ProbeResult {
+                    f: xyz(w[12]),
+                    pdf: w[12][3],
+                    sample: (flags & 1 != 0).then(|| ProbeSample {
+                        wi: xyz(w[13]),
+                        pdf: w[13][3],
+                        weight: xyz(w[14]),
+                        is_specular: flags & 2 != 0,
+                        eta: w[16][0],
+                    }),
+                    albedo: xyz(w[15]),
+                    leaves: counts & 255,
+                    has_non_delta: counts & 256 != 0,
+                }
+            })
+            .collect())
+    }
+
+    /// Evaluates and samples microfacet distributions on the GPU (`physical.wgsl`,
+    /// `probe_microfacet`): the kernel's port of `microfacet.rs`, for tests that hold it to
+    /// the CPU's on the same inputs.
+    pub fn probe_microfacets(
+        &self,
+        cases: &[MicrofacetCase],
+    ) -> Result<Vec<MicrofacetResult>, GpuError> {
+        let parts = SceneParts {
+            camera: glint_render::Camera::new(
+                glint_render::Projection::Perspective,
+                Vec3::Z,
+                -Vec3::Z,
+                1.0,
+                1.0,
+            ),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            lights: Vec::new(),
+            background: glint_render::Background::Color(Color::ZERO),
+            geometries: Vec::new(),
+            instances: Vec::new(),
+            physical: Default::default(),
+        };
+        let flat = FlatScene::new(&parts);
+        let mut words: Vec<[f32; 4]> = Vec::with_capacity(cases.len() * MICROFACET_STRIDE);
+        for c in cases {
+            let v = |a: [f32; 3]| [a[0], a[1], a[2], 0.0];
+            words.extend([
+                [
+                    layout::bits(u32::from(c.ggx)),
+                    c.alpha_u,
+                    c.alpha_v,
+                    layout::bits(u32::from(c.sample_visible)),
+                ],
+                v(c.wo),
+                v(c.m),
+                [c.u[0], c.u[1], 0.0, 0.0],
+                [0.0; 4],
+                [0.0; 4],
+            ]);
+        }
+        let out = self.run_probe(&flat, "probe_microfacet", &words, cases.len())?;
+        Ok(out
+            .chunks_exact(MICROFACET_STRIDE)
+            .map(|w| MicrofacetResult {
+                d: w[4][0],
+                g1: w[4][1],
+                g: w[4][2],
+                pdf: w[4][3],
+                sampled: [w[5][0], w[5][1], w[5][2]],
+                sampled_pdf: w[5][3],
+            })
+            .collect())
+    }
+
+    /// Runs probe entry point `entry` of the kernel over `count` cases written in `words`
+    /// (in the accumulation buffer, which the probe overwrites with its results), with the
+    /// scene `flat` bound, and returns the buffer.
+    fn run_probe(
+        &self,
+        flat: &FlatScene,
+        entry: &str,
+        words: &[[f32; 4]],
+        count: usize,
+    ) -> Result<Vec<[f32; 4]>, GpuError> {
+        let Bound {
+            uniform,
+            accum,
+            bind_group,
+        } = self.bind(flat, bytemuck::cast_slice(words))?;
+        let mut params = flat.params;
+        params.width = count as u32;
+        params.height = 1;
+        self.queue
+            .write_buffer(&uniform, 0, bytemuck::bytes_of(&params));
+        let pipeline = self
+            .device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry),
+                layout: Some(&self.pipeline_layout),
+                module: &self.module,
+                entry_point: Some(entry),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+        let mut encoder = self
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: None });
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some(entry),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&pipeline);
+            pass.set_bind_group(0, &bind_group, &[]);
+            pass.dispatch_workgroups((count as u32).div_ceil(64), 1, 1);
+        }
+        self.queue.submit([encoder.finish()]);
+        self.device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|error| GpuError::Device(error.to_string()))?;
+        self.check_device()?;
+        let out = self.read_back(&accum, (words.len() * 16) as u64)?;
+        Ok(out)
     }
 
     fn read_back(&self, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<[f32; 4]>, GpuError> {

@@ -14,23 +14,28 @@
 use std::f32::consts::PI;
 
 use bytemuck::{Pod, Zeroable};
+
+use crate::physical::{PhysicalBuffer, SPHERE_MITSUBA_UV};
 use glint_render::{
     Background, Camera, Color, ColorSource, CubeDistribution, FilterSampler, Image,
     LatLongDistribution, Light, LightSelection, Material, PixelFilter, Projection, SceneParts,
     Shape, TextureKind, TexturePoint, Transform, Vec3,
 };
 
-pub const NONE: u32 = u32::MAX;
+pub use crate::words::{bits, NONE};
 
 pub const PRIM_TRIANGLE: u32 = 0;
 pub const PRIM_SPHERE: u32 = 1;
 pub const PRIM_BOX: u32 = 2;
 /// vec4s per primitive, in its geometry's object space: [v0 | centre | min, kind],
-/// [v1 | (radius, ..) | max, material], [v2, 0], [unit normal of a triangle, 0].
+/// [v1 | (radius, ..) | max, material], [v2, a triangle's attribute record in `physical`
+/// (`NONE` without) | a sphere's flags (`physical::SPHERE_MITSUBA_UV`), ..], [unit normal of
+/// a triangle, 0].
 pub const PRIM_STRIDE: usize = 4;
 /// vec4s per instance, stored after the primitives: three rows of object_from_world (the
-/// identity without a transform), then [geometry's root node, material override, flags, 0].
-pub const INSTANCE_STRIDE: usize = 4;
+/// identity without a transform), then [geometry's root node, material override, flags, 0],
+/// then three rows of world_from_object.
+pub const INSTANCE_STRIDE: usize = 7;
 /// An instance's flags: it blocks shadow rays; it has a transform.
 pub const FLAG_CASTS_SHADOW: u32 = 1;
 pub const FLAG_TRANSFORMED: u32 = 2;
@@ -43,6 +48,8 @@ pub const BSDF_MIRROR: u32 = 4;
 pub const BSDF_GLAZE: u32 = 5;
 pub const BSDF_BLINN_PHONG_MIRRORED: u32 = 6;
 pub const BSDF_DIELECTRIC: u32 = 7;
+/// A physically based material; its BSDF tree's id is in the exponent's place.
+pub const BSDF_PHYSICAL: u32 = 8;
 /// vec4s per material: [kd, kd texture], [ks, ks texture], [bsdf kind, exponent, km,
 /// roughness], [η, emitter kind, light index, has attenuation], [attenuation],
 /// [unsampled emitter radiance].
@@ -99,12 +106,6 @@ const MAX_LEAF: usize = 4;
 const MAX_DEPTH: u32 = 48;
 const BINS: usize = 12;
 
-/// An integer carried in an f32 slot.
-#[inline]
-pub fn bits(value: u32) -> f32 {
-    f32::from_bits(value)
-}
-
 fn v4(v: Vec3, w: f32) -> [f32; 4] {
     [v.x, v.y, v.z, w]
 }
@@ -145,6 +146,7 @@ pub struct Params {
     pub pad: u32,
     pub bsdf_index: u32,
     pub texture_nodes: u32,
+    pub bsdf_count: u32,
     /// Bit 0: `RENDER_HIDE_EMITTERS`.
     pub render_flags: u32,
     /// `FILTER_*`, and its radius in pixels (f32 bits: the table's half-width).
@@ -152,7 +154,7 @@ pub struct Params {
     pub filter_param: u32,
     /// Where the filter's cumulative table (`FILTER_BINS` + 1 entries) starts in `tables`.
     pub filter_table: u32,
-    pub pad2: [u32; 2],
+    pub pad2: [u32; 1],
     pub camera_position: [f32; 4],
     pub camera_u: [f32; 4],
     pub camera_v: [f32; 4],
@@ -176,6 +178,40 @@ pub struct FlatScene {
     /// Physically based materials: BSDF nodes, texture nodes, mesh attributes.
     pub physical: Vec<[f32; 4]>,
     pub params: Params,
+}
+
+/// `Params::render_flags`: the texels are packed as halves (`FlatScene::pack_texels_half`).
+pub const RENDER_TEXELS_HALF: u32 = 2;
+
+impl FlatScene {
+    /// Packs the texels two to a vec4, each RGB as three IEEE halves (rounded to nearest), when
+    /// one vec4 a texel would take more than `max_bytes`: large images then still fit the
+    /// adapter's storage-binding limit (lavapipe's is 128 MiB, four 2048² images), at a
+    /// relative precision of 2^-11 and a largest value of 65504. The flag tells the kernel.
+    pub fn pack_texels_half(&mut self, max_bytes: u64) {
+        if (self.texels.len() as u64) * 16 <= max_bytes {
+            return;
+        }
+        let pack = |a: f32, b: f32| {
+            let (a, b) = (half::f16::from_f32(a), half::f16::from_f32(b));
+            f32::from_bits(u32::from(a.to_bits()) | (u32::from(b.to_bits()) << 16))
+        };
+        self.texels = self
+            .texels
+            .chunks(2)
+            .map(|pair| {
+                let t0 = pair[0];
+                let t1 = pair.get(1).copied().unwrap_or([0.0; 4]);
+                [
+                    pack(t0[0], t0[1]),
+                    pack(t0[2], 0.0),
+                    pack(t1[0], t1[1]),
+                    pack(t1[2], 0.0),
+                ]
+            })
+            .collect();
+        self.params.render_flags |= RENDER_TEXELS_HALF;
+    }
 }
 
 /// One primitive in its geometry's object space, before the BVH orders them.
@@ -220,15 +256,25 @@ impl FlatScene {
         let mut nodes: Vec<[f32; 4]> = Vec::new();
         let mut prims: Vec<[f32; 4]> = Vec::new();
         let mut roots = Vec::with_capacity(parts.geometries.len());
-        for geometry in &parts.geometries {
+        let mut physical = PhysicalBuffer::new(&parts.physical, parts.textures.len());
+        for (g, geometry) in parts.geometries.iter().enumerate() {
+            let attributes = parts.physical.attributes.get(g).and_then(Option::as_ref);
             let primitives: Vec<Primitive> = geometry
                 .shapes
                 .iter()
                 .enumerate()
                 .map(|(index, shape)| {
+                    let extra = match shape {
+                        Shape::Triangle { .. } => physical.triangle_attributes(attributes, index),
+                        Shape::Sphere { .. } if attributes.is_some_and(|a| a.mitsuba_sphere_uv) => {
+                            SPHERE_MITSUBA_UV
+                        }
+                        _ => 0,
+                    };
                     primitive(
                         shape,
                         geometry.materials.get(index).copied().unwrap_or(NONE),
+                        extra,
                     )
                 })
                 .collect();
@@ -261,16 +307,17 @@ impl FlatScene {
             if instance.casts_shadow {
                 flags |= FLAG_CASTS_SHADOW;
             }
-            let rows = match &instance.transform {
+            const IDENTITY: [[f32; 4]; 3] = [
+                [1.0, 0.0, 0.0, 0.0],
+                [0.0, 1.0, 0.0, 0.0],
+                [0.0, 0.0, 1.0, 0.0],
+            ];
+            let (rows, inverse) = match &instance.transform {
                 Some(t) => {
                     flags |= FLAG_TRANSFORMED;
-                    t.object_from_world
+                    (t.object_from_world, t.world_from_object)
                 }
-                None => [
-                    [1.0, 0.0, 0.0, 0.0],
-                    [0.0, 1.0, 0.0, 0.0],
-                    [0.0, 0.0, 1.0, 0.0],
-                ],
+                None => (IDENTITY, IDENTITY),
             };
             instance_words.push([
                 rows[0],
@@ -282,6 +329,9 @@ impl FlatScene {
                     bits(flags),
                     0.0,
                 ],
+                inverse[0],
+                inverse[1],
+                inverse[2],
             ]);
             let placed = placed_bounds(instance.transform.as_ref(), bounds);
             scene_lo = scene_lo.min(placed.0);
@@ -443,8 +493,9 @@ impl FlatScene {
             canary: 2,
             tlas_root: tlas_root as u32,
             pad: 0,
-            bsdf_index: 0,
-            texture_nodes: 0,
+            bsdf_index: physical.bsdf_index,
+            texture_nodes: physical.texture_nodes,
+            bsdf_count: physical.bsdf_count,
             render_flags: if defaults.hide_emitters {
                 RENDER_HIDE_EMITTERS
             } else {
@@ -453,7 +504,7 @@ impl FlatScene {
             filter_kind,
             filter_param: filter.radius().to_bits(),
             filter_table,
-            pad2: [0; 2],
+            pad2: [0; 1],
             camera_position: v4(camera.position, 0.0),
             camera_u: v4(camera.basis.u, camera.focal_length),
             camera_v: v4(camera.basis.v, camera.image_plane_width),
@@ -474,14 +525,15 @@ impl FlatScene {
             lights: light_words,
             tables,
             texels,
-            physical: Vec::new(),
+            physical: physical.words,
             params,
         }
     }
 }
 
-/// One shape in its geometry's object space, with `material` (the instance may override it).
-fn primitive(shape: &Shape, material: u32) -> Primitive {
+/// One shape in its geometry's object space, with `material` (the instance may override it)
+/// and `extra`: a triangle's attribute record, a sphere's flags.
+fn primitive(shape: &Shape, material: u32, extra: u32) -> Primitive {
     let material = bits(material);
     match *shape {
         Shape::Triangle { vertices } => {
@@ -492,7 +544,7 @@ fn primitive(shape: &Shape, material: u32) -> Primitive {
                 words: [
                     v4(vertices[0], bits(PRIM_TRIANGLE)),
                     v4(vertices[1], material),
-                    v4(vertices[2], 0.0),
+                    v4(vertices[2], bits(extra)),
                     v4(normal, 0.0),
                 ],
                 bounds: shape_bounds(shape),
@@ -502,7 +554,7 @@ fn primitive(shape: &Shape, material: u32) -> Primitive {
             words: [
                 v4(center, bits(PRIM_SPHERE)),
                 [radius, 0.0, 0.0, material],
-                [0.0; 4],
+                [bits(extra), 0.0, 0.0, 0.0],
                 [0.0; 4],
             ],
             bounds: shape_bounds(shape),
@@ -574,10 +626,8 @@ fn material_words(parts: &SceneParts, material: &Material) -> [[f32; 4]; MATERIA
     };
     // [kind, exponent, km, roughness] and η.
     let (kind, exponent, km, roughness, eta) = match plain {
-        // Physical materials are refused by `check_supported`.
-        None | Some(Material::Emissive { .. }) | Some(Material::Physical(_)) => {
-            (BSDF_BLACK, 0.0, 0.0, 0.0, 1.0)
-        }
+        Some(Material::Physical(tree)) => (BSDF_PHYSICAL, bits(*tree), 0.0, 0.0, 1.0),
+        None | Some(Material::Emissive { .. }) => (BSDF_BLACK, 0.0, 0.0, 0.0, 1.0),
         Some(
             Material::Lambertian { diffuse }
             | Material::Diffuse { diffuse }

@@ -21,7 +21,7 @@ const PRIM_TRIANGLE: u32 = 0u;
 const PRIM_SPHERE: u32 = 1u;
 const PRIM_BOX: u32 = 2u;
 const PRIM_STRIDE: u32 = 4u;
-const INSTANCE_STRIDE: u32 = 4u;
+const INSTANCE_STRIDE: u32 = 7u;
 const FLAG_CASTS_SHADOW: u32 = 1u;
 const FLAG_TRANSFORMED: u32 = 2u;
 
@@ -34,6 +34,8 @@ const BSDF_MIRROR: u32 = 4u;
 const BSDF_GLAZE: u32 = 5u;
 const BSDF_BLINN_PHONG_MIRRORED: u32 = 6u;
 const BSDF_DIELECTRIC: u32 = 7u;
+// A physically based material: its BSDF tree's id in the exponent's word (physical.wgsl).
+const BSDF_PHYSICAL: u32 = 8u;
 const MATERIAL_STRIDE: u32 = 6u;
 // Emitter kinds.
 const EMITTER_NONE: u32 = 0u;
@@ -111,6 +113,7 @@ struct Params {
     // offsets start, where the texture nodes start.
     bsdf_index: u32,
     texture_nodes: u32,
+    bsdf_count: u32,
     // Bit 0: emitters are hidden from camera rays (Mitsuba's `hide_emitters`).
     render_flags: u32,
     // The reconstruction filter: 0 box, 1 tent, 2 gaussian; its radius in pixels (f32
@@ -118,7 +121,6 @@ struct Params {
     filter_kind: u32,
     filter_param: u32,
     filter_table: u32,
-    _pad3: u32,
     _pad4: u32,
     camera_position: vec4<f32>,
     // xyz: the basis vectors; w of u: focal length, of v: image-plane width, of w: aspect.
@@ -130,6 +132,10 @@ struct Params {
     // camera's clipping planes: z near, w far, distances along the view; w = 0 for none.
     lens: vec4<f32>,
 }
+
+// Whether the scene has physically based materials. The host makes one pipeline of each:
+// for a course scene the physical code, and its per-invocation leaves, fall away.
+override physical_materials: bool = true;
 
 @group(0) @binding(0) var<uniform> params: Params;
 @group(0) @binding(1) var<storage, read> nodes: array<vec4<f32>>;
@@ -296,6 +302,20 @@ fn table_u32(index: u32) -> u32 {
     return bitcast<u32>(tables[index]);
 }
 
+// Texel `index` of the texels buffer: one vec4 each, or, where the scene's images would not
+// fit the adapter's binding otherwise (render_flags bit 1, layout.rs `pack_texels_half`), two
+// texels to a vec4, each RGB as three halves.
+fn texel_at(index: u32) -> vec3<f32> {
+    if ((params.render_flags & 2u) == 0u) {
+        return texels[index].xyz;
+    }
+    let word = texels[index >> 1u];
+    let pair = select(word.xy, word.zw, (index & 1u) != 0u);
+    let rg = unpack2x16float(bitcast<u32>(pair.x));
+    let b = unpack2x16float(bitcast<u32>(pair.y));
+    return vec3<f32>(rg, b.x);
+}
+
 fn texel(texture: u32, x: u32, y: u32) -> vec3<f32> {
     let info = params.texture_info + 3u * texture;
     let offset = table_u32(info);
@@ -303,7 +323,7 @@ fn texel(texture: u32, x: u32, y: u32) -> vec3<f32> {
     let height = table_u32(info + 2u);
     let cx = min(x, max(width, 1u) - 1u);
     let cy = min(y, max(height, 1u) - 1u);
-    return texels[offset + cy * width + cx].xyz;
+    return texel_at(offset + cy * width + cx);
 }
 
 fn texture_lookup(texture: u32, uv: vec2<f32>) -> vec3<f32> {
@@ -1802,6 +1822,27 @@ var<private> first_albedo: vec3<f32>;
 var<private> first_normal: vec3<f32>;
 var<private> first_depth: f32;
 
+// The BSDF tree of a physically based material, NONE for the course's materials.
+fn physical_tree(material: u32) -> u32 {
+    let m2 = materials[material * MATERIAL_STRIDE + 2u];
+    if (bitcast<u32>(m2.x) == BSDF_PHYSICAL) {
+        return bitcast<u32>(m2.y);
+    }
+    return NONE;
+}
+
+// Whether nothing that casts shadows lies between `point` and the light sample.
+fn unoccluded(point: vec3<f32>, sample: LightSample) -> bool {
+    var shadow: Ray;
+    if (sample.infinite) {
+        shadow = spawn(point, sample.direction);
+    } else {
+        shadow = spawn(point, sample.position - point);
+        shadow.t_max = 1.0 - SPAWN_EPSILON;
+    }
+    return traverse(shadow, true).primitive == NONE;
+}
+
 fn trace(camera: Ray) -> vec3<f32> {
     first_albedo = vec3<f32>(0.0);
     first_normal = vec3<f32>(0.0);
@@ -1876,53 +1917,86 @@ fn trace(camera: Ray) -> vec3<f32> {
             throughput = throughput * pow(attenuation, vec3<f32>(hit.t));
         }
 
-        let frame = frame_from_normal(si.normal);
-        let wo = to_local(frame, -ray.direction);
-        var bsdf = bsdf_black();
-        if (!behind_emitter) {
-            bsdf = build_bsdf(material, si.uv);
-        }
-        if (depth == 0u) {
-            first_normal = select(si.normal, -si.normal, wo.z < 0.0);
-            first_depth = hit.t;
-            if (bsdf.count > 0u) {
-                var albedo = vec3<f32>(0.0);
-                for (var i = 0u; i < bsdf.count; i += 1u) {
-                    albedo += bsdf.lobes[i].weight;
+        // The vertex scatters by its physically based tree or by the course's lobes; either
+        // way the path goes on from `point` along the world direction `next.wi`.
+        var point = si.point;
+        var next: BsdfSample;
+        let tree = physical_tree(material);
+        if (physical_materials && tree != NONE && !behind_emitter) {
+            let ps = physical_surface(ray, hit);
+            let wo_world = -ray.direction;
+            resolve_bsdf(tree, ps, wo_world);
+            if (depth == 0u) {
+                let n = ps.frame.w;
+                first_normal = select(n, -n, dot(n, wo_world) < 0.0);
+                first_depth = hit.t;
+                if (!phys_is_black()) {
+                    first_albedo = phys_albedo();
                 }
-                first_albedo = clamp(albedo, vec3<f32>(0.0), vec3<f32>(1.0));
             }
-        }
-        if (depth >= params.max_depth || bsdf.count == 0u || wo.z == 0.0) {
-            break;
-        }
-
-        let nee = bsdf_has_non_specular(&bsdf);
-        var u_light = vec2<f32>(0.5);
-        if (nee) {
-            u_light = next_2d();
-        }
-        var u_lobe = 0.5;
-        if (bsdf_uses_lobe_sample(&bsdf)) {
-            u_lobe = next_1d();
-        }
-        let u_direction = next_2d();
-        let continuation = bsdf_sample(&bsdf, wo, u_lobe, u_direction);
-
-        if (nee) {
-            let sample = sample_light(si.point, u_light);
-            if (sample.valid) {
-                let wi = to_local(frame, sample.direction);
-                let fp = bsdf_eval_and_pdf(&bsdf, wo, wi);
-                if (any(fp.xyz != vec3<f32>(0.0)) && any(sample.radiance != vec3<f32>(0.0))) {
-                    var shadow: Ray;
-                    if (sample.infinite) {
-                        shadow = spawn(si.point, sample.direction);
-                    } else {
-                        shadow = spawn(si.point, sample.position - si.point);
-                        shadow.t_max = 1.0 - SPAWN_EPSILON;
+            if (depth >= params.max_depth || phys_is_black()) {
+                break;
+            }
+            // The CPU's order: direction and light numbers, then the leaf's.
+            let u_direction = next_2d();
+            let u_light = next_2d();
+            let u_lobe = next_1d();
+            let continuation = phys_sample(wo_world, u_lobe, u_direction);
+            if (phys_has_non_delta()) {
+                let sample = sample_light(ps.point, u_light);
+                if (sample.valid) {
+                    let fp = phys_eval_pdf(wo_world, sample.direction);
+                    if (any(fp.xyz != vec3<f32>(0.0)) && any(sample.radiance != vec3<f32>(0.0)) && unoccluded(ps.point, sample)) {
+                        var weight = 1.0;
+                        if (!sample.is_delta && sample.reachable) {
+                            weight = power_heuristic(sample.pdf, fp.w);
+                        }
+                        radiance += throughput * fp.xyz * sample.radiance * (weight / sample.pdf);
                     }
-                    if (traverse(shadow, true).primitive == NONE) {
+                }
+            }
+            point = ps.point;
+            next = BsdfSample(continuation.wi, continuation.weight, continuation.pdf, continuation.is_specular, continuation.eta, continuation.valid);
+        } else {
+            let frame = frame_from_normal(si.normal);
+            let wo = to_local(frame, -ray.direction);
+            var bsdf = bsdf_black();
+            if (!behind_emitter) {
+                bsdf = build_bsdf(material, si.uv);
+            }
+            if (depth == 0u) {
+                first_normal = select(si.normal, -si.normal, wo.z < 0.0);
+                first_depth = hit.t;
+                if (bsdf.count > 0u) {
+                    var albedo = vec3<f32>(0.0);
+                    for (var i = 0u; i < bsdf.count; i += 1u) {
+                        albedo += bsdf.lobes[i].weight;
+                    }
+                    first_albedo = clamp(albedo, vec3<f32>(0.0), vec3<f32>(1.0));
+                }
+            }
+            if (depth >= params.max_depth || bsdf.count == 0u || wo.z == 0.0) {
+                break;
+            }
+
+            let nee = bsdf_has_non_specular(&bsdf);
+            var u_light = vec2<f32>(0.5);
+            if (nee) {
+                u_light = next_2d();
+            }
+            var u_lobe = 0.5;
+            if (bsdf_uses_lobe_sample(&bsdf)) {
+                u_lobe = next_1d();
+            }
+            let u_direction = next_2d();
+            let continuation = bsdf_sample(&bsdf, wo, u_lobe, u_direction);
+
+            if (nee) {
+                let sample = sample_light(si.point, u_light);
+                if (sample.valid) {
+                    let wi = to_local(frame, sample.direction);
+                    let fp = bsdf_eval_and_pdf(&bsdf, wo, wi);
+                    if (any(fp.xyz != vec3<f32>(0.0)) && any(sample.radiance != vec3<f32>(0.0)) && unoccluded(si.point, sample)) {
                         var weight = 1.0;
                         if (!sample.is_delta && sample.reachable) {
                             weight = power_heuristic(sample.pdf, fp.w);
@@ -1931,19 +2005,22 @@ fn trace(camera: Ray) -> vec3<f32> {
                     }
                 }
             }
+
+            next = continuation;
+            next.wi = to_world(frame, continuation.wi);
         }
 
-        if (!continuation.valid) {
+        if (!next.valid) {
             break;
         }
-        throughput = throughput * continuation.weight;
+        throughput = throughput * next.weight;
         if (all(throughput == vec3<f32>(0.0)) || !is_finite3(throughput)) {
             break;
         }
-        specular_bounce = continuation.is_specular;
-        bsdf_pdf = continuation.pdf;
-        eta_scale *= continuation.eta * continuation.eta;
-        ray = spawn(si.point, to_world(frame, continuation.wi));
+        specular_bounce = next.is_specular;
+        bsdf_pdf = next.pdf;
+        eta_scale *= next.eta * next.eta;
+        ray = spawn(point, next.wi);
         depth += 1u;
 
         if (depth >= params.rr_depth) {

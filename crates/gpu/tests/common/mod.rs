@@ -26,6 +26,7 @@ pub fn gpu(test: &str) -> Option<GpuRenderer> {
 }
 
 /// `../shared/refs/cornell/cornell.json`, loaded.
+#[allow(dead_code)] // not every test file renders it
 pub fn cornell() -> SceneParts {
     let path =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../../shared/refs/cornell/cornell.json");

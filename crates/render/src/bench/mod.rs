@@ -12,6 +12,11 @@ pub use crate::accel::build::build;
 pub use crate::accel::instances::{AccelKind, Hit};
 pub use crate::accel::wide::WalkCounts;
 pub use crate::accel::{Isa, LocalHit, WideBvh, ALL_LANES, PACKET};
+pub use crate::material::bsdf::BsdfSample;
+pub use crate::material::microfacet::{Distribution, Microfacet};
+pub use crate::material::surface::{prepare_rough_plastics, SurfaceBsdf};
+pub use crate::math::Frame;
+pub use crate::scene::physical::PhysicalSurface;
 pub use crate::scene::SurfaceNeeds;
 
 // The integrators' per-sample pieces and their samplers, for the tests that hold packet frames

@@ -1,0 +1,36 @@
+// The conductor and roughconductor (conductor.rs) on the GPU: not yet ported; these stand-ins scatter nothing.
+
+fn conductor_add(record: u32, weight: f32, frame: Frame, tilt: Tilt) {
+}
+
+fn conductor_eval_pdf(i: u32, wo: vec3<f32>, wi: vec3<f32>) -> vec4<f32> {
+    return vec4<f32>(0.0);
+}
+
+fn conductor_sample(i: u32, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> PhysSample {
+    return no_sample();
+}
+
+fn conductor_albedo(i: u32) -> vec3<f32> {
+    return vec3<f32>(0.0);
+}
+
+fn conductor_has_non_delta(i: u32) -> bool {
+    return false;
+}
+
+fn rough_conductor_eval_pdf(i: u32, wo: vec3<f32>, wi: vec3<f32>) -> vec4<f32> {
+    return vec4<f32>(0.0);
+}
+
+fn rough_conductor_sample(i: u32, wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> PhysSample {
+    return no_sample();
+}
+
+fn rough_conductor_albedo(i: u32) -> vec3<f32> {
+    return vec3<f32>(0.0);
+}
+
+fn rough_conductor_has_non_delta(i: u32) -> bool {
+    return false;
+}
