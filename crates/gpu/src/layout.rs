@@ -17,8 +17,9 @@ use bytemuck::{Pod, Zeroable};
 
 use crate::physical::{PhysicalBuffer, SPHERE_MITSUBA_UV};
 use glint_render::{
-    Background, Camera, Color, ColorSource, CubeDistribution, Image, Light, LightSelection,
-    Material, Projection, SceneParts, Shape, Transform, Vec3,
+    Background, Camera, Color, ColorSource, CubeDistribution, FilterSampler, Image,
+    LatLongDistribution, Light, LightSelection, Material, PixelFilter, Projection, SceneParts,
+    Shape, TextureKind, TexturePoint, Transform, Vec3,
 };
 
 pub use crate::words::{bits, NONE};
@@ -62,12 +63,41 @@ pub const LIGHT_RECTANGLE: u32 = 1;
 pub const LIGHT_SPHERE: u32 = 2;
 pub const LIGHT_TRIANGLES: u32 = 3;
 pub const LIGHT_ENVIRONMENT: u32 = 4;
+/// Mitsuba's `spot`: [kind, texture node | NONE, 0, 0], [position, cos cutoff],
+/// [object_from_world row 0, cos beam], [row 1, cutoff], [row 2, 1 / (cutoff − beam)],
+/// [intensity, tan cutoff].
+pub const LIGHT_SPOT: u32 = 5;
+/// Mitsuba's `directional`: [kind, ..], [direction the light travels (unit), 0], ..,
+/// [irradiance].
+pub const LIGHT_DIRECTIONAL: u32 = 6;
+/// Mitsuba's `projector`: [kind, texture node, aspect, 0], [position, scale],
+/// [object_from_world row 0], [row 1], [row 2] (with translations), [axis, cot(fov / 2)].
+pub const LIGHT_PROJECTOR: u32 = 7;
 /// vec4s per light: [kind, first triangle, triangle count, reachable by BSDF sampling],
-/// [position | centre, area | radius], [u edge, 1/area], [v edge], [normal], [radiance].
+/// [position | centre, area | radius], [u edge, 1/area], [v edge], [normal], [radiance];
+/// textured triangles: [texture node, first uv entry in `tables`, 0, 0] in place of the
+/// normal (6 floats per triangle there: the corners' uvs).
 pub const LIGHT_STRIDE: usize = 6;
 /// vec4s per emitting triangle, after the lights: [v0, cumulative area share], [edge1],
 /// [edge2], [unit normal].
 pub const LIGHT_TRIANGLE_STRIDE: usize = 4;
+
+/// `Params::background_kind`: a colour, a cube map, Mitsuba's latitude-longitude `envmap`.
+pub const BACKGROUND_COLOR: u32 = 0;
+pub const BACKGROUND_CUBE: u32 = 1;
+pub const BACKGROUND_LATLONG: u32 = 2;
+/// Floats of the envmap's block in `tables` (at `Params::first_row`): object_from_world
+/// (3x3, rows), world_from_object (3x3, rows), scale, cells across, cells down (bits).
+pub const LATLONG_INFO: usize = 21;
+
+/// `Params::render_flags`: camera rays pass through emitters and see no environment.
+pub const RENDER_HIDE_EMITTERS: u32 = 1;
+/// `Params::filter_kind`: box, tent, gaussian (the CPU's `PixelFilter`).
+pub const FILTER_BOX: u32 = 0;
+pub const FILTER_TENT: u32 = 1;
+pub const FILTER_GAUSSIAN: u32 = 2;
+/// Bins of the filter's table (`FilterSampler::BINS`).
+pub const FILTER_BINS: u32 = FilterSampler::BINS as u32;
 
 /// BVH leaves hold at most this many primitives (unless the depth limit forces more).
 const MAX_LEAF: usize = 4;
@@ -119,16 +149,19 @@ pub struct Params {
     pub bsdf_count: u32,
     /// Bit 0: `RENDER_HIDE_EMITTERS`.
     pub render_flags: u32,
-    /// `FILTER_*`, and its radius or standard deviation (f32 bits).
+    /// `FILTER_*`, and its radius in pixels (f32 bits: the table's half-width).
     pub filter_kind: u32,
     pub filter_param: u32,
-    pub pad2: [u32; 2],
+    /// Where the filter's cumulative table (`FILTER_BINS` + 1 entries) starts in `tables`.
+    pub filter_table: u32,
+    pub pad2: [u32; 1],
     pub camera_position: [f32; 4],
     pub camera_u: [f32; 4],
     pub camera_v: [f32; 4],
     pub camera_w: [f32; 4],
     pub background: [f32; 4],
-    /// The thin lens: aperture radius, focus distance (zero: a pinhole).
+    /// The thin lens: aperture radius, focus distance (zero: a pinhole); the clipping
+    /// planes: near, far (zero: none).
     pub lens: [f32; 4],
 }
 
@@ -318,18 +351,27 @@ impl FlatScene {
         let mut texels = Vec::new();
         let lights = LightTables::new(parts, (scene_lo, scene_hi));
         tables.extend_from_slice(lights.selection.cdf());
+        let triangle_uvs = tables.len() as u32;
+        tables.extend_from_slice(&lights.triangle_uvs);
+        let mut light_words = lights.words;
+        for &(record, first) in &lights.textured {
+            light_words[record + 4][1] = bits(triangle_uvs + first);
+        }
 
         // Textures: the material textures, then the cube map's six faces.
         let mut images: Vec<&Image> = parts.textures.iter().collect();
         let cube_first_texture = images.len() as u32;
         let background_kind = match &parts.background {
-            Background::Color(_) => 0,
+            Background::Color(_) => BACKGROUND_COLOR,
             Background::CubeMap(map) => {
                 images.extend(map.faces.iter());
-                1
+                BACKGROUND_CUBE
             }
-            // Refused by `check_supported`.
-            Background::Environment { .. } => 0,
+            // The lat-long image is texture `cube_first_texture`.
+            Background::Environment { image, .. } => {
+                images.push(image);
+                BACKGROUND_LATLONG
+            }
         };
         let texture_info = tables.len() as u32;
         for image in &images {
@@ -348,8 +390,41 @@ impl FlatScene {
                 tables.push(bits(0));
             }
         }
-        let (row_cdf, column_cdf, column_start, first_row) = match &lights.cube {
-            Some(cube) => {
+        let (row_cdf, column_cdf, column_start, first_row) = match (&lights.cube, &parts.background)
+        {
+            (
+                _,
+                Background::Environment {
+                    scale, to_world, ..
+                },
+            ) => {
+                let first_row = tables.len() as u32;
+                for matrix in [&to_world.object_from_world, &to_world.world_from_object] {
+                    for row in matrix {
+                        tables.extend_from_slice(&row[..3]);
+                    }
+                }
+                tables.push(*scale);
+                debug_assert_eq!(tables.len() - first_row as usize, LATLONG_INFO - 2);
+                let (row_cdf, column_cdf) = match &lights.latlong {
+                    Some(latlong) => {
+                        let (columns, rows) = latlong.cells();
+                        tables.extend([bits(columns), bits(rows)]);
+                        let row_cdf = tables.len() as u32;
+                        tables.extend_from_slice(latlong.row_cdf());
+                        let column_cdf = tables.len() as u32;
+                        tables.extend_from_slice(latlong.column_cdf());
+                        (row_cdf, column_cdf)
+                    }
+                    // No distribution (a black map): lookups only.
+                    None => {
+                        tables.extend([bits(0), bits(0)]);
+                        (first_row, first_row)
+                    }
+                };
+                (row_cdf, column_cdf, first_row, first_row)
+            }
+            (Some(cube), _) => {
                 let row_cdf = tables.len() as u32;
                 tables.extend_from_slice(cube.row_cdf());
                 let column_cdf = tables.len() as u32;
@@ -361,11 +436,23 @@ impl FlatScene {
                 (row_cdf, column_cdf, column_start, first_row)
             }
             // No distribution: a dummy first_row of zeros keeps every read in bounds.
-            None => {
+            (None, _) => {
                 let first_row = tables.len() as u32;
                 tables.extend([0.0; 8]);
                 (first_row, first_row, first_row, first_row)
             }
+        };
+
+        // The reconstruction filter's table (`FilterSampler`, the CPU's own).
+        let defaults = &parts.physical.defaults;
+        let filter = FilterSampler::new(defaults.filter);
+        let filter_table = tables.len() as u32;
+        debug_assert!(filter.cdf().is_empty() || filter.cdf().len() == FILTER_BINS as usize + 1);
+        tables.extend_from_slice(filter.cdf());
+        let filter_kind = match defaults.filter {
+            PixelFilter::Box => FILTER_BOX,
+            PixelFilter::Tent { .. } => FILTER_TENT,
+            PixelFilter::Gaussian { .. } => FILTER_GAUSSIAN,
         };
 
         let camera: &Camera = &parts.camera;
@@ -381,7 +468,8 @@ impl FlatScene {
             seed_lo: 0,
             seed_hi: 0,
             max_depth: 0,
-            rr_depth: 5,
+            // `PathSettings::for_scene`: the scene's `rr_depth`, else 5.
+            rr_depth: defaults.russian_roulette_depth.unwrap_or(5),
             light_count: lights.count,
             environment_light: lights.environment.unwrap_or(NONE),
             material_count: (materials.len() / MATERIAL_STRIDE) as u32,
@@ -408,22 +496,33 @@ impl FlatScene {
             bsdf_index: physical.bsdf_index,
             texture_nodes: physical.texture_nodes,
             bsdf_count: physical.bsdf_count,
-            render_flags: 0,
-            filter_kind: 0,
-            filter_param: 0,
-            pad2: [0; 2],
+            render_flags: if defaults.hide_emitters {
+                RENDER_HIDE_EMITTERS
+            } else {
+                0
+            },
+            filter_kind,
+            filter_param: filter.radius().to_bits(),
+            filter_table,
+            pad2: [0; 1],
             camera_position: v4(camera.position, 0.0),
             camera_u: v4(camera.basis.u, camera.focal_length),
             camera_v: v4(camera.basis.v, camera.image_plane_width),
             camera_w: v4(camera.basis.w, 1.0),
             background,
-            lens: [0.0; 4],
+            lens: {
+                let (radius, focus) = camera
+                    .lens
+                    .map_or((0.0, 0.0), |l| (l.radius, l.focus_distance));
+                let (near, far) = camera.clip.unwrap_or((0.0, 0.0));
+                [radius, focus, near, far]
+            },
         };
         FlatScene {
             nodes,
             prims,
             materials,
-            lights: lights.words,
+            lights: light_words,
             tables,
             texels,
             physical: physical.words,
@@ -620,6 +719,12 @@ struct LightTables {
     triangles_offset: u32,
     selection: LightSelection,
     cube: Option<CubeDistribution>,
+    latlong: Option<LatLongDistribution>,
+    /// The corner uvs of textured emitting triangles, six floats a triangle.
+    triangle_uvs: Vec<f32>,
+    /// Per textured light: the index of its first word in `words`, and where its uvs start
+    /// in `triangle_uvs` (the caller adds where that goes in `tables`).
+    textured: Vec<(usize, u32)>,
 }
 
 fn mean(c: Color) -> f32 {
@@ -641,7 +746,15 @@ impl LightTables {
         }
         let mut words = Vec::new();
         let mut triangles: Vec<[f32; 4]> = Vec::new();
+        let mut triangle_uvs = Vec::new();
+        let mut textured = Vec::new();
         let mut power = Vec::new();
+        // The scene's bounding radius, for the power of the lights at infinity.
+        let radius = if scene_lo.x <= scene_hi.x {
+            0.5 * (scene_hi - scene_lo).length()
+        } else {
+            1.0
+        };
         for (index, light) in parts.lights.iter().enumerate() {
             let mut w = [[0.0f32; 4]; LIGHT_STRIDE];
             let reachable = if reachable[index] { 1.0 } else { 0.0 };
@@ -685,7 +798,23 @@ impl LightTables {
                 Light::Triangles {
                     triangles: list,
                     intensity,
+                }
+                | Light::TexturedTriangles {
+                    triangles: list,
+                    intensity,
+                    ..
                 } => {
+                    w[4] = [bits(NONE), 0.0, 0.0, 0.0];
+                    if let Light::TexturedTriangles { uvs, texture, .. } = light {
+                        textured.push((words.len(), triangle_uvs.len() as u32));
+                        w[4] = [bits(*texture), 0.0, 0.0, 0.0];
+                        for i in 0..list.len() {
+                            let corners = uvs.get(i).copied().unwrap_or_default();
+                            for (u, v) in corners {
+                                triangle_uvs.extend([u, v]);
+                            }
+                        }
+                    }
                     let first = triangles.len() / LIGHT_TRIANGLE_STRIDE;
                     let mut total = 0.0f64;
                     let mut cumulative = Vec::with_capacity(list.len());
@@ -719,34 +848,100 @@ impl LightTables {
                     w[5] = v4(*intensity, 0.0);
                     triangles_area = total;
                 }
-                // Refused by `check_supported`: they stay zero words, which emit nothing.
-                Light::Spot { .. }
-                | Light::Directional { .. }
-                | Light::Projector { .. }
-                | Light::TexturedTriangles { .. } => {}
+                Light::Spot {
+                    to_world,
+                    intensity,
+                    cutoff_angle,
+                    beam_width,
+                    texture,
+                } => {
+                    let cutoff = cutoff_angle.to_radians();
+                    let beam = beam_width.to_radians();
+                    let rows = &to_world.object_from_world;
+                    w[0] = [bits(LIGHT_SPOT), bits(texture.unwrap_or(NONE)), 0.0, 0.0];
+                    w[1] = v4(to_world.point_to_world(Vec3::ZERO), cutoff.cos());
+                    w[2] = [rows[0][0], rows[0][1], rows[0][2], beam.cos()];
+                    w[3] = [rows[1][0], rows[1][1], rows[1][2], cutoff];
+                    w[4] = [rows[2][0], rows[2][1], rows[2][2], 1.0 / (cutoff - beam)];
+                    w[5] = v4(*intensity, cutoff.tan());
+                }
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => {
+                    w[0] = [bits(LIGHT_DIRECTIONAL), 0.0, 0.0, 0.0];
+                    w[1] = v4(direction.normalized(), 0.0);
+                    w[5] = v4(*irradiance, 0.0);
+                }
+                Light::Projector {
+                    to_world,
+                    irradiance,
+                    scale,
+                    fov,
+                } => {
+                    let rows = &to_world.object_from_world;
+                    w[0] = [
+                        bits(LIGHT_PROJECTOR),
+                        bits(*irradiance),
+                        texture_aspect(parts, *irradiance),
+                        0.0,
+                    ];
+                    w[1] = v4(to_world.point_to_world(Vec3::ZERO), *scale);
+                    w[2] = rows[0];
+                    w[3] = rows[1];
+                    w[4] = rows[2];
+                    w[5] = v4(
+                        to_world.vector_to_world(Vec3::Z),
+                        1.0 / (0.5 * fov.to_radians()).tan(),
+                    );
+                }
             }
             words.extend_from_slice(&w);
-            power.push(LightSelection::power(light, triangles_area));
+            // The power as `LightSampler::new` weighs each light.
+            power.push(match light {
+                Light::Directional { irradiance, .. } => {
+                    LightSelection::environment_power(radius, mean(*irradiance))
+                }
+                Light::Projector {
+                    irradiance,
+                    scale,
+                    fov,
+                    ..
+                } => LightSelection::projector_power(
+                    *fov,
+                    texture_aspect(parts, *irradiance),
+                    *scale * texture_mean(parts, *irradiance),
+                ),
+                Light::TexturedTriangles { texture, .. } => {
+                    LightSelection::power(light, triangles_area) * texture_mean(parts, *texture)
+                }
+                _ => LightSelection::power(light, triangles_area),
+            });
         }
-        let (environment_integral, cube) = match &parts.background {
+        let (environment_integral, cube, latlong) = match &parts.background {
             Background::Color(c) => {
                 let integral = 4.0 * PI * mean(c.max(Color::ZERO));
-                ((integral > 0.0 && c.is_finite()).then_some(integral), None)
+                (
+                    (integral > 0.0 && c.is_finite()).then_some(integral),
+                    None,
+                    None,
+                )
             }
             Background::CubeMap(map) => match CubeDistribution::new(map) {
-                Some((cube, integral)) => (Some(integral), Some(cube)),
-                None => (None, None),
+                Some((cube, integral)) => (Some(integral), Some(cube), None),
+                None => (None, None, None),
             },
-            Background::Environment { .. } => (None, None),
+            Background::Environment {
+                image,
+                scale,
+                to_world,
+            } => match LatLongDistribution::new(image, *scale, to_world) {
+                Some((latlong, integral)) => (Some(integral), None, Some(latlong)),
+                None => (None, None, None),
+            },
         };
         let mut environment = None;
         if let Some(integral) = environment_integral {
-            // The scene's bounding radius, for the environment's power.
-            let radius = if scene_lo.x <= scene_hi.x {
-                0.5 * (scene_hi - scene_lo).length()
-            } else {
-                1.0
-            };
             environment = Some(power.len() as u32);
             let mut w = [[0.0f32; 4]; LIGHT_STRIDE];
             w[0] = [bits(LIGHT_ENVIRONMENT), 0.0, 0.0, 1.0];
@@ -756,6 +951,12 @@ impl LightTables {
         let count = power.len() as u32;
         let triangles_offset = words.len() as u32;
         words.extend_from_slice(&triangles);
+        // Mitsuba scenes choose every emitting light alike (`RenderDefaults`).
+        if parts.physical.defaults.uniform_light_selection {
+            for p in &mut power {
+                *p = if *p > 0.0 { 1.0 } else { 0.0 };
+            }
+        }
         LightTables {
             words,
             count,
@@ -763,8 +964,52 @@ impl LightTables {
             triangles_offset,
             selection: LightSelection::new(&power),
             cube,
+            latlong,
+            triangle_uvs,
+            textured,
         }
     }
+}
+
+/// Texture `node` of `PhysicalParts::textures` at (u, v), black for a node out of range (the
+/// CPU light sampler's `texture_value`).
+fn texture_value(parts: &SceneParts, node: u32, uv: (f32, f32)) -> Color {
+    match parts.physical.textures.get(node as usize) {
+        Some(texture) => texture.eval(
+            &parts.textures,
+            &TexturePoint {
+                uv,
+                ..TexturePoint::default()
+            },
+        ),
+        None => Color::ZERO,
+    }
+}
+
+/// Width / height of texture `node` (the CPU light sampler's `texture_aspect`).
+fn texture_aspect(parts: &SceneParts, node: u32) -> f32 {
+    match parts.physical.textures.get(node as usize).map(|t| &t.kind) {
+        Some(TextureKind::Bitmap { image, .. }) => match parts.textures.get(*image as usize) {
+            Some(image) if image.width > 0 && image.height > 0 => {
+                image.width as f32 / image.height as f32
+            }
+            _ => 1.0,
+        },
+        _ => 1.0,
+    }
+}
+
+/// Texture `node`'s mean over its uv square (the CPU light sampler's `texture_mean`).
+fn texture_mean(parts: &SceneParts, node: u32) -> f32 {
+    const N: usize = 16;
+    let mut sum = 0.0f64;
+    for i in 0..N {
+        for j in 0..N {
+            let uv = ((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
+            sum += mean(texture_value(parts, node, uv).max(Color::ZERO)) as f64;
+        }
+    }
+    (sum / (N * N) as f64) as f32
 }
 
 /// A binary BVH over the primitives' bounds, binned SAH (pbrt-v4's `BVHAggregate` with
@@ -1109,5 +1354,60 @@ mod tests {
         assert_eq!(flat.lights[first + LIGHT_TRIANGLE_STRIDE][3], 1.0);
         // Its 1/area for the pdf.
         assert!((flat.lights[2][3] - 1.0 / 1.5).abs() < 1e-6);
+    }
+
+    /// The scene's defaults reach `Params` and the light table: `rr_depth`, hidden emitters,
+    /// the filter's table, the lens, and every emitting light chosen alike when the scene
+    /// asks (the directional light weighed as `LightSampler` weighs it otherwise).
+    #[test]
+    fn scene_defaults_reach_params_and_light_selection() {
+        use glint_render::{PixelFilter, ThinLens};
+        let mut parts = scene(1);
+        parts.lights.push(Light::Directional {
+            direction: -Vec3::Y,
+            irradiance: Color::splat(2.0),
+        });
+        let flat = FlatScene::new(&parts);
+        assert_eq!(flat.params.rr_depth, 5);
+        assert_eq!(flat.params.render_flags, 0);
+        assert_eq!(flat.params.filter_kind, FILTER_BOX);
+        assert_eq!(flat.params.lens, [0.0; 4]);
+        let cdf = &flat.tables[..4];
+        // The directional light's power is the scene disk's: π r² E.
+        let bounds = glint_render::Scene::new(parts.clone()).bounds();
+        let radius = 0.5 * (bounds.max - bounds.min).length();
+        let powers = [PI * 1.5, 4.0 * PI, PI * radius * radius * 2.0];
+        let total: f32 = powers.iter().sum();
+        for (i, power) in powers.iter().enumerate() {
+            assert!(
+                (cdf[i + 1] - cdf[i] - power / total).abs() < 1e-5,
+                "{cdf:?}"
+            );
+        }
+
+        parts.physical.defaults.russian_roulette_depth = Some(9);
+        parts.physical.defaults.hide_emitters = true;
+        parts.physical.defaults.uniform_light_selection = true;
+        parts.physical.defaults.filter = PixelFilter::Tent { radius: 1.5 };
+        parts.camera.lens = Some(ThinLens {
+            focus_distance: 3.0,
+            radius: 0.25,
+        });
+        let flat = FlatScene::new(&parts);
+        assert_eq!(flat.params.rr_depth, 9);
+        assert_eq!(flat.params.render_flags, RENDER_HIDE_EMITTERS);
+        assert_eq!(flat.params.lens[..2], [0.25, 3.0]);
+        assert_eq!(flat.tables[..4], [0.0, 1.0 / 3.0, 2.0 / 3.0, 1.0]);
+        assert_eq!(flat.params.filter_kind, FILTER_TENT);
+        assert_eq!(f32::from_bits(flat.params.filter_param), 1.5);
+        let table = &flat.tables[flat.params.filter_table as usize..];
+        let table = &table[..FILTER_BINS as usize + 1];
+        assert_eq!(
+            table,
+            glint_render::FilterSampler::new(PixelFilter::Tent { radius: 1.5 }).cdf()
+        );
+        // A tent: the middle bins weigh most.
+        let bin = |i: usize| table[i + 1] - table[i];
+        assert!(bin(512) > 100.0 * bin(0), "{} {}", bin(512), bin(0));
     }
 }

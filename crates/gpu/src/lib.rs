@@ -66,18 +66,14 @@ pub enum GpuError {
     Cancelled,
 }
 
-/// Refuses, before any device is opened, what the GPU path does not do: a thin lens, what
+/// Refuses, before any device is opened, what the GPU path does not do: what
 /// `unsupported_feature` names in the scene, any integrator but the path tracer (the course
 /// integrator, the volumetric path tracer and the debug views run on the CPU only), and
 /// settings `RenderSettings::validate` rejects. The course's scenes (triangles, spheres,
 /// boxes, instances, every course material and light, textures, both backgrounds, both
-/// projections) are supported, and so are feature layers, crop windows and sample ranges.
+/// projections, the thin lens of `-d`) are supported, and so are feature layers, crop windows
+/// and sample ranges.
 pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<(), GpuError> {
-    if parts.camera.lens.is_some() {
-        return Err(GpuError::Unsupported(
-            "depth of field (-d): the GPU camera is a pinhole".to_owned(),
-        ));
-    }
     if let Some(name) = unsupported_feature(parts) {
         return Err(GpuError::Unsupported(name));
     }
@@ -91,11 +87,13 @@ pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<
 }
 
 /// The first thing in `parts` that the kernel cannot render, named as the scene names it:
-/// the participating media, the BSDF families not yet ported, lights, environment maps and
-/// pixel filters of Mitsuba scenes. Media come first: the medium is what a user would move
-/// to the CPU for.
+/// the participating media and the BSDF families not yet ported of Mitsuba scenes, and its
+/// lights that read a texture (a spot's cone texture, a projector, an area emitter's textured
+/// radiance). Its untextured spot and directional lights, its `envmap`, its tent and
+/// gaussian filters and its `hide_emitters` are rendered. Media come first: the medium is
+/// what a user would move to the CPU for.
 pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
-    use glint_render::{Background, BsdfNode, Light, Material};
+    use glint_render::{BsdfNode, Light, Material};
     if let Some(medium) = parts.physical.media.first() {
         let kind = if medium.is_homogeneous() {
             "homogeneous"
@@ -134,24 +132,16 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
     }
     for light in &parts.lights {
         let name = match light {
-            Light::Spot { .. } => "spot",
-            Light::Directional { .. } => "directional",
+            Light::Spot {
+                texture: Some(_), ..
+            } => "spot (with a texture)",
             Light::Projector { .. } => "projector",
             Light::TexturedTriangles { .. } => "area (with a textured radiance)",
             _ => continue,
         };
         return Some(format!(
-            "the {name} emitter (the GPU kernel has the course's lights only)"
+            "the {name} emitter (the GPU kernel reads no texture node yet)"
         ));
-    }
-    if let Background::Environment { .. } = parts.background {
-        return Some("the envmap emitter (the GPU kernel has cube maps only)".to_owned());
-    }
-    if parts.physical.defaults.filter != glint_render::PixelFilter::Box {
-        return Some(
-            "a tent or gaussian reconstruction filter (the GPU takes box-filtered samples)"
-                .to_owned(),
-        );
     }
     fn bsdf_name(node: &BsdfNode) -> &'static str {
         match node {
@@ -220,6 +210,85 @@ mod tests {
         assert!(message.contains("medium 0 (homogeneous;"), "{message}");
     }
 
+    /// Spot (untextured) and directional lights, an envmap, tent and gaussian filters, hidden
+    /// emitters and a thin lens are rendered; media and lights that read a texture are not.
+    #[test]
+    fn lights_envmap_filters_and_lens_are_supported_media_are_not() {
+        use glint_render::{
+            Background, Camera, Color, Image, Light, Matrix4, Medium, PhaseFunction, PixelFilter,
+            Projection, SceneParts, ThinLens, Transform, Vec3,
+        };
+        let mut camera = Camera::new(Projection::Perspective, Vec3::Z, -Vec3::Z, 1.0, 1.0);
+        camera.lens = Some(ThinLens {
+            focus_distance: 2.0,
+            radius: 0.1,
+        });
+        let mut parts = SceneParts {
+            camera,
+            materials: Vec::new(),
+            textures: Vec::new(),
+            lights: vec![
+                Light::Spot {
+                    to_world: Transform::from_matrix(&Matrix4::IDENTITY).unwrap(),
+                    intensity: Color::ONE,
+                    cutoff_angle: 20.0,
+                    beam_width: 15.0,
+                    texture: None,
+                },
+                Light::Directional {
+                    direction: -Vec3::Y,
+                    irradiance: Color::ONE,
+                },
+            ],
+            background: Background::Environment {
+                image: Box::new(Image {
+                    width: 1,
+                    height: 1,
+                    texels: vec![Color::ONE],
+                }),
+                scale: 1.0,
+                to_world: Transform::from_matrix(&Matrix4::IDENTITY).unwrap(),
+            },
+            geometries: Vec::new(),
+            instances: Vec::new(),
+            physical: Default::default(),
+        };
+        parts.physical.defaults.hide_emitters = true;
+        let settings = glint_render::RenderSettings {
+            integrator: glint_render::IntegratorKind::Path,
+            ..Default::default()
+        };
+        for filter in [
+            PixelFilter::Tent { radius: 1.0 },
+            PixelFilter::Gaussian { stddev: 0.5 },
+        ] {
+            parts.physical.defaults.filter = filter;
+            assert!(super::unsupported_feature(&parts).is_none());
+            super::check_supported(&parts, &settings).expect("supported");
+        }
+        // A spot's cone texture needs the kernel's texture nodes.
+        if let Light::Spot { texture, .. } = &mut parts.lights[0] {
+            *texture = Some(0);
+        }
+        let textured = super::unsupported_feature(&parts).expect("a textured spot");
+        assert!(textured.contains("spot (with a texture)"), "{textured}");
+        parts.lights.truncate(1);
+        parts.lights[0] = Light::Directional {
+            direction: -Vec3::Y,
+            irradiance: Color::ONE,
+        };
+        parts.physical.media.push(Medium::Homogeneous {
+            sigma_t: Color::ONE,
+            albedo: Color::ONE,
+            phase: PhaseFunction::Isotropic,
+            sample_emitters: true,
+        });
+        let message = super::check_supported(&parts, &settings)
+            .expect_err("media are refused")
+            .to_string();
+        assert!(message.contains("medium 0"), "{message}");
+    }
+
     const KERNEL: &str = crate::device::KERNEL;
 
     /// The value of `const NAME: u32 = Nu;` in the kernel.
@@ -267,6 +336,18 @@ mod tests {
             ("LIGHT_SPHERE", LIGHT_SPHERE),
             ("LIGHT_TRIANGLES", LIGHT_TRIANGLES),
             ("LIGHT_ENVIRONMENT", LIGHT_ENVIRONMENT),
+            ("LIGHT_SPOT", LIGHT_SPOT),
+            ("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
+            ("LIGHT_PROJECTOR", LIGHT_PROJECTOR),
+            ("BACKGROUND_COLOR", BACKGROUND_COLOR),
+            ("BACKGROUND_CUBE", BACKGROUND_CUBE),
+            ("BACKGROUND_LATLONG", BACKGROUND_LATLONG),
+            ("LATLONG_INFO", LATLONG_INFO as u32),
+            ("RENDER_HIDE_EMITTERS", RENDER_HIDE_EMITTERS),
+            ("FILTER_BOX", FILTER_BOX),
+            ("FILTER_TENT", FILTER_TENT),
+            ("FILTER_GAUSSIAN", FILTER_GAUSSIAN),
+            ("FILTER_BINS", FILTER_BINS),
             ("LIGHT_STRIDE", LIGHT_STRIDE as u32),
             ("LIGHT_TRIANGLE_STRIDE", LIGHT_TRIANGLE_STRIDE as u32),
             ("NONE", NONE),

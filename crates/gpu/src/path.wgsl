@@ -48,8 +48,26 @@ const LIGHT_RECTANGLE: u32 = 1u;
 const LIGHT_SPHERE: u32 = 2u;
 const LIGHT_TRIANGLES: u32 = 3u;
 const LIGHT_ENVIRONMENT: u32 = 4u;
+const LIGHT_SPOT: u32 = 5u;
+const LIGHT_DIRECTIONAL: u32 = 6u;
+const LIGHT_PROJECTOR: u32 = 7u;
 const LIGHT_STRIDE: u32 = 6u;
 const LIGHT_TRIANGLE_STRIDE: u32 = 4u;
+
+// Backgrounds (layout.rs BACKGROUND_*), the envmap's block in `tables`.
+const BACKGROUND_COLOR: u32 = 0u;
+const BACKGROUND_CUBE: u32 = 1u;
+const BACKGROUND_LATLONG: u32 = 2u;
+const LATLONG_INFO: u32 = 21u;
+// Mitsuba's smallest sin θ in the envmap's Jacobian (sampler.rs POLE_SIN_THETA).
+const POLE_SIN_THETA: f32 = 5.9604645e-8;
+
+// Render flags and reconstruction filters (layout.rs RENDER_*, FILTER_*).
+const RENDER_HIDE_EMITTERS: u32 = 1u;
+const FILTER_BOX: u32 = 0u;
+const FILTER_TENT: u32 = 1u;
+const FILTER_GAUSSIAN: u32 = 2u;
+const FILTER_BINS: u32 = 1024u;
 
 // Lobes of a BSDF (bsdf.rs Lobe).
 const LOBE_DIFFUSE: u32 = 0u;
@@ -98,11 +116,11 @@ struct Params {
     bsdf_count: u32,
     // Bit 0: emitters are hidden from camera rays (Mitsuba's `hide_emitters`).
     render_flags: u32,
-    // The reconstruction filter: 0 box, 1 tent, 2 gaussian; its radius or standard
-    // deviation in pixels (f32 bits).
+    // The reconstruction filter: 0 box, 1 tent, 2 gaussian; its radius in pixels (f32
+    // bits: the half-width of its table), where its cumulative table starts in `tables`.
     filter_kind: u32,
     filter_param: u32,
-    _pad3: u32,
+    filter_table: u32,
     _pad4: u32,
     camera_position: vec4<f32>,
     // xyz: the basis vectors; w of u: focal length, of v: image-plane width, of w: aspect.
@@ -110,7 +128,8 @@ struct Params {
     camera_v: vec4<f32>,
     camera_w: vec4<f32>,
     background: vec4<f32>,
-    // A thin lens: x its aperture radius, y its focus distance; x = 0 for a pinhole.
+    // A thin lens: x its aperture radius, y its focus distance; x = 0 for a pinhole. The
+    // camera's clipping planes: z near, w far, distances along the view; w = 0 for none.
     lens: vec4<f32>,
 }
 
@@ -382,8 +401,11 @@ fn face_size(face: u32) -> vec2<u32> {
 }
 
 fn background_radiance(direction: vec3<f32>) -> vec3<f32> {
-    if (params.background_kind == 0u) {
+    if (params.background_kind == BACKGROUND_COLOR) {
         return params.background.xyz;
+    }
+    if (params.background_kind == BACKGROUND_LATLONG) {
+        return latlong_radiance(direction);
     }
     let c = cube_face_coordinates(direction);
     let face = u32(c.x);
@@ -392,6 +414,77 @@ fn background_radiance(direction: vec3<f32>) -> vec3<f32> {
     }
     let size = face_size(face);
     return texel(params.cube_first_texture + face, u32(c.y * f32(size.x)), u32(c.z * f32(size.y)));
+}
+
+// ---------------------------------------------------------------------------------------
+// Mitsuba's latitude-longitude `envmap` (light/envmap.rs): texture `cube_first_texture`, its
+// turn and scale in the block at `first_row` in `tables`.
+
+fn latlong_matrix(first: u32, v: vec3<f32>) -> vec3<f32> {
+    let base = params.first_row + first;
+    return vec3<f32>(
+        dot(vec3<f32>(tables[base], tables[base + 1u], tables[base + 2u]), v),
+        dot(vec3<f32>(tables[base + 3u], tables[base + 4u], tables[base + 5u]), v),
+        dot(vec3<f32>(tables[base + 6u], tables[base + 7u], tables[base + 8u]), v),
+    );
+}
+
+// The map's frame from the world's (Transform::vector_to_object), normalised.
+fn latlong_local(direction: vec3<f32>) -> vec3<f32> {
+    return normalize(latlong_matrix(0u, direction));
+}
+
+// (u, v) of a unit direction in the map's frame (envmap.rs direction_to_uv).
+fn latlong_uv(d: vec3<f32>) -> vec2<f32> {
+    return vec2<f32>(atan2(d.x, -d.z) * (0.5 / PI), acos(clamp(d.y, -1.0, 1.0)) * (1.0 / PI));
+}
+
+// The map's padded size (envmap.rs LatLongMap: at least 2 x 3; texel() clamps to the image).
+fn latlong_size() -> vec2<u32> {
+    let size = face_size(0u);
+    if (size.x == 0u || size.y == 0u) {
+        return vec2<u32>(0u);
+    }
+    return vec2<u32>(max(size.x, 2u), max(size.y, 3u));
+}
+
+// Mitsuba's bilinear lookup (LatLongMap::eval): u wraps, v is clamped.
+fn latlong_eval(u_in: f32, v_in: f32) -> vec3<f32> {
+    let size = latlong_size();
+    if (size.x == 0u) {
+        return vec3<f32>(0.0);
+    }
+    let u = u_in - floor(u_in);
+    let v = select(clamp(v_in, 0.0, 1.0), 0.0, v_in != v_in);
+    let x = u * f32(size.x) - 0.5;
+    let y = v * f32(size.y - 1u);
+    let x0 = floor(x);
+    let y0 = floor(y);
+    let fx = x - x0;
+    let fy = y - y0;
+    let w = i32(size.x);
+    let xa = u32(((i32(x0) % w) + w) % w);
+    let xb = u32(((i32(x0) + 1) % w + w) % w);
+    let ya = min(u32(y0), size.y - 1u);
+    let yb = min(ya + 1u, size.y - 1u);
+    let t = params.cube_first_texture;
+    let top = texel(t, xa, ya) * (1.0 - fx) + texel(t, xb, ya) * fx;
+    let bottom = texel(t, xa, yb) * (1.0 - fx) + texel(t, xb, yb) * fx;
+    return top * (1.0 - fy) + bottom * fy;
+}
+
+fn latlong_radiance(direction: vec3<f32>) -> vec3<f32> {
+    let local = latlong_local(direction);
+    if (!is_finite3(local)) {
+        return vec3<f32>(0.0);
+    }
+    let uv = latlong_uv(local);
+    return latlong_eval(uv.x, uv.y) * tables[params.first_row + 18u];
+}
+
+// The distribution's cells across and down (0 for a map without one).
+fn latlong_cells() -> vec2<u32> {
+    return vec2<u32>(table_u32(params.first_row + 19u), table_u32(params.first_row + 20u));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -442,10 +535,13 @@ struct DirectionPdf {
 fn environment_sample(u: vec2<f32>) -> DirectionPdf {
     var result: DirectionPdf;
     result.pdf = 0.0;
-    if (params.background_kind == 0u) {
+    if (params.background_kind == BACKGROUND_COLOR) {
         result.direction = sample_uniform_sphere(u);
         result.pdf = 1.0 / (4.0 * PI);
         return result;
+    }
+    if (params.background_kind == BACKGROUND_LATLONG) {
+        return latlong_sample(u);
     }
     let rows = table_u32(params.first_row + 6u);
     let row = sample_cdf(params.row_cdf, rows, u.x);
@@ -476,9 +572,66 @@ fn environment_sample(u: vec2<f32>) -> DirectionPdf {
     return result;
 }
 
+// LatLongDistribution::sample: a cell by its row and column tables, uniform within it.
+fn latlong_sample(u: vec2<f32>) -> DirectionPdf {
+    var result: DirectionPdf;
+    result.pdf = 0.0;
+    let cells = latlong_cells();
+    let row = sample_cdf(params.row_cdf, cells.y, u.x);
+    if (!row.valid) {
+        return result;
+    }
+    let column = sample_cdf(params.column_cdf + row.index * (cells.x + 1u), cells.x, u.y);
+    if (!column.valid) {
+        return result;
+    }
+    // Cells start at texel centres: half a texel on in u.
+    let map_u = (f32(column.index) + 0.5 + column.remapped) / f32(cells.x);
+    let map_v = (f32(row.index) + row.remapped) / f32(cells.y);
+    let sin_theta = sin(map_v * PI);
+    let phi = map_u * TAU;
+    let local = vec3<f32>(sin(phi) * sin_theta, cos(map_v * PI), -cos(phi) * sin_theta);
+    let direction = normalize(latlong_matrix(9u, local));
+    let density = row.probability * column.probability * f32(cells.x * cells.y);
+    // sin θ as latlong_pdf computes it, so that both give the same density.
+    let back = latlong_local(direction);
+    let sin_back = sqrt(back.x * back.x + back.z * back.z);
+    let pdf = density / (2.0 * PI * PI * max(sin_back, POLE_SIN_THETA));
+    if (pdf > 0.0 && pdf < 3.4028235e38 && is_finite3(direction)) {
+        result.direction = direction;
+        result.pdf = pdf;
+    }
+    return result;
+}
+
+fn latlong_pdf(direction: vec3<f32>) -> f32 {
+    let cells = latlong_cells();
+    if (cells.x == 0u || cells.y == 0u) {
+        return 0.0;
+    }
+    let local = latlong_local(direction);
+    if (!is_finite3(local)) {
+        return 0.0;
+    }
+    let uv = latlong_uv(local);
+    let x = (uv.x - floor(uv.x)) * f32(cells.x) - 0.5;
+    let c = i32(cells.x);
+    let column = u32(((i32(floor(x)) % c) + c) % c);
+    let row = min(u32(uv.y * f32(cells.y)), cells.y - 1u);
+    let row_probability = tables[params.row_cdf + row + 1u] - tables[params.row_cdf + row];
+    let columns = params.column_cdf + row * (cells.x + 1u);
+    let column_probability = tables[columns + column + 1u] - tables[columns + column];
+    let density = row_probability * column_probability * f32(cells.x * cells.y);
+    let sin_theta = sqrt(local.x * local.x + local.z * local.z);
+    return density / (2.0 * PI * PI * max(sin_theta, POLE_SIN_THETA));
+}
+
 fn environment_pdf(direction: vec3<f32>) -> f32 {
-    if (params.background_kind == 0u) {
+    if (params.background_kind == BACKGROUND_COLOR) {
         return 1.0 / (4.0 * PI);
+    }
+    if (params.background_kind == BACKGROUND_LATLONG) {
+        return latlong_pdf(direction);
     }
     let c = cube_face_coordinates(direction);
     let face = u32(c.x);
@@ -579,6 +732,97 @@ fn sphere_cone(reference: vec3<f32>, center: vec3<f32>, radius: f32) -> Cone {
     return cone;
 }
 
+// Texture node `node` of the physical buffer at `uv` (Mitsuba's texture space, v = 0 on the
+// image's top row): a spot's cone texture, a projector's irradiance. Until the kernel reads
+// texture nodes, `check_supported` refuses the lights that have one.
+fn light_texture(node: u32, uv: vec2<f32>) -> vec3<f32> {
+    return vec3<f32>(1.0);
+}
+
+// The sample of a light at a point (a spot, a projector): no BSDF sample finds it.
+fn delta_sample(position: vec3<f32>, reference: vec3<f32>, radiance: vec3<f32>) -> LightSample {
+    var s: LightSample;
+    let to_light = position - reference;
+    let distance = length(to_light);
+    s.radiance = radiance;
+    s.direction = to_light / distance;
+    s.position = position;
+    s.distance = distance;
+    s.pdf = 1.0;
+    s.is_delta = true;
+    s.infinite = false;
+    s.valid = true;
+    return s;
+}
+
+// Mitsuba's `spot` (sampler.rs PreparedLight::Spot): intensity × falloff × texture / r², the
+// falloff linear in the angle from the beam width to the cutoff.
+fn sample_spot(light: u32, reference: vec3<f32>) -> LightSample {
+    var s: LightSample;
+    s.valid = false;
+    let p = light_word(light, 1u);
+    let r0 = light_word(light, 2u);
+    let r1 = light_word(light, 3u);
+    let r2 = light_word(light, 4u);
+    let i = light_word(light, 5u);
+    let to_light = p.xyz - reference;
+    let distance_squared = dot(to_light, to_light);
+    if (!(distance_squared > 0.0)) {
+        return s;
+    }
+    let direction = to_light / sqrt(distance_squared);
+    let local = normalize(vec3<f32>(dot(r0.xyz, -direction), dot(r1.xyz, -direction), dot(r2.xyz, -direction)));
+    let cos_theta = local.z;
+    if (!(cos_theta > p.w)) {
+        return s;
+    }
+    var falloff = 1.0;
+    if (cos_theta < r0.w) {
+        falloff = (r1.w - acos(clamp(cos_theta, -1.0, 1.0))) * r2.w;
+    }
+    var radiance = i.xyz * (falloff / distance_squared);
+    let texture = bitcast<u32>(light_word(light, 0u).y);
+    if (texture != NONE) {
+        // Mitsuba's uv over the cutoff cone.
+        let uv = vec2<f32>(0.5 + 0.5 * local.x / (local.z * i.w), 0.5 + 0.5 * local.y / (local.z * i.w));
+        radiance = radiance * light_texture(texture, uv);
+    }
+    return delta_sample(p.xyz, reference, radiance);
+}
+
+// Mitsuba's `projector` (sampler.rs PreparedLight::Projector): π · scale · E(uv) / (z² cos θ)
+// inside its frustum.
+fn sample_projector(light: u32, reference: vec3<f32>) -> LightSample {
+    var s: LightSample;
+    s.valid = false;
+    let header = light_word(light, 0u);
+    let p = light_word(light, 1u);
+    let axis = light_word(light, 5u);
+    let h = vec4<f32>(reference, 1.0);
+    let local = vec3<f32>(dot(light_word(light, 2u), h), dot(light_word(light, 3u), h), dot(light_word(light, 4u), h));
+    if (!(local.z > 0.0)) {
+        return s;
+    }
+    let cot = axis.w;
+    let aspect = header.z;
+    let uv = vec2<f32>(0.5 - 0.5 * cot * local.x / local.z, 0.5 - 0.5 * aspect * cot * local.y / local.z);
+    if (!(uv.x >= 0.0 && uv.x <= 1.0 && uv.y >= 0.0 && uv.y <= 1.0)) {
+        return s;
+    }
+    let to_light = p.xyz - reference;
+    let distance_squared = dot(to_light, to_light);
+    if (!(distance_squared > 0.0)) {
+        return s;
+    }
+    let direction = to_light / sqrt(distance_squared);
+    let cos_theta = -dot(axis.xyz, direction);
+    let factor = PI * p.w / (local.z * local.z * cos_theta);
+    if (!(factor > 0.0 && factor < 3.4028235e38)) {
+        return s;
+    }
+    return delta_sample(p.xyz, reference, light_texture(bitcast<u32>(header.y), uv) * factor);
+}
+
 fn sample_light(reference: vec3<f32>, u_in: vec2<f32>) -> LightSample {
     var s: LightSample;
     s.valid = false;
@@ -653,7 +897,18 @@ fn sample_light(reference: vec3<f32>, u_in: vec2<f32>) -> LightSample {
             let base = params.light_triangles + (first + chosen_triangle) * LIGHT_TRIANGLE_STRIDE;
             let b = sample_uniform_triangle(vec2<f32>(u0, u.y));
             let position = lights[base].xyz + lights[base + 1u].xyz * b.x + lights[base + 2u].xyz * b.y;
-            s = area_sample(reference, position, lights[base + 3u].xyz, inverse_area, radiance);
+            var emitted = radiance;
+            let textured = light_word(light, 4u);
+            if (bitcast<u32>(textured.x) != NONE) {
+                // A textured radiance, read at the point's uv (sampler.rs textured_radiance).
+                let at = bitcast<u32>(textured.y) + 6u * chosen_triangle;
+                let uv0 = vec2<f32>(tables[at], tables[at + 1u]);
+                let uv1 = vec2<f32>(tables[at + 2u], tables[at + 3u]);
+                let uv2 = vec2<f32>(tables[at + 4u], tables[at + 5u]);
+                let uv = uv0 * (1.0 - b.x - b.y) + uv1 * b.x + uv2 * b.y;
+                emitted = emitted * light_texture(bitcast<u32>(textured.x), uv);
+            }
+            s = area_sample(reference, position, lights[base + 3u].xyz, inverse_area, emitted);
         }
         case LIGHT_SPHERE: {
             let radius = p.w;
@@ -675,6 +930,23 @@ fn sample_light(reference: vec3<f32>, u_in: vec2<f32>) -> LightSample {
             s.is_delta = false;
             s.valid = true;
         }
+        case LIGHT_SPOT: {
+            s = sample_spot(light, reference);
+        }
+        case LIGHT_DIRECTIONAL: {
+            // From infinitely far against the light's direction: an unbounded shadow ray.
+            s.radiance = radiance;
+            s.direction = -p.xyz;
+            s.position = reference - p.xyz;
+            s.distance = INF;
+            s.infinite = true;
+            s.pdf = 1.0;
+            s.is_delta = true;
+            s.valid = true;
+        }
+        case LIGHT_PROJECTOR: {
+            s = sample_projector(light, reference);
+        }
         default: {
             let env = environment_sample(u);
             if (!(env.pdf > 0.0)) {
@@ -691,7 +963,7 @@ fn sample_light(reference: vec3<f32>, u_in: vec2<f32>) -> LightSample {
         }
     }
     s.reachable = reachable;
-    if (kind == LIGHT_POINT) {
+    if (s.is_delta) {
         s.reachable = false;
     }
     s.pdf *= chosen.probability;
@@ -1466,7 +1738,10 @@ fn surface(ray: Ray, hit: Hit, needs_uv: bool) -> Surface {
 // ---------------------------------------------------------------------------------------
 // The camera (camera.rs) and the path loop (integrator/path.rs).
 
-fn camera_ray(px: f32, py: f32) -> Ray {
+// The ray through image-plane point (px, py) (camera.rs Camera::lens_ray): with a thin lens
+// (`params.lens.x` its radius, `.y` its focus distance), from the point of the lens that
+// `lens_sample` maps to, through where the pinhole ray meets the plane in focus.
+fn camera_ray(px: f32, py: f32, lens_sample: vec2<f32>) -> Ray {
     let w = params.camera_v.w;
     let h = w / params.camera_w.w;
     let u = -0.5 * w + w * px / f32(params.width);
@@ -1484,7 +1759,51 @@ fn camera_ray(px: f32, py: f32) -> Ray {
         ray.origin = params.camera_position.xyz + bu * u + bv * v;
         ray.direction = -bw;
     }
+    if (params.lens.x > 0.0) {
+        let d = sample_uniform_disk_concentric(lens_sample);
+        let offset = bu * (d.x * params.lens.x) + bv * (d.y * params.lens.x);
+        let along = -dot(ray.direction, bw);
+        let t_focus = params.lens.y / along;
+        ray.origin = ray.origin + offset;
+        ray.direction = ray.direction - offset * (1.0 / t_focus);
+    }
+    if (params.lens.w > 0.0) {
+        // Camera::clipped: the planes' distances along the view become distances along the
+        // (unit) ray.
+        ray.direction = normalize(ray.direction);
+        let along = -dot(ray.direction, bw);
+        if (along > 0.0) {
+            ray.t_min = params.lens.z / along;
+            ray.t_max = params.lens.w / along;
+        }
+    }
     return ray;
+}
+
+// One axis of a sample's offset from the pixel's centre, by the filter's table
+// (path.rs FilterSampler::sample).
+fn filter_sample(u: f32) -> f32 {
+    let radius = bitcast<f32>(params.filter_param);
+    // partition_point(c <= u) over the FILTER_BINS + 1 entries, clamped to [1, BINS].
+    var lo = 0u;
+    var hi = FILTER_BINS + 1u;
+    while (lo < hi) {
+        let mid = (lo + hi) / 2u;
+        if (tables[params.filter_table + mid] <= u) {
+            lo = mid + 1u;
+        } else {
+            hi = mid;
+        }
+    }
+    let bin = clamp(lo, 1u, FILTER_BINS) - 1u;
+    let c0 = tables[params.filter_table + bin];
+    let c1 = tables[params.filter_table + bin + 1u];
+    var within = 0.5;
+    if (c1 > c0) {
+        within = (u - c0) / (c1 - c0);
+    }
+    let width = 2.0 * radius / f32(FILTER_BINS);
+    return -radius + (f32(bin) + within) * width;
 }
 
 fn spawn(origin: vec3<f32>, direction: vec3<f32>) -> Ray {
@@ -1542,7 +1861,10 @@ fn trace(camera: Ray) -> vec3<f32> {
     loop {
         let hit = traverse(ray, false);
         if (hit.primitive == NONE) {
-            let background = background_radiance(ray.direction);
+            var background = background_radiance(ray.direction);
+            if (depth == 0u && (params.render_flags & RENDER_HIDE_EMITTERS) != 0u) {
+                background = vec3<f32>(0.0);
+            }
             if (depth == 0u) {
                 first_albedo = clamp(background, vec3<f32>(0.0), vec3<f32>(1.0));
             }
@@ -1558,6 +1880,11 @@ fn trace(camera: Ray) -> vec3<f32> {
         let material = material_index(hit_material(hit));
         let mbase = material * MATERIAL_STRIDE;
         let m3 = materials[mbase + 3u];
+        // Hidden emitters are not there for camera rays (Mitsuba's hide_emitters).
+        if (depth == 0u && (params.render_flags & RENDER_HIDE_EMITTERS) != 0u && bitcast<u32>(m3.y) != EMITTER_NONE) {
+            ray = spawn(ray.origin + ray.direction * hit.t, ray.direction);
+            continue;
+        }
         let textured = bitcast<u32>(materials[mbase].w) != NONE || bitcast<u32>(materials[mbase + 1u].w) != NONE;
         let si = surface(ray, hit, textured);
 
@@ -1748,8 +2075,16 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
     var normal = accum[slot + 2u];
     for (var s = 0u; s < params.samples; s += 1u) {
         rng_seed(pixel, params.first_sample + s);
-        let offset = next_2d();
-        let ray = camera_ray(f32(x) + offset.x, f32(j) + offset.y);
+        var offset = next_2d();
+        if (params.filter_kind != FILTER_BOX) {
+            // The sample placed by importance-sampling the filter around the pixel's centre.
+            offset = vec2<f32>(0.5 + filter_sample(offset.x), 0.5 + filter_sample(offset.y));
+        }
+        var lens = vec2<f32>(0.5);
+        if (params.lens.x > 0.0) {
+            lens = next_2d();
+        }
+        let ray = camera_ray(f32(x) + offset.x, f32(j) + offset.y, lens);
         let radiance = trace(ray);
         if (loop_limit_reached()) {
             // This sample and the pass's remaining ones are lost: the host reports it.

@@ -67,6 +67,19 @@ fn render_gpu(gpu: &GpuRenderer, parts: &SceneParts, samples: u32, seed: u64) ->
 
 /// Renders `parts` on both back ends and applies the criterion, then the negative control.
 fn compare(test: &str, parts: &SceneParts, gpu_samples: u32, cpu_samples: u32) {
+    compare_with_control(test, parts, None, gpu_samples, cpu_samples);
+}
+
+/// `compare`, and where `without` is given (the scene with the feature under test taken
+/// away), a second negative control: the GPU's render of `without` must fail against the
+/// CPU's of `parts`, so the test can tell whether the feature was rendered at all.
+fn compare_with_control(
+    test: &str,
+    parts: &SceneParts,
+    without: Option<&SceneParts>,
+    gpu_samples: u32,
+    cpu_samples: u32,
+) {
     let Some(gpu) = gpu(test) else {
         return;
     };
@@ -98,6 +111,19 @@ fn compare(test: &str, parts: &SceneParts, gpu_samples: u32, cpu_samples: u32) {
         dark.as_ref().unwrap_or_else(|e| e)
     );
     assert!(dark.is_err(), "{test}: a 3% darker GPU image passed");
+    if let Some(without) = without {
+        let w1 = render_gpu(&gpu, without, gpu_samples / 2, 1);
+        let w2 = render_gpu(&gpu, without, gpu_samples / 2, 2);
+        let verdict = judge(&criterion, (&w1, &w2), cpu);
+        println!(
+            "{test}: GPU without the feature (must fail): {}",
+            verdict.as_ref().unwrap_or_else(|e| e)
+        );
+        assert!(
+            verdict.is_err(),
+            "{test}: the GPU without the feature passed"
+        );
+    }
 }
 
 fn samples(variable: &str, default: u32) -> u32 {
@@ -490,4 +516,264 @@ fn physical_surfaces_and_wrappers_agree_with_the_cpu() {
         samples("GLINT_GPU_TEST_SPP", 256),
         samples("GLINT_CPU_TEST_SPP", 2048),
     );
+}
+
+// ---------------------------------------------------------------------------------------
+// Mitsuba's emitters, its envmap, pixel filters, the thin lens and the scene's defaults.
+
+/// A floor, three spheres (diffuse, glossy, mirror) and a back wall under `lights` and
+/// `background`, seen from above the floor.
+fn lit_scene(lights: Vec<Light>, background: Background) -> SceneParts {
+    let materials = vec![
+        Material::Diffuse {
+            diffuse: Color::splat(0.7).into(),
+        },
+        Material::Diffuse {
+            diffuse: Color::new(0.8, 0.3, 0.2).into(),
+        },
+        Material::BlinnPhong {
+            diffuse: Color::new(0.2, 0.4, 0.7).into(),
+            specular: Color::splat(0.3).into(),
+            phong_exponent: 25.0,
+            mirror_coef: 0.0,
+        },
+        Material::Mirror { roughness: 0.0 },
+    ];
+    SceneParts {
+        physical: Default::default(),
+        camera: Camera::new(
+            Projection::Perspective,
+            Vec3::new(0.0, 1.6, 4.0),
+            Vec3::new(0.0, -0.35, -1.0),
+            0.5,
+            0.5,
+        ),
+        materials,
+        textures: vec![],
+        lights,
+        background,
+        geometries: vec![GeometryDesc {
+            shapes: vec![
+                Shape::Box {
+                    min: Vec3::new(-3.0, -0.2, -3.0),
+                    max: Vec3::new(3.0, 0.0, 3.0),
+                },
+                Shape::Box {
+                    min: Vec3::new(-3.0, 0.0, -3.2),
+                    max: Vec3::new(3.0, 1.2, -3.0),
+                },
+                Shape::Sphere {
+                    center: Vec3::new(-0.9, 0.5, 0.0),
+                    radius: 0.5,
+                },
+                Shape::Sphere {
+                    center: Vec3::new(0.3, 0.5, -0.8),
+                    radius: 0.5,
+                },
+                Shape::Sphere {
+                    center: Vec3::new(1.1, 0.35, 0.7),
+                    radius: 0.35,
+                },
+            ],
+            materials: vec![0, 0, 1, 2, 3],
+        }],
+        instances: vec![Instance {
+            geometry: 0,
+            transform: None,
+            material: None,
+            casts_shadow: true,
+        }],
+    }
+}
+
+fn gpu_spp() -> u32 {
+    samples("GLINT_GPU_TEST_SPP", 256)
+}
+
+fn cpu_spp() -> u32 {
+    samples("GLINT_CPU_TEST_SPP", 2048)
+}
+
+/// A spot above the floor shining down (its +z turned to −y), the falloff ring between
+/// the beam width and the cutoff inside the image.
+fn spot_light() -> Light {
+    Light::Spot {
+        to_world: Transform::from_matrix(
+            &Matrix4::translate(Vec3::new(-0.2, 3.0, 0.0)).mul(&Matrix4::rotate(0, 90.0)),
+        )
+        .unwrap(),
+        intensity: Color::new(9.0, 8.0, 6.0),
+        cutoff_angle: 32.0,
+        beam_width: 20.0,
+        texture: None,
+    }
+}
+
+#[test]
+fn spot_light_agrees_with_the_cpu() {
+    let parts = lit_scene(vec![spot_light()], Background::Color(Color::ZERO));
+    // Without the spot the image is black: a point light at its place instead.
+    let point = lit_scene(
+        vec![Light::Point {
+            position: Vec3::new(-0.2, 3.0, 0.0),
+            intensity: Color::new(9.0, 8.0, 6.0),
+        }],
+        Background::Color(Color::ZERO),
+    );
+    compare_with_control("spot", &parts, Some(&point), gpu_spp(), cpu_spp());
+}
+
+#[test]
+fn directional_light_agrees_with_the_cpu() {
+    let light = Light::Directional {
+        direction: Vec3::new(0.4, -1.0, -0.3).normalized(),
+        irradiance: Color::new(1.5, 1.4, 1.2),
+    };
+    let parts = lit_scene(vec![light], Background::Color(Color::ZERO));
+    // The light from the other side: the shadows and shading move.
+    let other = lit_scene(
+        vec![Light::Directional {
+            direction: Vec3::new(-0.4, -1.0, -0.3).normalized(),
+            irradiance: Color::new(1.5, 1.4, 1.2),
+        }],
+        Background::Color(Color::ZERO),
+    );
+    compare_with_control("directional", &parts, Some(&other), gpu_spp(), cpu_spp());
+}
+
+/// A 32x16 lat-long sky: a gradient from a blue zenith to a dark ground, with a small bright
+/// sun, turned about y and tilted, times 1.2.
+fn envmap(turn: f64) -> Background {
+    let sky = image(32, 16, |x, y| {
+        if (20..22).contains(&x) && (4..6).contains(&y) {
+            Color::new(30.0, 26.0, 20.0)
+        } else if y < 8 {
+            Color::new(0.3, 0.45, 0.8) * (1.0 - y as f32 / 10.0) + Color::splat(0.02 * x as f32)
+        } else {
+            Color::new(0.15, 0.12, 0.1) * (1.0 + 0.05 * x as f32)
+        }
+    });
+    Background::Environment {
+        image: Box::new(sky),
+        scale: 1.2,
+        to_world: Transform::from_matrix(&Matrix4::rotate(1, turn).mul(&Matrix4::rotate(0, 10.0)))
+            .unwrap(),
+    }
+}
+
+#[test]
+fn envmap_lights_and_is_seen_as_the_cpu_renders_it() {
+    let parts = lit_scene(vec![], envmap(40.0));
+    // The same map turned the other way.
+    let turned = lit_scene(vec![], envmap(-40.0));
+    compare_with_control("envmap", &parts, Some(&turned), gpu_spp(), cpu_spp());
+}
+
+/// A black box's slanted edge against a grey sky, seen by an orthographic camera: pixels away
+/// from the edge are exact, pixels near it are what the filter makes of the edge.
+fn edge_scene(filter: glint_render::PixelFilter) -> SceneParts {
+    let mut parts = SceneParts {
+        physical: Default::default(),
+        camera: Camera::new(
+            Projection::Orthographic,
+            Vec3::new(0.0, 0.0, 5.0),
+            -Vec3::Z,
+            1.0,
+            4.0,
+        ),
+        materials: vec![Material::Diffuse {
+            diffuse: Color::ZERO.into(),
+        }],
+        textures: vec![],
+        lights: vec![],
+        background: Background::Color(Color::new(0.8, 0.7, 0.6)),
+        geometries: vec![GeometryDesc {
+            shapes: vec![Shape::Box {
+                min: Vec3::new(-4.0, -4.0, -1.0),
+                max: Vec3::new(0.1, 4.0, 1.0),
+            }],
+            materials: vec![0],
+        }],
+        instances: vec![Instance {
+            geometry: 0,
+            transform: Some(Transform::from_matrix(&Matrix4::rotate(2, 12.0)).unwrap()),
+            material: None,
+            casts_shadow: true,
+        }],
+    };
+    parts.physical.defaults.filter = filter;
+    parts
+}
+
+#[test]
+fn tent_filter_agrees_with_the_cpu_and_differs_from_a_box() {
+    use glint_render::PixelFilter;
+    let tent = edge_scene(PixelFilter::Tent { radius: 1.0 });
+    let boxed = edge_scene(PixelFilter::Box);
+    compare_with_control("tent", &tent, Some(&boxed), gpu_spp(), cpu_spp());
+}
+
+#[test]
+fn gaussian_filter_agrees_with_the_cpu_and_differs_from_a_box() {
+    use glint_render::PixelFilter;
+    let gaussian = edge_scene(PixelFilter::Gaussian { stddev: 0.5 });
+    let boxed = edge_scene(PixelFilter::Box);
+    compare_with_control("gaussian", &gaussian, Some(&boxed), gpu_spp(), cpu_spp());
+}
+
+/// The lit scene under a point and an area light.
+fn course_lit_scene() -> SceneParts {
+    lit_scene(
+        vec![
+            Light::Point {
+                position: Vec3::new(2.0, 3.0, 2.5),
+                intensity: Color::splat(6.0),
+            },
+            Light::Area {
+                position: Vec3::new(0.0, 2.4, 0.5),
+                normal: -Vec3::Y,
+                width: 0.8,
+                length: 0.6,
+                intensity: Color::splat(5.0),
+            },
+        ],
+        Background::Color(Color::new(0.1, 0.12, 0.15)),
+    )
+}
+
+#[test]
+fn thin_lens_agrees_with_the_cpu() {
+    let pinhole = course_lit_scene();
+    let mut lens = pinhole.clone();
+    // Focused in front of the spheres: they and the wall blur by pixels.
+    lens.camera.lens = Some(glint_render::ThinLens {
+        focus_distance: 3.0,
+        radius: 0.4,
+    });
+    compare_with_control("thin lens", &lens, Some(&pinhole), gpu_spp(), cpu_spp());
+}
+
+#[test]
+fn hidden_emitters_agree_with_the_cpu() {
+    let mut shown = course_lit_scene();
+    // An emitting sphere in view, and a sky: hidden from the camera, not from the paths.
+    shown.materials.push(Material::Emissive {
+        radiance: Color::new(3.0, 2.0, 1.0),
+        surface: None,
+        light: Some(2),
+    });
+    shown.lights.push(Light::Sphere {
+        center: Vec3::new(-1.0, 0.3, 1.5),
+        radius: 0.3,
+        intensity: Color::new(3.0, 2.0, 1.0),
+    });
+    shown.geometries[0].shapes.push(Shape::Sphere {
+        center: Vec3::new(-1.0, 0.3, 1.5),
+        radius: 0.3,
+    });
+    shown.geometries[0].materials.push(4);
+    shown.background = Background::Color(Color::new(0.3, 0.4, 0.6));
+    let mut hidden = shown.clone();
+    hidden.physical.defaults.hide_emitters = true;
+    compare_with_control("hide_emitters", &hidden, Some(&shown), gpu_spp(), cpu_spp());
 }

@@ -88,7 +88,9 @@ pub const MAX_SAMPLES_PER_PIXEL: u32 = 1 << 24;
 pub use accel::build::{BuildPhases, SplitMethod};
 pub use camera::{Camera, Projection, ThinLens};
 pub use geometry::{Aabb, Shape};
+pub use integrator::path::FilterSampler;
 pub use light::sampler::CubeDistribution;
+pub use light::sampler::LatLongDistribution;
 pub use light::sampler::LightSelection;
 pub use light::Light;
 pub use material::physical::{

@@ -613,8 +613,9 @@ fn unoccluded(
 /// Places a camera sample in its pixel by importance-sampling the reconstruction filter, one
 /// axis at a time (the filters are separable), so that a pixel's mean is the filter-weighted
 /// mean of the radiance around its centre, as Mitsuba's film computes it.
+/// Public so that the GPU back end uploads its table instead of computing its own.
 #[derive(Clone, Debug)]
-pub(crate) struct FilterSampler {
+pub struct FilterSampler {
     /// Half-width in pixels; 0 for the box, whose offsets are the uniform numbers themselves.
     radius: f32,
     /// The filter's cumulative distribution over `BINS` equal bins of [−radius, radius].
@@ -622,9 +623,11 @@ pub(crate) struct FilterSampler {
 }
 
 impl FilterSampler {
-    const BINS: usize = 1024;
+    /// Bins of the table (`cdf` has one more entry).
+    pub const BINS: usize = 1024;
 
-    pub(crate) fn new(filter: PixelFilter) -> FilterSampler {
+    /// The sampler of `filter`.
+    pub fn new(filter: PixelFilter) -> FilterSampler {
         let (radius, weight): (f32, Box<dyn Fn(f32) -> f64>) = match filter {
             PixelFilter::Box => {
                 return FilterSampler {
@@ -666,6 +669,17 @@ impl FilterSampler {
             *c /= total as f32;
         }
         FilterSampler { radius, cdf }
+    }
+
+    /// Half-width in pixels; 0 for the box.
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// The filter's cumulative distribution over `BINS` equal bins of [−radius, radius]
+    /// (`BINS` + 1 entries); empty for the box.
+    pub fn cdf(&self) -> &[f32] {
+        &self.cdf
     }
 
     /// The offset in [0, 1)² of the pixel's corner (outside it for wide filters) for the

@@ -1439,6 +1439,22 @@ impl LatLongDistribution {
         ))
     }
 
+    /// Cells across (the padded map's columns) and down (its rows − 1).
+    pub fn cells(&self) -> (u32, u32) {
+        (self.columns, self.rows)
+    }
+
+    /// Cumulative probability of the rows of cells before row r (rows + 1 entries, the last
+    /// 1).
+    pub fn row_cdf(&self) -> &[f32] {
+        &self.row_cdf
+    }
+
+    /// Per row of cells, columns + 1 cumulative probabilities, one row after another.
+    pub fn column_cdf(&self) -> &[f32] {
+        &self.column_cdf
+    }
+
     fn row_columns(&self, row: usize) -> &[f32] {
         let stride = self.columns as usize + 1;
         &self.column_cdf[row * stride..(row + 1) * stride]
