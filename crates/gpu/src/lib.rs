@@ -93,7 +93,7 @@ pub fn check_supported(parts: &SceneParts, settings: &RenderSettings) -> Result<
 /// gaussian filters and its `hide_emitters` are rendered. Media come first: the medium is
 /// what a user would move to the CPU for.
 pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
-    use glint_render::{BsdfNode, Light, Material};
+    use glint_render::{BsdfNode, Material};
     if let Some(medium) = parts.physical.media.first() {
         let kind = if medium.is_homogeneous() {
             "homogeneous"
@@ -129,19 +129,6 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
                 | BsdfNode::Blend { .. }
                 | BsdfNode::Null
         )
-    }
-    for light in &parts.lights {
-        let name = match light {
-            Light::Spot {
-                texture: Some(_), ..
-            } => "spot (with a texture)",
-            Light::Projector { .. } => "projector",
-            Light::TexturedTriangles { .. } => "area (with a textured radiance)",
-            _ => continue,
-        };
-        return Some(format!(
-            "the {name} emitter (the GPU kernel reads no texture node yet)"
-        ));
     }
     fn bsdf_name(node: &BsdfNode) -> &'static str {
         match node {
@@ -266,12 +253,23 @@ mod tests {
             assert!(super::unsupported_feature(&parts).is_none());
             super::check_supported(&parts, &settings).expect("supported");
         }
-        // A spot's cone texture needs the kernel's texture nodes.
+        // Lights that read a texture node, too.
         if let Light::Spot { texture, .. } = &mut parts.lights[0] {
             *texture = Some(0);
         }
-        let textured = super::unsupported_feature(&parts).expect("a textured spot");
-        assert!(textured.contains("spot (with a texture)"), "{textured}");
+        parts.lights.push(Light::Projector {
+            to_world: Transform::from_matrix(&Matrix4::IDENTITY).unwrap(),
+            irradiance: 0,
+            scale: 1.0,
+            fov: 40.0,
+        });
+        parts.lights.push(Light::TexturedTriangles {
+            triangles: vec![[Vec3::ZERO, Vec3::X, Vec3::Y]],
+            uvs: vec![[(0.0, 0.0), (1.0, 0.0), (0.0, 1.0)]],
+            texture: 0,
+            intensity: Color::ONE,
+        });
+        assert_eq!(super::unsupported_feature(&parts), None);
         parts.lights.truncate(1);
         parts.lights[0] = Light::Directional {
             direction: -Vec3::Y,

@@ -736,7 +736,8 @@ fn sphere_cone(reference: vec3<f32>, center: vec3<f32>, radius: f32) -> Cone {
 // image's top row): a spot's cone texture, a projector's irradiance. Until the kernel reads
 // texture nodes, `check_supported` refuses the lights that have one.
 fn light_texture(node: u32, uv: vec2<f32>) -> vec3<f32> {
-    return vec3<f32>(1.0);
+    // Lights read their texture at a uv alone, as sampler.rs does (no mesh colours).
+    return tex_eval(node, TexPoint(uv, vec2<f32>(0.0), vec3<f32>(0.0), vec3<f32>(0.0)));
 }
 
 // The sample of a light at a point (a spot, a projector): no BSDF sample finds it.
@@ -1012,6 +1013,14 @@ fn pdf_environment(direction: vec3<f32>) -> f32 {
 
 // What light `light` emits towards a ray travelling along `travel` that hit a surface with
 // normal `n`: xyz, and w = 1 on the emitting side, 0 behind it.
+// The texture node of an area light's radiance, NONE for a constant one.
+fn textured_radiance(light: u32) -> u32 {
+    if (light_kind(light) != LIGHT_TRIANGLES) {
+        return NONE;
+    }
+    return bitcast<u32>(light_word(light, 4u).x);
+}
+
 fn emission_towards(light: u32, travel: vec3<f32>, n: vec3<f32>) -> vec4<f32> {
     let radiance = light_word(light, 5u).xyz;
     switch light_kind(light) {
@@ -1893,7 +1902,13 @@ fn trace(camera: Ray) -> vec3<f32> {
         if (emitter != EMITTER_NONE) {
             var emitted = vec4<f32>(0.0);
             if (emitter == EMITTER_LIGHT) {
-                emitted = emission_towards(bitcast<u32>(m3.z), ray.direction, si.normal);
+                let light = bitcast<u32>(m3.z);
+                emitted = emission_towards(light, ray.direction, si.normal);
+                let texture = textured_radiance(light);
+                if (texture != NONE && emitted.w > 0.5) {
+                    // A textured radiance, read where the path meets it (path.rs `emitted`).
+                    emitted = vec4<f32>(emitted.xyz * tex_eval(texture, physical_surface(ray, hit).tex), emitted.w);
+                }
             } else {
                 emitted = vec4<f32>(materials[mbase + 5u].xyz, select(0.0, 1.0, dot(ray.direction, si.normal) < 0.0));
             }

@@ -777,3 +777,121 @@ fn hidden_emitters_agree_with_the_cpu() {
     hidden.physical.defaults.hide_emitters = true;
     compare_with_control("hide_emitters", &hidden, Some(&shown), gpu_spp(), cpu_spp());
 }
+
+/// `lit_scene` under three lights that read a texture node (a bilinear 4x4 bitmap, `flip`
+/// mirroring it): a spot with a cone texture, a projector, and an area emitter of two
+/// triangles whose radiance is textured, seen directly too (its uvs are the mesh's).
+fn textured_lights_scene(flip: bool) -> SceneParts {
+    use glint_render::{
+        MeshAttributes, PhysicalParts, TexelFilter, TextureKind, TextureNode, Wrap,
+    };
+    let mut parts = lit_scene(vec![], Background::Color(Color::ZERO));
+    parts.textures.push(image(4, 4, |x, y| {
+        let x = if flip { 3 - x } else { x };
+        Color::new(
+            0.2 + 0.25 * x as f32,
+            0.3 + 0.2 * y as f32,
+            1.0 - 0.2 * x as f32,
+        )
+    }));
+    parts.physical = PhysicalParts {
+        textures: vec![TextureNode {
+            kind: TextureKind::Bitmap {
+                image: 0,
+                filter: TexelFilter::Bilinear,
+                wrap: [Wrap::Clamp; 2],
+            },
+            to_uv: glint_render::IDENTITY_UV,
+            uv_set: 0,
+        }],
+        ..PhysicalParts::default()
+    };
+    let Light::Spot {
+        to_world,
+        intensity,
+        cutoff_angle,
+        beam_width,
+        ..
+    } = spot_light()
+    else {
+        unreachable!()
+    };
+    parts.lights.push(Light::Spot {
+        to_world,
+        intensity,
+        cutoff_angle,
+        beam_width,
+        texture: Some(0),
+    });
+    parts.lights.push(Light::Projector {
+        to_world: Transform::from_matrix(
+            &Matrix4::translate(Vec3::new(1.5, 2.0, 2.0))
+                .mul(&Matrix4::rotate(1, 200.0))
+                .mul(&Matrix4::rotate(0, 35.0)),
+        )
+        .unwrap(),
+        irradiance: 0,
+        scale: 6.0,
+        fov: 40.0,
+    });
+    // A quad above the scene, facing down, its corners' uvs spanning the image.
+    let (a, b, c, d) = (
+        Vec3::new(-1.6, 2.2, -1.8),
+        Vec3::new(-0.4, 2.2, -1.8),
+        Vec3::new(-0.4, 2.2, -0.6),
+        Vec3::new(-1.6, 2.2, -0.6),
+    );
+    let triangles = vec![[a, c, b], [a, d, c]];
+    let uvs = vec![
+        [(0.0, 0.0), (1.0, 1.0), (1.0, 0.0)],
+        [(0.0, 0.0), (0.0, 1.0), (1.0, 1.0)],
+    ];
+    let light = parts.lights.len() as u32;
+    parts.lights.push(Light::TexturedTriangles {
+        triangles: triangles.clone(),
+        uvs: uvs.clone(),
+        texture: 0,
+        intensity: Color::splat(4.0),
+    });
+    parts.materials.push(Material::Emissive {
+        radiance: Color::splat(4.0),
+        surface: None,
+        light: Some(light),
+    });
+    let emitter = parts.materials.len() as u32 - 1;
+    parts.geometries.push(GeometryDesc {
+        shapes: triangles
+            .iter()
+            .map(|&vertices| Shape::Triangle { vertices })
+            .collect(),
+        materials: vec![emitter; 2],
+    });
+    parts.physical.attributes = vec![
+        None,
+        Some(MeshAttributes {
+            uvs: Some(uvs),
+            ..MeshAttributes::default()
+        }),
+    ];
+    parts.instances.push(Instance {
+        geometry: 1,
+        transform: None,
+        material: None,
+        casts_shadow: false,
+    });
+    parts
+}
+
+#[test]
+fn textured_spot_projector_and_area_emitter_agree_with_the_cpu() {
+    let parts = textured_lights_scene(false);
+    // The same lights with their texture mirrored.
+    let mirrored = textured_lights_scene(true);
+    compare_with_control(
+        "textured lights",
+        &parts,
+        Some(&mirrored),
+        gpu_spp(),
+        cpu_spp(),
+    );
+}
