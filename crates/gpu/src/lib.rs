@@ -126,6 +126,8 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
                 | BsdfNode::Mask { .. }
                 | BsdfNode::Blend { .. }
                 | BsdfNode::Null
+                | BsdfNode::Principled(_)
+                | BsdfNode::PrincipledThin(_)
         )
     }
     for light in &parts.lights {
