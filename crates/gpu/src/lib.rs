@@ -128,6 +128,8 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
                 | BsdfNode::Mask { .. }
                 | BsdfNode::Blend { .. }
                 | BsdfNode::Null
+                | BsdfNode::Principled(_)
+                | BsdfNode::PrincipledThin(_)
         )
     }
     fn bsdf_name(node: &BsdfNode) -> &'static str {
@@ -384,6 +386,19 @@ mod tests {
             ("SPHERE_MITSUBA_UV", SPHERE_MITSUBA_UV),
             ("DIST_BECKMANN", DIST_BECKMANN),
             ("DIST_GGX", DIST_GGX),
+            ("PRINCIPLED_BASE_COLOR", PRINCIPLED_BASE_COLOR),
+            ("PRINCIPLED_ROUGHNESS", PRINCIPLED_ROUGHNESS),
+            ("PRINCIPLED_ANISOTROPIC", PRINCIPLED_ANISOTROPIC),
+            ("PRINCIPLED_METALLIC", PRINCIPLED_METALLIC),
+            ("PRINCIPLED_SPEC_TRANS", PRINCIPLED_SPEC_TRANS),
+            ("PRINCIPLED_ETA", PRINCIPLED_ETA),
+            ("PRINCIPLED_SPEC_TINT", PRINCIPLED_SPEC_TINT),
+            ("PRINCIPLED_SHEEN", PRINCIPLED_SHEEN),
+            ("PRINCIPLED_SHEEN_TINT", PRINCIPLED_SHEEN_TINT),
+            ("PRINCIPLED_CLEARCOAT", PRINCIPLED_CLEARCOAT),
+            ("PRINCIPLED_CLEARCOAT_GLOSS", PRINCIPLED_CLEARCOAT_GLOSS),
+            ("PRINCIPLED_FLATNESS", PRINCIPLED_FLATNESS),
+            ("PRINCIPLED_DIFF_TRANS", PRINCIPLED_DIFF_TRANS),
             ("PROBE_STRIDE", crate::device::PROBE_STRIDE as u32),
             ("MICROFACET_STRIDE", crate::device::MICROFACET_STRIDE as u32),
         ];
@@ -394,6 +409,61 @@ mod tests {
             kernel_constant("ACCUM_STRIDE") as usize * 16,
             crate::device::ACCUM_BYTES_PER_PIXEL
         );
+    }
+
+    /// A principled record holds each parameter at the word the kernel reads it from: a
+    /// record of distinct constants, read back at each `PRINCIPLED_*` word.
+    #[test]
+    fn principled_records_hold_each_parameter_at_its_word() {
+        use crate::physical::*;
+        use glint_render::{BsdfNode, Param, PhysicalParts, PrincipledParams};
+        let value = |i: u32| Param::value(0.01 * i as f32);
+        let q = PrincipledParams {
+            base_color: value(1),
+            roughness: value(2),
+            anisotropic: value(3),
+            metallic: value(4),
+            spec_trans: value(5),
+            eta: value(6),
+            spec_tint: value(7),
+            sheen: value(8),
+            sheen_tint: value(9),
+            clearcoat: value(10),
+            clearcoat_gloss: value(11),
+            flatness: value(12),
+            diff_trans: value(13),
+            sample_visible: true,
+        };
+        let words = [
+            PRINCIPLED_BASE_COLOR,
+            PRINCIPLED_ROUGHNESS,
+            PRINCIPLED_ANISOTROPIC,
+            PRINCIPLED_METALLIC,
+            PRINCIPLED_SPEC_TRANS,
+            PRINCIPLED_ETA,
+            PRINCIPLED_SPEC_TINT,
+            PRINCIPLED_SHEEN,
+            PRINCIPLED_SHEEN_TINT,
+            PRINCIPLED_CLEARCOAT,
+            PRINCIPLED_CLEARCOAT_GLOSS,
+            PRINCIPLED_FLATNESS,
+            PRINCIPLED_DIFF_TRANS,
+        ];
+        for node in [
+            BsdfNode::Principled(Box::new(q.clone())),
+            BsdfNode::PrincipledThin(Box::new(q.clone())),
+        ] {
+            let physical = PhysicalParts {
+                bsdfs: vec![node],
+                ..PhysicalParts::default()
+            };
+            let buffer = PhysicalBuffer::new(&physical, 0);
+            for (i, &word) in words.iter().enumerate() {
+                let expected = 0.01 * (i + 1) as f32;
+                assert_eq!(buffer.words[word as usize][0], expected, "word {word}");
+            }
+            assert_eq!(buffer.words[0][1].to_bits(), 1, "sample visible");
+        }
     }
 
     /// The kernel's `Params` has the Rust struct's size: as many u32 and vec4 fields.

@@ -53,6 +53,22 @@ pub const SPHERE_MITSUBA_UV: u32 = 1;
 pub const DIST_BECKMANN: u32 = 0;
 pub const DIST_GGX: u32 = 1;
 
+/// The word of each parameter in a principled or principledthin record, after its header
+/// (`PrincipledParams` order, as `node_record` writes them).
+pub const PRINCIPLED_BASE_COLOR: u32 = 1;
+pub const PRINCIPLED_ROUGHNESS: u32 = 2;
+pub const PRINCIPLED_ANISOTROPIC: u32 = 3;
+pub const PRINCIPLED_METALLIC: u32 = 4;
+pub const PRINCIPLED_SPEC_TRANS: u32 = 5;
+pub const PRINCIPLED_ETA: u32 = 6;
+pub const PRINCIPLED_SPEC_TINT: u32 = 7;
+pub const PRINCIPLED_SHEEN: u32 = 8;
+pub const PRINCIPLED_SHEEN_TINT: u32 = 9;
+pub const PRINCIPLED_CLEARCOAT: u32 = 10;
+pub const PRINCIPLED_CLEARCOAT_GLOSS: u32 = 11;
+pub const PRINCIPLED_FLATNESS: u32 = 12;
+pub const PRINCIPLED_DIFF_TRANS: u32 = 13;
+
 /// glTF alpha modes in a glTF record's flags (bits 3 and 4).
 pub const GLTF_VERTEX_COLOR: u32 = 1;
 pub const GLTF_THIN_WALLED: u32 = 2;
@@ -206,24 +222,27 @@ fn node_record(node: &BsdfNode, textures: usize, out: &mut Vec<[f32; 4]>) {
             } else {
                 NODE_PRINCIPLED_THIN
             };
-            out.push([bits(kind), bits(u32::from(q.sample_visible)), 0.0, 0.0]);
-            for x in [
-                &q.base_color,
-                &q.roughness,
-                &q.anisotropic,
-                &q.metallic,
-                &q.spec_trans,
-                &q.eta,
-                &q.spec_tint,
-                &q.sheen,
-                &q.sheen_tint,
-                &q.clearcoat,
-                &q.clearcoat_gloss,
-                &q.flatness,
-                &q.diff_trans,
+            // Each parameter at the word the kernel reads it from.
+            let mut words = [[0.0; 4]; PRINCIPLED_DIFF_TRANS as usize + 1];
+            words[0] = [bits(kind), bits(u32::from(q.sample_visible)), 0.0, 0.0];
+            for (word, x) in [
+                (PRINCIPLED_BASE_COLOR, &q.base_color),
+                (PRINCIPLED_ROUGHNESS, &q.roughness),
+                (PRINCIPLED_ANISOTROPIC, &q.anisotropic),
+                (PRINCIPLED_METALLIC, &q.metallic),
+                (PRINCIPLED_SPEC_TRANS, &q.spec_trans),
+                (PRINCIPLED_ETA, &q.eta),
+                (PRINCIPLED_SPEC_TINT, &q.spec_tint),
+                (PRINCIPLED_SHEEN, &q.sheen),
+                (PRINCIPLED_SHEEN_TINT, &q.sheen_tint),
+                (PRINCIPLED_CLEARCOAT, &q.clearcoat),
+                (PRINCIPLED_CLEARCOAT_GLOSS, &q.clearcoat_gloss),
+                (PRINCIPLED_FLATNESS, &q.flatness),
+                (PRINCIPLED_DIFF_TRANS, &q.diff_trans),
             ] {
-                out.push(p(x));
+                words[word as usize] = p(x);
             }
+            out.extend(words);
         }
         BsdfNode::TwoSided { front, back } => {
             out.push([bits(NODE_TWOSIDED), bits(*front), bits(*back), 0.0]);
