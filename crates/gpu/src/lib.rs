@@ -126,6 +126,7 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
                 | BsdfNode::Mask { .. }
                 | BsdfNode::Blend { .. }
                 | BsdfNode::Null
+                | BsdfNode::Gltf(_)
         )
     }
     for light in &parts.lights {
@@ -301,6 +302,11 @@ mod tests {
             ("SPHERE_MITSUBA_UV", SPHERE_MITSUBA_UV),
             ("DIST_BECKMANN", DIST_BECKMANN),
             ("DIST_GGX", DIST_GGX),
+            ("GLTF_VERTEX_COLOR", GLTF_VERTEX_COLOR),
+            ("GLTF_THIN_WALLED", GLTF_THIN_WALLED),
+            ("GLTF_DOUBLE_SIDED", GLTF_DOUBLE_SIDED),
+            ("GLTF_ALPHA_MASK", GLTF_ALPHA_MASK),
+            ("GLTF_ALPHA_BLEND", GLTF_ALPHA_BLEND),
             ("PROBE_STRIDE", crate::device::PROBE_STRIDE as u32),
         ];
         for &(name, value) in constants.iter().chain(physical) {
