@@ -130,6 +130,7 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
                 | BsdfNode::Null
                 | BsdfNode::Principled(_)
                 | BsdfNode::PrincipledThin(_)
+                | BsdfNode::Gltf(_)
         )
     }
     fn bsdf_name(node: &BsdfNode) -> &'static str {
@@ -399,6 +400,11 @@ mod tests {
             ("PRINCIPLED_CLEARCOAT_GLOSS", PRINCIPLED_CLEARCOAT_GLOSS),
             ("PRINCIPLED_FLATNESS", PRINCIPLED_FLATNESS),
             ("PRINCIPLED_DIFF_TRANS", PRINCIPLED_DIFF_TRANS),
+            ("GLTF_VERTEX_COLOR", GLTF_VERTEX_COLOR),
+            ("GLTF_THIN_WALLED", GLTF_THIN_WALLED),
+            ("GLTF_DOUBLE_SIDED", GLTF_DOUBLE_SIDED),
+            ("GLTF_ALPHA_MASK", GLTF_ALPHA_MASK),
+            ("GLTF_ALPHA_BLEND", GLTF_ALPHA_BLEND),
             ("PROBE_STRIDE", crate::device::PROBE_STRIDE as u32),
             ("MICROFACET_STRIDE", crate::device::MICROFACET_STRIDE as u32),
         ];
