@@ -120,6 +120,9 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
         matches!(
             node,
             BsdfNode::Diffuse { .. }
+                | BsdfNode::Conductor { .. }
+                | BsdfNode::Dielectric { .. }
+                | BsdfNode::ThinDielectric { .. }
                 | BsdfNode::TwoSided { .. }
                 | BsdfNode::NormalMap { .. }
                 | BsdfNode::BumpMap { .. }
