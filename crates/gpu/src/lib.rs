@@ -123,6 +123,7 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
                 | BsdfNode::Conductor { .. }
                 | BsdfNode::Dielectric { .. }
                 | BsdfNode::ThinDielectric { .. }
+                | BsdfNode::Plastic { .. }
                 | BsdfNode::TwoSided { .. }
                 | BsdfNode::NormalMap { .. }
                 | BsdfNode::BumpMap { .. }
@@ -304,6 +305,8 @@ mod tests {
             ("SPHERE_MITSUBA_UV", SPHERE_MITSUBA_UV),
             ("DIST_BECKMANN", DIST_BECKMANN),
             ("DIST_GGX", DIST_GGX),
+            ("PLASTIC_TABLE_WORD", PLASTIC_TABLE_WORD),
+            ("PLASTIC_TABLE_RES", PLASTIC_TABLE_RES),
             ("PROBE_STRIDE", crate::device::PROBE_STRIDE as u32),
         ];
         for &(name, value) in constants.iter().chain(physical) {
