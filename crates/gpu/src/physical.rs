@@ -139,6 +139,7 @@ fn texture_or_none(t: Option<u32>, textures: usize) -> f32 {
 ///   roughness, normal scale, 0], texture nodes [base colour, alpha, metallic-roughness,
 ///   normal], [specular, specular colour, transmission, clearcoat], [clearcoat roughness,
 ///   0, 0, 0].
+///
 /// `prepared` is the node's rough plastic tables, where it is one.
 fn node_record(
     node: &BsdfNode,
