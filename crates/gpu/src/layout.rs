@@ -256,7 +256,7 @@ impl FlatScene {
         let mut nodes: Vec<[f32; 4]> = Vec::new();
         let mut prims: Vec<[f32; 4]> = Vec::new();
         let mut roots = Vec::with_capacity(parts.geometries.len());
-        let mut physical = PhysicalBuffer::new(&parts.physical, parts.textures.len());
+        let mut physical = PhysicalBuffer::new(&parts.physical, &parts.textures);
         for (g, geometry) in parts.geometries.iter().enumerate() {
             let attributes = parts.physical.attributes.get(g).and_then(Option::as_ref);
             let primitives: Vec<Primitive> = geometry

@@ -122,6 +122,10 @@ pub fn unsupported_feature(parts: &SceneParts) -> Option<String> {
         matches!(
             node,
             BsdfNode::Diffuse { .. }
+                | BsdfNode::Conductor { .. }
+                | BsdfNode::Dielectric { .. }
+                | BsdfNode::ThinDielectric { .. }
+                | BsdfNode::Plastic { .. }
                 | BsdfNode::TwoSided { .. }
                 | BsdfNode::NormalMap { .. }
                 | BsdfNode::BumpMap { .. }
@@ -405,6 +409,8 @@ mod tests {
             ("GLTF_DOUBLE_SIDED", GLTF_DOUBLE_SIDED),
             ("GLTF_ALPHA_MASK", GLTF_ALPHA_MASK),
             ("GLTF_ALPHA_BLEND", GLTF_ALPHA_BLEND),
+            ("PLASTIC_TABLE_WORD", PLASTIC_TABLE_WORD),
+            ("PLASTIC_TABLE_RES", PLASTIC_TABLE_RES),
             ("PROBE_STRIDE", crate::device::PROBE_STRIDE as u32),
             ("MICROFACET_STRIDE", crate::device::MICROFACET_STRIDE as u32),
         ];

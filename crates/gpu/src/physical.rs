@@ -9,8 +9,9 @@
 //! `param_float`).
 
 use glint_render::{
-    BsdfNode, Color, DistributionKind, GltfAlphaMode, MeshAttributes, Param, PhysicalParts,
-    Roughness, TexelFilter, TextureKind, TextureNode, Vec3, Wrap,
+    prepare_rough_plastics, BsdfNode, Color, DistributionKind, GltfAlphaMode, Image,
+    MeshAttributes, Param, PhysicalParts, RoughPlastic, Roughness, TexelFilter, TextureKind,
+    TextureNode, Vec3, Wrap, TRANSMITTANCE_RES,
 };
 
 use crate::words::{bits, NONE};
@@ -49,6 +50,12 @@ pub const ATTR_VERTEX_COLORS: u32 = 16;
 pub const ATTR_FACE_COLOR: u32 = 32;
 /// A sphere's flag word (`prims`, its third word's x): Mitsuba's uv parameterisation.
 pub const SPHERE_MITSUBA_UV: u32 = 1;
+
+/// Where a rough plastic's tables start in its record: [internal reflectance, α, 0, 0],
+/// then its transmittance table, four entries a word.
+pub const PLASTIC_TABLE_WORD: u32 = 6;
+/// The transmittance table's length (`plastic.wgsl` PLASTIC_TABLE_RES).
+pub const PLASTIC_TABLE_RES: u32 = TRANSMITTANCE_RES as u32;
 
 pub const DIST_BECKMANN: u32 = 0;
 pub const DIST_GGX: u32 = 1;
@@ -135,6 +142,8 @@ fn texture_or_none(t: Option<u32>, textures: usize) -> f32 {
 ///   transmittance], roughness words;
 /// - thin dielectric: header c = η; [specular reflectance], [specular transmittance];
 /// - plastic: header b = rough, c = η, d = nonlinear; [diffuse], [specular], roughness words;
+///   a rough one then [internal reflectance, α of its coating, 0, 0] (at `PLASTIC_TABLE_WORD`)
+///   and its transmittance table, both from glint-render's `prepare_rough_plastics`;
 /// - principled, principled thin: header b = sample visible; base colour, roughness,
 ///   anisotropic, metallic, spec_trans, eta, spec_tint, sheen, sheen_tint, clearcoat,
 ///   clearcoat_gloss, flatness, diff_trans;
@@ -146,7 +155,14 @@ fn texture_or_none(t: Option<u32>, textures: usize) -> f32 {
 ///   roughness, normal scale, 0], texture nodes [base colour, alpha, metallic-roughness,
 ///   normal], [specular, specular colour, transmission, clearcoat], [clearcoat roughness,
 ///   0, 0, 0].
-fn node_record(node: &BsdfNode, textures: usize, out: &mut Vec<[f32; 4]>) {
+///
+/// `prepared` is the node's rough plastic tables, where it is one.
+fn node_record(
+    node: &BsdfNode,
+    textures: usize,
+    prepared: Option<&RoughPlastic>,
+    out: &mut Vec<[f32; 4]>,
+) {
     let p = |x: &Param| param(x, textures);
     match node {
         BsdfNode::Null => out.push([bits(NODE_NULL), 0.0, 0.0, 0.0]),
@@ -206,6 +222,7 @@ fn node_record(node: &BsdfNode, textures: usize, out: &mut Vec<[f32; 4]>) {
             nonlinear,
             roughness,
         } => {
+            let start = out.len();
             out.push([
                 bits(NODE_PLASTIC),
                 bits(u32::from(roughness.is_some())),
@@ -215,6 +232,25 @@ fn node_record(node: &BsdfNode, textures: usize, out: &mut Vec<[f32; 4]>) {
             out.push(p(diffuse_reflectance));
             out.push(p(specular_reflectance));
             out.extend(roughness_words(roughness.as_ref(), textures));
+            if let (Some(_), Some(tables)) = (roughness, prepared) {
+                debug_assert_eq!(out.len() - start, PLASTIC_TABLE_WORD as usize);
+                debug_assert_eq!(
+                    tables.external_transmittance.len(),
+                    PLASTIC_TABLE_RES as usize
+                );
+                out.push([
+                    tables.internal_reflectance,
+                    tables.microfacet.alpha_u,
+                    0.0,
+                    0.0,
+                ]);
+                out.extend(
+                    tables
+                        .external_transmittance
+                        .chunks(4)
+                        .map(|c| [c[0], c[1], c[2], c[3]]),
+                );
+            }
         }
         BsdfNode::Principled(q) | BsdfNode::PrincipledThin(q) => {
             let kind = if matches!(node, BsdfNode::Principled(_)) {
@@ -373,15 +409,17 @@ fn texture_words(node: &TextureNode, images: usize) -> [[f32; 4]; TEX_STRIDE] {
 }
 
 impl PhysicalBuffer {
-    /// The BSDF nodes and texture nodes of `physical`; `images` is the count of the scene's
-    /// images (`SceneParts::textures`).
-    pub fn new(physical: &PhysicalParts, images: usize) -> PhysicalBuffer {
+    /// The BSDF nodes and texture nodes of `physical`; `images` are the scene's images
+    /// (`SceneParts::textures`), which a rough plastic's tables read its roughness from.
+    pub fn new(physical: &PhysicalParts, images: &[Image]) -> PhysicalBuffer {
         let textures = physical.textures.len();
+        let prepared = prepare_rough_plastics(&physical.bsdfs, &physical.textures, images);
+        let images = images.len();
         let mut words = Vec::new();
         let mut offsets = Vec::with_capacity(physical.bsdfs.len());
-        for node in &physical.bsdfs {
+        for (node, tables) in physical.bsdfs.iter().zip(&prepared) {
             offsets.push(words.len() as u32);
-            node_record(node, textures, &mut words);
+            node_record(node, textures, tables.as_ref(), &mut words);
         }
         let bsdf_index = words.len() as u32;
         words.extend(offsets.iter().map(|&o| [bits(o), 0.0, 0.0, 0.0]));

@@ -97,7 +97,12 @@ pub use material::physical::{
     BsdfId, BsdfNode, DistributionKind, GltfAlphaMode, GltfParams, Param, PrincipledParams,
     Roughness,
 };
+/// A rough plastic's tables (its coating's transmittance by cos θ and internal reflectance),
+/// tabulated once per material; the GPU kernel reads them as the CPU does.
+pub use material::plastic::{RoughPlastic, TRANSMITTANCE_RES};
 pub use material::principled::eta_from_specular;
+/// The rough plastics' tables of a scene's BSDF nodes, by node.
+pub use material::surface::prepare_rough_plastics;
 pub use material::{Material, MaterialId};
 pub use math::{Color, Matrix4, Transform, Vec3};
 pub use medium::{Medium, MediumBoundary, MediumId, PhaseFunction, Volume, VolumeGrid};

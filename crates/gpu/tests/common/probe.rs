@@ -15,6 +15,7 @@
 
 use glint_gpu::{GpuRenderer, ProbeCase, ProbeResult};
 use glint_render::bench::{prepare_rough_plastics, Frame, PhysicalSurface, SurfaceBsdf};
+use glint_render::RoughPlastic;
 use glint_render::{
     Background, Camera, Color, Image, Material, PhysicalParts, Projection, SceneParts,
     TexturePoint, Vec3,
@@ -144,17 +145,17 @@ fn close3(a: [f32; 3], b: [f32; 3]) -> bool {
 fn difference(
     gpu: &ProbeResult,
     parts: &SceneParts,
+    prepared: &[Option<RoughPlastic>],
     case: &ProbeCase,
     surface: &PhysicalSurface,
 ) -> Option<String> {
     let p = &parts.physical;
-    let prepared = prepare_rough_plastics(&p.bsdfs, &p.textures, &parts.textures);
     let v = |a: [f32; 3]| Vec3::new(a[0], a[1], a[2]);
     let (wo, wi) = (v(case.wo), v(case.wi));
     let bsdf = SurfaceBsdf::new(
         &p.bsdfs,
         &p.textures,
-        &prepared,
+        prepared,
         &parts.textures,
         case.bsdf,
         surface,
@@ -205,12 +206,15 @@ pub fn mismatches(
     cpu_parts: &SceneParts,
     cases: &[(ProbeCase, PhysicalSurface)],
 ) -> Vec<(usize, String)> {
+    // Once, not per case: a rough plastic's tables take a million microfacet samples.
+    let p = &cpu_parts.physical;
+    let prepared = prepare_rough_plastics(&p.bsdfs, &p.textures, &cpu_parts.textures);
     results
         .iter()
         .zip(cases)
         .enumerate()
         .filter_map(|(i, (g, (case, surface)))| {
-            difference(g, cpu_parts, case, surface).map(|why| (i, why))
+            difference(g, cpu_parts, &prepared, case, surface).map(|why| (i, why))
         })
         .collect()
 }
