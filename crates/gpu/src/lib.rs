@@ -469,7 +469,7 @@ mod tests {
                 bsdfs: vec![node],
                 ..PhysicalParts::default()
             };
-            let buffer = PhysicalBuffer::new(&physical, 0);
+            let buffer = PhysicalBuffer::new(&physical, &[]);
             for (i, &word) in words.iter().enumerate() {
                 let expected = 0.01 * (i + 1) as f32;
                 assert_eq!(buffer.words[word as usize][0], expected, "word {word}");

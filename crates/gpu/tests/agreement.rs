@@ -895,3 +895,16 @@ fn textured_spot_projector_and_area_emitter_agree_with_the_cpu() {
         cpu_spp(),
     );
 }
+
+/// Every physically based family on spheres over a textured floor under an area light
+/// (`tests/scenes/families.xml`): smooth and rough conductors (anisotropic GGX, Beckmann over
+/// all normals), dielectric, roughdielectric, thindielectric, plastic, nonlinear roughplastic,
+/// principled (metallic with clearcoat and sheen; transmissive), principledthin, a twosided
+/// roughplastic.
+#[test]
+fn every_physical_family_agrees_with_the_cpu() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/scenes/families.xml");
+    let loaded = glint_io::load_scene(&path).unwrap_or_else(|error| panic!("{error}"));
+    assert!(loaded.warnings.is_empty(), "{:?}", loaded.warnings);
+    compare("families", &loaded.parts, gpu_spp(), cpu_spp());
+}

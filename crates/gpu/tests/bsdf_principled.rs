@@ -10,7 +10,6 @@
 
 mod common;
 #[path = "common/probe.rs"]
-#[allow(dead_code)] // `check_trees` probes once per call; `check` below probes once for all
 mod probe;
 
 use common::gpu;
