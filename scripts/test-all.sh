@@ -96,8 +96,9 @@ result[mitsuba-suite]=$(tail -n 1 "$logs/mitsuba.log")
 
 echo "== Mitsuba's test suite on the GPU by its rule (scripts/mitsuba-suite.sh --device gpu)"
 status=0
-# A quarter of the rule's samples: software Vulkan on CI's two cores would otherwise take
-# half an hour here; the Z-test is computed with the samples taken (mitsuba_suite.rs).
+# A quarter of the rule's samples (at least 64 a pixel, mitsuba_suite.rs): software Vulkan on
+# CI's two cores would otherwise take a quarter of an hour here; the Z-test is computed with
+# the samples taken.
 GLINT_SUITE_SAMPLE_BUDGET=500000 scripts/mitsuba-suite.sh --device gpu 2>&1 | tee "$logs/mitsuba-gpu.log" || status=$?
 result[mitsuba-suite-gpu]=$(tail -n 1 "$logs/mitsuba-gpu.log")
 [ "$status" = 0 ] || failed=1

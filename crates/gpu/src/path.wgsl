@@ -1959,18 +1959,23 @@ fn trace(camera: Ray) -> vec3<f32> {
             let u_direction = next_2d();
             let u_light = next_2d();
             let u_lobe = next_1d();
-            let continuation = phys_sample(wo_world, u_lobe, u_direction);
+            let draw = phys_draw(wo_world, u_lobe, u_direction);
+            var sample: LightSample;
+            sample.valid = false;
             if (phys_has_non_delta()) {
-                let sample = sample_light(ps.point, u_light);
-                if (sample.valid) {
-                    let fp = phys_eval_pdf(wo_world, sample.direction);
-                    if (any(fp.xyz != vec3<f32>(0.0)) && any(sample.radiance != vec3<f32>(0.0)) && unoccluded(ps.point, sample)) {
-                        var weight = 1.0;
-                        if (!sample.is_delta && sample.reachable) {
-                            weight = power_heuristic(sample.pdf, fp.w);
-                        }
-                        radiance += throughput * fp.xyz * sample.radiance * (weight / sample.pdf);
+                sample = sample_light(ps.point, u_light);
+            }
+            // The light's direction and the BSDF sample's, evaluated in one pass.
+            let pair = phys_eval_pdf_pair(wo_world, sample.direction, sample.valid, draw.s.wi, draw.mis);
+            let continuation = phys_finish(draw, pair[1]);
+            if (sample.valid) {
+                let fp = pair[0];
+                if (any(fp.xyz != vec3<f32>(0.0)) && any(sample.radiance != vec3<f32>(0.0)) && unoccluded(ps.point, sample)) {
+                    var weight = 1.0;
+                    if (!sample.is_delta && sample.reachable) {
+                        weight = power_heuristic(sample.pdf, fp.w);
                     }
+                    radiance += throughput * fp.xyz * sample.radiance * (weight / sample.pdf);
                 }
             }
             point = ps.point;

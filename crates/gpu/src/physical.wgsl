@@ -722,7 +722,7 @@ fn refract_local(w: vec3<f32>, cos_theta_t: f32, eta_ti: f32) -> vec3<f32> {
 // Leaves and their resolution (surface.rs).
 
 // A sample of a leaf or of the whole BSDF (bsdf.rs BsdfSample): `wi` local to the leaf's
-// frame from a family, world space from `phys_sample`; `weight` is f·|cos θi| / pdf.
+// frame from a family, world space from `phys_draw`; `weight` is f·|cos θi| / pdf.
 struct PhysSample {
     wi: vec3<f32>,
     weight: vec3<f32>,
@@ -1108,54 +1108,85 @@ fn phys_albedo() -> vec3<f32> {
     return clamp(sum, vec3<f32>(0.0), vec3<f32>(1.0));
 }
 
-// f·|cos θi| (xyz) and the density (w) for world directions (SurfaceBsdf::eval_pdf).
-fn phys_eval_pdf(wo: vec3<f32>, wi: vec3<f32>) -> vec4<f32> {
-    var sum = vec4<f32>(0.0);
-    for (var i = 0u; i < leaf_count; i += 1u) {
-        sum += leaf_eval_pdf(i, wo, wi) * leaves[i].weight;
-    }
-    return sum;
+// A leaf's sample of a world direction for `wo`, before the one-sample MIS of `phys_finish`
+// (`mis`: the sample is continuous and there are other leaves to weigh it against).
+struct LeafDraw {
+    s: PhysSample,
+    mis: bool,
 }
 
-// A world direction for `wo` (SurfaceBsdf::sample): a leaf chosen by weight, then a
-// continuous sample weighed against every leaf (one-sample MIS), a delta by its own
-// probability.
-fn phys_sample(wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> PhysSample {
+// The leaf `u_lobe` picks by weight, and its sample (SurfaceBsdf::sample up to the MIS). The
+// kernel calls each family's sampling from here alone: llvmpipe inlines every call, and one
+// call site keeps the kernel, and its compilation, smaller.
+fn phys_draw(wo: vec3<f32>, u_lobe: f32, u: vec2<f32>) -> LeafDraw {
     if (leaf_count == 0u) {
-        return no_sample();
+        return LeafDraw(no_sample(), false);
     }
-    if (leaf_count == 1u) {
-        return leaf_sample(0u, wo, u_lobe, u);
-    }
-    var start = 0.0;
-    var chosen = leaf_count - 1u;
-    for (var i = 0u; i < leaf_count; i += 1u) {
-        if (u_lobe < start + leaves[i].weight) {
-            chosen = i;
-            break;
+    var chosen = 0u;
+    var u_leaf = u_lobe;
+    var weight = 1.0;
+    if (leaf_count > 1u) {
+        var start = 0.0;
+        chosen = leaf_count - 1u;
+        for (var i = 0u; i < leaf_count; i += 1u) {
+            if (u_lobe < start + leaves[i].weight) {
+                chosen = i;
+                break;
+            }
+            start += leaves[i].weight;
         }
-        start += leaves[i].weight;
+        weight = leaves[chosen].weight;
+        if (weight <= 0.0) {
+            return LeafDraw(no_sample(), false);
+        }
+        u_leaf = clamp((u_lobe - start) / weight, 0.0, 1.0 - 5.9604645e-8);
     }
-    let weight = leaves[chosen].weight;
-    if (weight <= 0.0) {
-        return no_sample();
-    }
-    let u_leaf = clamp((u_lobe - start) / weight, 0.0, 1.0 - 5.9604645e-8);
     var s = leaf_sample(chosen, wo, u_leaf, u);
-    if (!s.valid) {
-        return s;
+    if (!s.valid || leaf_count == 1u) {
+        return LeafDraw(s, false);
     }
     if (s.is_specular) {
+        // A delta is not in the other leaves' densities: its weight stands, and its
+        // probability includes the choice of the leaf.
         s.pdf *= weight;
-        return s;
+        return LeafDraw(s, false);
     }
-    let fp = phys_eval_pdf(wo, s.wi);
+    return LeafDraw(s, true);
+}
+
+// `draw` finished with `fp`, the mixture's f·cos and density in its direction: a
+// continuous sample weighed against every leaf (one-sample MIS, SurfaceBsdf::sample).
+fn phys_finish(draw: LeafDraw, fp: vec4<f32>) -> PhysSample {
+    if (!draw.mis) {
+        return draw.s;
+    }
     if (fp.w <= 0.0) {
         return no_sample();
     }
+    var s = draw.s;
     s.weight = fp.xyz / fp.w;
     s.pdf = fp.w;
     return s;
+}
+
+// f·|cos θi| (xyz) and the density (w) for world directions (SurfaceBsdf::eval_pdf), in two
+// directions, each where asked for (the path loop's light sample and BSDF sample), from one
+// call site of the families' evaluation (see `phys_draw`).
+fn phys_eval_pdf_pair(wo: vec3<f32>, a: vec3<f32>, want_a: bool, b: vec3<f32>, want_b: bool) -> array<vec4<f32>, 2> {
+    var out = array<vec4<f32>, 2>(vec4<f32>(0.0), vec4<f32>(0.0));
+    let directions = array<vec3<f32>, 2>(a, b);
+    let wanted = array<bool, 2>(want_a, want_b);
+    for (var d = 0u; d < 2u; d += 1u) {
+        if (!wanted[d]) {
+            continue;
+        }
+        var sum = vec4<f32>(0.0);
+        for (var i = 0u; i < leaf_count; i += 1u) {
+            sum += leaf_eval_pdf(i, wo, directions[d]) * leaves[i].weight;
+        }
+        out[d] = sum;
+    }
+    return out;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -1220,8 +1251,11 @@ fn probe(@builtin(global_invocation_id) id: vec3<u32>) {
     let wo = accum[b + 10u].xyz;
     let wi = accum[b + 11u].xyz;
     resolve_bsdf(bitcast<u32>(head.x), surf, wo);
-    let fp = phys_eval_pdf(wo, wi);
-    let s = phys_sample(wo, head.y, head.zw);
+    // As the path loop does it: one draw, both directions evaluated in one pass.
+    let draw = phys_draw(wo, head.y, head.zw);
+    let pair = phys_eval_pdf_pair(wo, wi, true, draw.s.wi, draw.mis);
+    let fp = pair[0];
+    let s = phys_finish(draw, pair[1]);
     var flags = 0u;
     if (s.valid) {
         flags |= 1u;
