@@ -974,15 +974,52 @@ fn a_mitsuba_scene_renders_with_its_own_settings_unless_flags_say_otherwise() {
 
 #[cfg(feature = "gpu")]
 #[test]
-fn the_gpu_refuses_mitsubas_materials_by_name() {
+fn the_gpu_renders_mitsubas_materials_as_the_cpu_does() {
+    // Mitsuba's default conductor on a rectangle under a constant white sky: the middle of
+    // the image is the same constant on either device, and the edges, where the filter
+    // mixes sky and metal at random, agree on average (to 1e-4 at 1024 spp).
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("m.xml"), MITSUBA_XML).unwrap();
     let result = glint_in(
         dir.path(),
-        &["render", "m.xml", "-o", "g.exr", "--device", "gpu"],
+        &[
+            "render", "m.xml", "-o", "g.exr", "--device", "gpu", "--spp", "256",
+        ],
     );
-    assert_exit(&result, 2);
     let log = stderr(&result);
-    assert!(log.contains("conductor"), "{log}");
-    assert!(!dir.path().join("g.exr").exists());
+    if result.status.code() == Some(1) && log.contains("no GPU adapter") {
+        assert!(
+            std::env::var_os("CI").is_none_or(|v| v.is_empty() || v == "0"),
+            "CI is set but there is no Vulkan adapter: {log}"
+        );
+        println!("SKIPPED (no Vulkan adapter): {log}");
+        return;
+    }
+    assert_exit(&result, 0);
+    assert_exit(
+        &glint_in(
+            dir.path(),
+            &["render", "m.xml", "-o", "c.exr", "--spp", "256"],
+        ),
+        0,
+    );
+    let read = |name: &str| image::open(dir.path().join(name)).unwrap().into_rgb32f();
+    let (gpu, cpu) = (read("g.exr"), read("c.exr"));
+    assert_eq!(gpu.dimensions(), (12, 8));
+    for (x, y) in [(5, 3), (6, 3), (5, 4), (6, 4)] {
+        let (g, c) = (gpu.get_pixel(x, y).0, cpu.get_pixel(x, y).0);
+        for k in 0..3 {
+            assert!(
+                (g[k] - c[k]).abs() < 1e-4,
+                "({x}, {y}): GPU {g:?}, CPU {c:?}"
+            );
+        }
+        // The metal, not the sky.
+        assert!(c[2] < 0.99, "({x}, {y}): CPU {c:?}");
+    }
+    let mean = |image: &image::Rgb32FImage| {
+        image.pixels().map(|p| p.0.iter().sum::<f32>()).sum::<f32>() / (3.0 * 96.0)
+    };
+    let (g, c) = (mean(&gpu), mean(&cpu));
+    assert!((g - c).abs() < 0.01 * c, "image means: GPU {g}, CPU {c}");
 }
