@@ -13,26 +13,7 @@ use glint_render::{
     BsdfNode, Color, Image, Param, PhysicalParts, TexelFilter, TextureKind, TextureNode, Vec3,
     Wrap, IDENTITY_UV,
 };
-use probe::{check_trees, parts_with};
-
-/// A 5 x 3 image of distinct colours.
-fn colours() -> Image {
-    let texels = (0..15)
-        .map(|i| {
-            let i = i as f32;
-            Color::new(
-                0.1 + 0.05 * i,
-                0.9 - 0.04 * i,
-                0.3 + 0.3 * (i * 0.7).sin().abs(),
-            )
-        })
-        .collect();
-    Image {
-        width: 5,
-        height: 3,
-        texels,
-    }
-}
+use probe::{bitmap, check_trees, colours, parts_with};
 
 /// A 4 x 4 tangent-space normal map (raw values (n + 1) / 2) of tilted normals.
 fn normals() -> Image {
@@ -47,18 +28,6 @@ fn normals() -> Image {
         width: 4,
         height: 4,
         texels,
-    }
-}
-
-fn bitmap(image: u32, filter: TexelFilter, wrap: [Wrap; 2]) -> TextureNode {
-    TextureNode {
-        kind: TextureKind::Bitmap {
-            image,
-            filter,
-            wrap,
-        },
-        to_uv: IDENTITY_UV,
-        uv_set: 0,
     }
 }
 

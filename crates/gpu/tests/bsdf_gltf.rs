@@ -13,31 +13,12 @@ mod probe;
 use common::gpu;
 use glint_render::{
     BsdfNode, Color, GltfAlphaMode, GltfParams, Image, Param, PhysicalParts, TexelFilter,
-    TextureKind, TextureNode, Vec3, Wrap, IDENTITY_UV,
+    TextureKind, TextureNode, Vec3, Wrap,
 };
-use probe::{check_trees, parts_with};
+use probe::{bitmap, check_trees, colours, parts_with};
 
 /// Cases per tree.
 const CASES: usize = 128;
-
-/// A 5 x 3 image of distinct colours in (0, 1).
-fn colours() -> Image {
-    let texels = (0..15)
-        .map(|i| {
-            let i = i as f32;
-            Color::new(
-                0.1 + 0.05 * i,
-                0.9 - 0.04 * i,
-                0.3 + 0.3 * (i * 0.7).sin().abs(),
-            )
-        })
-        .collect();
-    Image {
-        width: 5,
-        height: 3,
-        texels,
-    }
-}
 
 /// A 4 x 4 tangent-space normal map (raw values (n + 1) / 2) of tilted normals.
 fn normals() -> Image {
@@ -64,18 +45,6 @@ fn greys() -> Image {
         width: 3,
         height: 3,
         texels,
-    }
-}
-
-fn bitmap(image: u32, filter: TexelFilter, wrap: [Wrap; 2]) -> TextureNode {
-    TextureNode {
-        kind: TextureKind::Bitmap {
-            image,
-            filter,
-            wrap,
-        },
-        to_uv: IDENTITY_UV,
-        uv_set: 0,
     }
 }
 

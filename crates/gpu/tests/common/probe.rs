@@ -17,8 +17,8 @@ use glint_gpu::{GpuRenderer, ProbeCase, ProbeResult};
 use glint_render::bench::{prepare_rough_plastics, Frame, PhysicalSurface, SurfaceBsdf};
 use glint_render::RoughPlastic;
 use glint_render::{
-    Background, Camera, Color, Image, Material, PhysicalParts, Projection, SceneParts,
-    TexturePoint, Vec3,
+    Background, Camera, Color, Image, Material, PhysicalParts, Projection, SceneParts, TexelFilter,
+    TextureKind, TextureNode, TexturePoint, Vec3, Wrap, IDENTITY_UV,
 };
 
 pub const REL: f32 = 2e-3;
@@ -262,4 +262,35 @@ pub fn check_trees(
         "{test}: the negative control passed ({} cases differ): the rule cannot tell",
         control.len()
     );
+}
+
+/// A 5 x 3 image of distinct colours.
+pub fn colours() -> Image {
+    let texels = (0..15)
+        .map(|i| {
+            let i = i as f32;
+            Color::new(
+                0.1 + 0.05 * i,
+                0.9 - 0.04 * i,
+                0.3 + 0.3 * (i * 0.7).sin().abs(),
+            )
+        })
+        .collect();
+    Image {
+        width: 5,
+        height: 3,
+        texels,
+    }
+}
+
+pub fn bitmap(image: u32, filter: TexelFilter, wrap: [Wrap; 2]) -> TextureNode {
+    TextureNode {
+        kind: TextureKind::Bitmap {
+            image,
+            filter,
+            wrap,
+        },
+        to_uv: IDENTITY_UV,
+        uv_set: 0,
+    }
 }
