@@ -19,7 +19,7 @@ use crate::physical::{PhysicalBuffer, SPHERE_MITSUBA_UV};
 use glint_render::{
     Background, Camera, Color, ColorSource, CubeDistribution, FilterSampler, Image,
     LatLongDistribution, Light, LightSelection, Material, PixelFilter, Projection, SceneParts,
-    Shape, TextureKind, TexturePoint, Transform, Vec3,
+    Shape, Transform, Vec3,
 };
 
 pub use crate::words::{bits, NONE};
@@ -883,7 +883,11 @@ impl LightTables {
                     w[0] = [
                         bits(LIGHT_PROJECTOR),
                         bits(*irradiance),
-                        texture_aspect(parts, *irradiance),
+                        glint_render::texture_aspect(
+                            &parts.physical.textures,
+                            &parts.textures,
+                            *irradiance,
+                        ),
                         0.0,
                     ];
                     w[1] = v4(to_world.point_to_world(Vec3::ZERO), *scale);
@@ -909,11 +913,25 @@ impl LightTables {
                     ..
                 } => LightSelection::projector_power(
                     *fov,
-                    texture_aspect(parts, *irradiance),
-                    *scale * texture_mean(parts, *irradiance),
+                    glint_render::texture_aspect(
+                        &parts.physical.textures,
+                        &parts.textures,
+                        *irradiance,
+                    ),
+                    *scale
+                        * glint_render::texture_mean(
+                            &parts.physical.textures,
+                            &parts.textures,
+                            *irradiance,
+                        ),
                 ),
                 Light::TexturedTriangles { texture, .. } => {
-                    LightSelection::power(light, triangles_area) * texture_mean(parts, *texture)
+                    LightSelection::power(light, triangles_area)
+                        * glint_render::texture_mean(
+                            &parts.physical.textures,
+                            &parts.textures,
+                            *texture,
+                        )
                 }
                 _ => LightSelection::power(light, triangles_area),
             });
@@ -969,47 +987,6 @@ impl LightTables {
             textured,
         }
     }
-}
-
-/// Texture `node` of `PhysicalParts::textures` at (u, v), black for a node out of range (the
-/// CPU light sampler's `texture_value`).
-fn texture_value(parts: &SceneParts, node: u32, uv: (f32, f32)) -> Color {
-    match parts.physical.textures.get(node as usize) {
-        Some(texture) => texture.eval(
-            &parts.textures,
-            &TexturePoint {
-                uv,
-                ..TexturePoint::default()
-            },
-        ),
-        None => Color::ZERO,
-    }
-}
-
-/// Width / height of texture `node` (the CPU light sampler's `texture_aspect`).
-fn texture_aspect(parts: &SceneParts, node: u32) -> f32 {
-    match parts.physical.textures.get(node as usize).map(|t| &t.kind) {
-        Some(TextureKind::Bitmap { image, .. }) => match parts.textures.get(*image as usize) {
-            Some(image) if image.width > 0 && image.height > 0 => {
-                image.width as f32 / image.height as f32
-            }
-            _ => 1.0,
-        },
-        _ => 1.0,
-    }
-}
-
-/// Texture `node`'s mean over its uv square (the CPU light sampler's `texture_mean`).
-fn texture_mean(parts: &SceneParts, node: u32) -> f32 {
-    const N: usize = 16;
-    let mut sum = 0.0f64;
-    for i in 0..N {
-        for j in 0..N {
-            let uv = ((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
-            sum += mean(texture_value(parts, node, uv).max(Color::ZERO)) as f64;
-        }
-    }
-    (sum / (N * N) as f64) as f32
 }
 
 /// A binary BVH over the primitives' bounds, binned SAH (pbrt-v4's `BVHAggregate` with

@@ -92,6 +92,7 @@ pub use integrator::path::FilterSampler;
 pub use light::sampler::CubeDistribution;
 pub use light::sampler::LatLongDistribution;
 pub use light::sampler::LightSelection;
+pub use light::sampler::{texture_aspect, texture_mean};
 pub use light::Light;
 pub use material::physical::{
     BsdfId, BsdfNode, DistributionKind, GltfAlphaMode, GltfParams, Param, PrincipledParams,

@@ -33,7 +33,7 @@ use crate::sampling::warp::{
 };
 use crate::scene::{Background, Scene};
 use crate::texture::CubeMap;
-use crate::texture::{Image, TexturePoint};
+use crate::texture::{Image, TextureNode, TexturePoint};
 use rayon::prelude::*;
 
 use std::f32::consts::PI;
@@ -417,7 +417,7 @@ impl LightSampler {
                     irradiance: *irradiance,
                     scale: *scale,
                     cot: 1.0 / (0.5 * fov.to_radians()).tan(),
-                    aspect: texture_aspect(scene, *irradiance),
+                    aspect: texture_aspect(&scene.physical.textures, &scene.textures, *irradiance),
                 },
             };
             lights.push(prepared);
@@ -432,11 +432,12 @@ impl LightSampler {
                     ..
                 } => LightSelection::projector_power(
                     *fov,
-                    texture_aspect(scene, *irradiance),
-                    *scale * texture_mean(scene, *irradiance),
+                    texture_aspect(&scene.physical.textures, &scene.textures, *irradiance),
+                    *scale * texture_mean(&scene.physical.textures, &scene.textures, *irradiance),
                 ),
                 Light::TexturedTriangles { texture, .. } => {
-                    LightSelection::power(light, triangles_area) * texture_mean(scene, *texture)
+                    LightSelection::power(light, triangles_area)
+                        * texture_mean(&scene.physical.textures, &scene.textures, *texture)
                 }
                 _ => LightSelection::power(light, triangles_area),
             });
@@ -1110,9 +1111,14 @@ fn delta_sample(
 /// `TextureNode::eval` reads them); black for a node out of range.
 #[inline]
 fn texture_value(scene: &Scene, node: u32, uv: (f32, f32)) -> Color {
-    match scene.physical.textures.get(node as usize) {
+    node_value(&scene.physical.textures, &scene.textures, node, uv)
+}
+
+#[inline]
+fn node_value(nodes: &[TextureNode], images: &[Image], node: u32, uv: (f32, f32)) -> Color {
+    match nodes.get(node as usize) {
         Some(texture) => texture.eval(
-            &scene.textures,
+            images,
             &TexturePoint {
                 uv,
                 ..TexturePoint::default()
@@ -1122,12 +1128,13 @@ fn texture_value(scene: &Scene, node: u32, uv: (f32, f32)) -> Color {
     }
 }
 
-/// Width / height of texture `node`, as Mitsuba's `Texture::resolution` gives it: the
-/// image's for a bitmap, 1 for the others.
-fn texture_aspect(scene: &Scene, node: u32) -> f32 {
+/// Width / height of texture `node` of `nodes` (over `images`), as Mitsuba's
+/// `Texture::resolution` gives it: the image's for a bitmap, 1 for the others. Public for the
+/// GPU back end, which sets up projectors with it.
+pub fn texture_aspect(nodes: &[TextureNode], images: &[Image], node: u32) -> f32 {
     use crate::texture::TextureKind;
-    match scene.physical.textures.get(node as usize).map(|t| &t.kind) {
-        Some(TextureKind::Bitmap { image, .. }) => match scene.textures.get(*image as usize) {
+    match nodes.get(node as usize).map(|t| &t.kind) {
+        Some(TextureKind::Bitmap { image, .. }) => match images.get(*image as usize) {
             Some(image) if image.width > 0 && image.height > 0 => {
                 image.width as f32 / image.height as f32
             }
@@ -1137,14 +1144,15 @@ fn texture_aspect(scene: &Scene, node: u32) -> f32 {
     }
 }
 
-/// Texture `node`'s mean over its uv square (channel mean), for the light's power.
-fn texture_mean(scene: &Scene, node: u32) -> f32 {
+/// Texture `node`'s mean over its uv square (channel mean), for the power of a light that
+/// reads it. Public for the GPU back end, whose light selection must be the CPU's.
+pub fn texture_mean(nodes: &[TextureNode], images: &[Image], node: u32) -> f32 {
     const N: usize = 16;
     let mut sum = 0.0f64;
     for i in 0..N {
         for j in 0..N {
             let uv = ((i as f32 + 0.5) / N as f32, (j as f32 + 0.5) / N as f32);
-            sum += mean(texture_value(scene, node, uv).max(Color::ZERO)) as f64;
+            sum += mean(node_value(nodes, images, node, uv).max(Color::ZERO)) as f64;
         }
     }
     (sum / (N * N) as f64) as f32
