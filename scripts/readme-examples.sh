@@ -66,6 +66,7 @@ mapfile -t commands < <(awk '/^```sh$/ {inside = 1; next} /^```$/ {inside = 0} i
 not_run_reason() {
   case "$1" in
     "cargo test --workspace"* | scripts/test-all.sh*) echo "the test suite itself (CI runs it)" ;;
+    "crates/gpu/ci.sh test"*) echo "the GPU tests, which cargo test --workspace runs" ;;
     *"-- bench table"*) echo "a benchmark of several minutes" ;;
     bench/embree_compare.sh*) echo "needs native Embree 3, libembree-dev (see bench/README.md)" ;;
     farm/slurm/submit.sh*) echo "needs a Slurm cluster (farm/ci.sh test starts one and runs it)" ;;

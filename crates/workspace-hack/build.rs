@@ -1,0 +1,3 @@
+// Present so that Cargo resolves this crate's build-dependencies (syn's features for the proc
+// macros); it does nothing.
+fn main() {}
