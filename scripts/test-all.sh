@@ -49,6 +49,8 @@ fi
 logs=$(mktemp -d)
 trap 'rm -rf "$logs"' EXIT
 declare -A result
+# Seconds each suite took, for the summary: CI's time limit is what they add up to.
+declare -A took
 
 # Totals from the `test result:` lines cargo prints, one per test binary.
 cargo_totals() {
@@ -77,62 +79,78 @@ print(s.submodule_search_locations[0] + "/oidn/lib/libOpenImageDenoise.so.2" if 
 fi
 
 echo "== cargo test --workspace"
+t0=$SECONDS
 status=0
 cargo test --workspace --locked --no-fail-fast 2>&1 | tee "$logs/cargo.log" || status=$?
 result[cargo]="$(cargo_totals "$logs/cargo.log")$([ "$status" = 0 ] || echo " (exit $status)")"
+took[cargo]=$((SECONDS - t0))
 failed=$status
 
 echo "== course images bit for bit (scripts/same-images.sh)"
+t0=$SECONDS
 status=0
 scripts/same-images.sh 2>&1 | tee "$logs/same-images.log" || status=$?
 result[same-images]=$(tail -n 1 "$logs/same-images.log")
+took[same-images]=$((SECONDS - t0))
 [ "$status" = 0 ] || failed=1
 
 echo "== Mitsuba's test suite by its rule (scripts/mitsuba-suite.sh)"
+t0=$SECONDS
 status=0
 scripts/mitsuba-suite.sh 2>&1 | tee "$logs/mitsuba.log" || status=$?
 result[mitsuba-suite]=$(tail -n 1 "$logs/mitsuba.log")
+took[mitsuba-suite]=$((SECONDS - t0))
 [ "$status" = 0 ] || failed=1
 
 echo "== Mitsuba's test suite on the GPU by its rule (scripts/mitsuba-suite.sh --device gpu)"
+t0=$SECONDS
 status=0
 # A quarter of the rule's samples (at least 64 a pixel, mitsuba_suite.rs): software Vulkan on
 # CI's two cores would otherwise take a quarter of an hour here; the Z-test is computed with
 # the samples taken.
 GLINT_SUITE_SAMPLE_BUDGET=500000 scripts/mitsuba-suite.sh --device gpu 2>&1 | tee "$logs/mitsuba-gpu.log" || status=$?
 result[mitsuba-suite-gpu]=$(tail -n 1 "$logs/mitsuba-gpu.log")
+took[mitsuba-suite-gpu]=$((SECONDS - t0))
 [ "$status" = 0 ] || failed=1
 
 echo "== SIMD intrinsics inlined in the release glint (scripts/inlined-intrinsics.sh)"
+t0=$SECONDS
 status=0
 scripts/inlined-intrinsics.sh 2>&1 | tee "$logs/intrinsics.log" || status=$?
 result[intrinsics]=$(tail -n 1 "$logs/intrinsics.log")
+took[intrinsics]=$((SECONDS - t0))
 [ "$status" = 0 ] || failed=1
 
 echo "== README examples in a fresh clone (scripts/readme-examples.sh)"
+t0=$SECONDS
 status=0
 CARGO_TARGET_DIR="$root/target" scripts/readme-examples.sh 2>&1 | tee "$logs/readme.log" || status=$?
 result[readme]=$(tail -n 1 "$logs/readme.log")
+took[readme]=$((SECONDS - t0))
 [ "$status" = 0 ] || failed=1
 
 echo "== README as a newcomer: a fresh clone, no ../shared (scripts/readme-examples.sh --newcomer)"
+t0=$SECONDS
 status=0
 CARGO_TARGET_DIR="$root/target" scripts/readme-examples.sh --newcomer 2>&1 | tee "$logs/newcomer.log" || status=$?
 result[newcomer]=$(tail -n 1 "$logs/newcomer.log")
+took[newcomer]=$((SECONDS - t0))
 [ "$status" = 0 ] || failed=1
 
 for suite in "${SUITES[@]}"; do
   echo "== $suite test"
+  t0=$SECONDS
   status=0
   "$root/$suite" test 2>&1 | tee "$logs/suite.log" || status=$?
   result[$suite]="$(tail -n 1 "$logs/suite.log")$([ "$status" = 0 ] || echo " (exit $status)")"
+  took[$suite]=$((SECONDS - t0))
   [ "$status" = 0 ] || failed=1
 done
 
 echo
 echo "== summary"
 for name in cargo same-images mitsuba-suite mitsuba-suite-gpu intrinsics readme newcomer "${SUITES[@]}"; do
-  printf '%-26s %s\n' "$name" "${result[$name]}"
+  printf '%-26s %5s s  %s\n' "$name" "${took[$name]}" "${result[$name]}"
 done
 if [ "$failed" != 0 ]; then
   echo "FAILED" >&2
