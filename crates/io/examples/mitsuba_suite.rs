@@ -49,7 +49,7 @@ fn samples_per_pixel(budget: u64, pixels: u64) -> u32 {
 
 /// The samples per scene: the rule's 2,000,000, or `GLINT_SUITE_SAMPLE_BUDGET`. Fewer samples
 /// widen the Z-test's acceptance honestly (it is computed with the samples taken), so a
-/// smaller budget is a weaker test, never a looser rule; scripts/test-all.sh uses 500,000 for
+/// smaller budget is a weaker test, never a looser rule; scripts/test-all.sh uses 250,000 for
 /// the GPU mode on software Vulkan, which would otherwise take most of CI's time.
 fn sample_budget() -> Result<u64, String> {
     match std::env::var("GLINT_SUITE_SAMPLE_BUDGET") {
