@@ -10,45 +10,18 @@ mod probe;
 
 use common::gpu;
 use glint_render::{
-    BsdfNode, Color, DistributionKind, Image, Param, PhysicalParts, Roughness, TexelFilter,
-    TextureKind, TextureNode, Wrap, IDENTITY_UV,
+    BsdfNode, Color, DistributionKind, Param, PhysicalParts, Roughness, TexelFilter, TextureKind,
+    TextureNode, Wrap,
 };
-use probe::{check_trees, parts_with};
+use probe::{bitmap, check_trees, colours, parts_with};
 
 /// Random cases per tree.
 const CASES: usize = 128;
 
-/// A 5 x 3 image of distinct colours in (0, 1).
-fn colours() -> Image {
-    let texels = (0..15)
-        .map(|i| {
-            let i = i as f32;
-            Color::new(
-                0.1 + 0.05 * i,
-                0.9 - 0.04 * i,
-                0.3 + 0.3 * (i * 0.7).sin().abs(),
-            )
-        })
-        .collect();
-    Image {
-        width: 5,
-        height: 3,
-        texels,
-    }
-}
-
 /// 0: the image, bilinear; 1: a checkerboard whose luminances (0.35, 0.15) make roughnesses.
 fn textures() -> Vec<TextureNode> {
     vec![
-        TextureNode {
-            kind: TextureKind::Bitmap {
-                image: 0,
-                filter: TexelFilter::Bilinear,
-                wrap: [Wrap::Repeat, Wrap::Mirror],
-            },
-            to_uv: IDENTITY_UV,
-            uv_set: 0,
-        },
+        bitmap(0, TexelFilter::Bilinear, [Wrap::Repeat, Wrap::Mirror]),
         TextureNode {
             kind: TextureKind::Checkerboard {
                 color0: Color::new(0.3, 0.35, 0.4),

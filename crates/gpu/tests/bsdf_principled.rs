@@ -15,47 +15,19 @@ mod probe;
 use common::gpu;
 use glint_gpu::ProbeCase;
 use glint_render::{
-    BsdfNode, Color, Image, Param, PhysicalParts, PrincipledParams, TexelFilter, TextureKind,
-    TextureNode, Wrap, IDENTITY_UV,
+    BsdfNode, Color, Param, PhysicalParts, PrincipledParams, TexelFilter, TextureKind, TextureNode,
+    Wrap, IDENTITY_UV,
 };
-use probe::{cases, mismatches, parts_with, MAX_MISMATCH};
+use probe::{bitmap, cases, colours, mismatches, parts_with, MAX_MISMATCH};
 
 /// Cases per tree.
 const CASES: usize = 96;
 
-/// A 5 x 3 image of distinct colours, luminances between about 0.3 and 0.7.
-fn colours() -> Image {
-    let texels = (0..15)
-        .map(|i| {
-            let i = i as f32;
-            Color::new(
-                0.1 + 0.05 * i,
-                0.9 - 0.04 * i,
-                0.3 + 0.3 * (i * 0.7).sin().abs(),
-            )
-        })
-        .collect();
-    Image {
-        width: 5,
-        height: 3,
-        texels,
-    }
-}
-
 /// Texture 0: the colours, bilinear; 1: a checkerboard of two greys (a float read as its
 /// luminance); 2: the colours, nearest, mirrored; 3: the vertex colour.
 fn textures() -> Vec<TextureNode> {
-    let bitmap = |filter, wrap| TextureNode {
-        kind: TextureKind::Bitmap {
-            image: 0,
-            filter,
-            wrap,
-        },
-        to_uv: IDENTITY_UV,
-        uv_set: 0,
-    };
     vec![
-        bitmap(TexelFilter::Bilinear, [Wrap::Repeat, Wrap::Repeat]),
+        bitmap(0, TexelFilter::Bilinear, [Wrap::Repeat, Wrap::Repeat]),
         TextureNode {
             kind: TextureKind::Checkerboard {
                 color0: Color::splat(0.15),
@@ -64,7 +36,7 @@ fn textures() -> Vec<TextureNode> {
             to_uv: [[3.0, 0.0, 0.0], [0.0, 3.0, 0.25]],
             uv_set: 0,
         },
-        bitmap(TexelFilter::Nearest, [Wrap::Mirror, Wrap::Mirror]),
+        bitmap(0, TexelFilter::Nearest, [Wrap::Mirror, Wrap::Mirror]),
         TextureNode {
             kind: TextureKind::MeshAttribute(glint_render::MeshAttribute::VertexColor),
             to_uv: IDENTITY_UV,
