@@ -10,26 +10,9 @@ mod probe;
 
 use common::gpu;
 use glint_render::{
-    BsdfNode, Color, Image, Param, PhysicalParts, TexelFilter, TextureKind, TextureNode, Vec3,
-    Wrap, IDENTITY_UV,
+    BsdfNode, Color, Param, PhysicalParts, TexelFilter, TextureKind, TextureNode, Wrap, IDENTITY_UV,
 };
-use probe::{bitmap, check_trees, colours, parts_with};
-
-/// A 4 x 4 tangent-space normal map (raw values (n + 1) / 2) of tilted normals.
-fn normals() -> Image {
-    let texels = (0..16)
-        .map(|i| {
-            let i = i as f32;
-            let n = Vec3::new(0.4 * (i * 1.3).sin(), 0.4 * (i * 0.7).cos(), 1.0).normalized();
-            (n + Vec3::ONE) * 0.5
-        })
-        .collect();
-    Image {
-        width: 4,
-        height: 4,
-        texels,
-    }
-}
+use probe::{bitmap, check_trees, colours, normal_map, parts_with};
 
 fn textures() -> Vec<TextureNode> {
     let mut transformed = bitmap(0, TexelFilter::Bilinear, [Wrap::Mirror, Wrap::Clamp]);
@@ -138,7 +121,7 @@ fn diffuse_wrappers_and_textures_agree_with_the_cpu() {
     let Some(gpu) = gpu("diffuse_wrappers_and_textures_agree_with_the_cpu") else {
         return;
     };
-    let images = vec![colours(), normals()];
+    let images = vec![colours(), normal_map(0.4)];
     let parts = parts_with(physical(0.5), images.clone());
     let altered = parts_with(physical(0.515), images);
     check_trees(

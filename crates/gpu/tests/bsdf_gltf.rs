@@ -13,28 +13,12 @@ mod probe;
 use common::gpu;
 use glint_render::{
     BsdfNode, Color, GltfAlphaMode, GltfParams, Image, Param, PhysicalParts, TexelFilter,
-    TextureKind, TextureNode, Vec3, Wrap,
+    TextureKind, TextureNode, Wrap,
 };
-use probe::{bitmap, check_trees, colours, parts_with};
+use probe::{bitmap, check_trees, colours, normal_map, parts_with};
 
 /// Cases per tree.
 const CASES: usize = 128;
-
-/// A 4 x 4 tangent-space normal map (raw values (n + 1) / 2) of tilted normals.
-fn normals() -> Image {
-    let texels = (0..16)
-        .map(|i| {
-            let i = i as f32;
-            let n = Vec3::new(0.5 * (i * 1.3).sin(), 0.5 * (i * 0.7).cos(), 1.0).normalized();
-            (n + Vec3::ONE) * 0.5
-        })
-        .collect();
-    Image {
-        width: 4,
-        height: 4,
-        texels,
-    }
-}
 
 /// A 3 x 3 grey image spanning [0, 1] (an alpha channel, as the loader makes one).
 fn greys() -> Image {
@@ -80,7 +64,7 @@ fn textures() -> Vec<TextureNode> {
 }
 
 fn images() -> Vec<Image> {
-    vec![colours(), normals(), greys()]
+    vec![colours(), normal_map(0.5), greys()]
 }
 
 /// An opaque, single-sided dielectric of base colour (0.8, 0.4, 0.2) to vary.

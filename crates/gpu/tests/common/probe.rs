@@ -283,6 +283,23 @@ pub fn colours() -> Image {
     }
 }
 
+/// A 4 x 4 tangent-space normal map (raw values (n + 1) / 2) of normals tilted by up to
+/// `tilt` in x and y before normalising.
+pub fn normal_map(tilt: f32) -> Image {
+    let texels = (0..16)
+        .map(|i| {
+            let i = i as f32;
+            let n = Vec3::new(tilt * (i * 1.3).sin(), tilt * (i * 0.7).cos(), 1.0).normalized();
+            (n + Vec3::ONE) * 0.5
+        })
+        .collect();
+    Image {
+        width: 4,
+        height: 4,
+        texels,
+    }
+}
+
 pub fn bitmap(image: u32, filter: TexelFilter, wrap: [Wrap; 2]) -> TextureNode {
     TextureNode {
         kind: TextureKind::Bitmap {
